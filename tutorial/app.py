@@ -1,0 +1,286 @@
+"""Run a project: build the world, attach controllers, simulate and show it.
+
+This is what Choreonoid does when it opens a ``.cnoid`` project, and what
+``rtt-run`` and the notebooks use.  Threads:
+
+* **main thread** (the one that creates the :class:`App`): owns the project's
+  bodies (over ``App.data``), the meshcat scene and the :class:`MainLoop`;
+  runs ``configure``/``unconfigure`` and every ``call_later`` call.
+* **spin thread** (:class:`tutorial.ros_env.SpinThread`): runs the node's
+  subscription callbacks.
+* **simulation thread** (:class:`tutorial.simulator.Simulator`, only when the
+  project has a simulator): owns the simulation's ``MjData``; the main thread
+  copies a snapshot of it once per frame to draw.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from typing import Callable
+
+import mujoco
+
+from tutorial.body import Body
+from tutorial.call_later import MainLoop
+from tutorial.controller import ControllerConfig
+from tutorial.project import Project, check_parameter
+from tutorial.simulator import Attachment, Simulator
+from tutorial.world import build_world
+
+DEFAULT_NODE_NAME = "rtt"
+FRAME_RATE = 60.0  # Hz, the most often the scene is redrawn
+GRAPH_CHECK_PERIOD = 2.0  # s, how often the node graph is checked for a twin name
+
+
+class ControllerError(RuntimeError):
+    """A controller refused a lifecycle step or raised."""
+
+
+class App:
+    """One running project.
+
+    Args:
+        project: the loaded project.
+        node: the ``rclpy`` node to use (its callbacks must be spun by the
+            caller), or None to create ``node_name`` and spin it here.
+        node_name: name of the node created when ``node`` is None.
+        headless: no meshcat server and scene.
+        realtime_sync: override the project's ``simulator.realtime_sync``.
+        duration: stop after this many seconds: simulated time when the
+            project simulates, wall-clock time otherwise (None: until stopped).
+        output: called with one dict per status line or event (main thread).
+        vis: an existing ``meshcat.Visualizer`` to draw in (notebooks),
+            instead of starting a server.
+
+    Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
+    becomes the owner of everything the main thread owns.
+    """
+
+    def __init__(self, project: Project, node=None, node_name: str = DEFAULT_NODE_NAME, headless: bool = False,
+                 realtime_sync: bool | None = None, duration: float | None = None,
+                 output: Callable[[dict], None] | None = None, vis=None):
+        self.project = project
+        self.node = node
+        self.node_name = node_name
+        self.headless = headless
+        self.realtime_sync = realtime_sync
+        self.duration = duration
+        self.output = output or (lambda record: print(record, flush=True))
+        self.vis = vis
+        self.loop = MainLoop()
+        self.log = logging.getLogger("rtt")
+        self.server = None
+        self.scene = None
+        self.sim: Simulator | None = None
+        self.spin = None
+        self._own_node = node is None
+        self.controllers: list[tuple[str, object, str]] = []  # (name, controller, body name)
+        self.configured: list[tuple[str, object]] = []
+        self.warned_duplicate = False
+        self._started = None
+        self._last_frame = 0.0
+        self._drawn_step = -1
+        self.stop_requested = False
+
+    # ---- lifecycle (owner thread) -------------------------------------------------
+    def open(self) -> "App":
+        """Build the world, configure the controllers, start simulation and view.
+
+        Raises:
+            ValueError: a model does not load.
+            ControllerError: a controller refused to configure or to start.
+        """
+        settings = self.project.simulator
+        kwargs = {} if settings is None else {"time_step": settings.time_step, "gravity": settings.gravity}
+        self.model = build_world(self.project.models, **kwargs)
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        self.bodies = {m.name: Body(self.model, self.data, m.name) for m in self.project.models}
+        if self.node is None:
+            from rclpy.node import Node
+
+            from tutorial.ros_env import SpinThread
+
+            self.node = Node(self.node_name)
+            self.spin = SpinThread(self.node)
+        for entry in self.project.models:
+            for c in entry.controllers:
+                self._configure(entry.name, c)
+        self.node_fqn = self.node.get_fully_qualified_name()
+        if self.spin is not None:
+            self.spin.start()
+        self.loop.call_every(GRAPH_CHECK_PERIOD, self.check_node_name)
+        if not self.headless:
+            self._open_view()
+        if settings is not None:
+            realtime = settings.realtime_sync if self.realtime_sync is None else self.realtime_sync
+            sim_data = mujoco.MjData(self.model)
+            mujoco.mj_forward(self.model, sim_data)
+            attachments = [Attachment(n, c, b) for n, c, b in self.controllers]
+            self.sim = Simulator(self.model, sim_data, attachments, node=self.node,
+                                 realtime_sync=realtime, duration=self.duration).start()
+        self._started = time.monotonic()
+        return self
+
+    def _configure(self, body_name: str, entry) -> None:
+        controller = entry.cls()
+        params = self._ros_parameters(entry)
+        config = ControllerConfig(
+            name=entry.name, body=self.bodies[body_name], node=self.node, parameters=params,
+            call_later=self.loop.call_later, call_every=self.loop.call_every, output=self.output,
+            log=logging.getLogger(f"rtt.{entry.name}"),
+        )
+        try:
+            ok = controller.configure(config)
+        except Exception as exc:
+            raise ControllerError(f"controller {entry.name} failed to configure: {exc!r}") from exc
+        if not ok:
+            raise ControllerError(f"controller {entry.name} refused to configure")
+        self.configured.append((entry.name, controller))
+        self.controllers.append((entry.name, controller, body_name))
+
+    def _ros_parameters(self, entry) -> dict:
+        """Declare the controller's parameters on the node: ``<controller>.<parameter>``.
+
+        The project's value is the default; ``--ros-args -p RttJointStatePublisher.rate:=100``
+        overrides it.  A wrong type is a ControllerError naming the parameter.
+        """
+        values = dict(entry.parameters)
+        for name, (typ, _default, description) in entry.cls.PARAMETERS.items():
+            full = f"{entry.name}.{name}"
+            from rcl_interfaces.msg import ParameterDescriptor
+
+            if not self.node.has_parameter(full):
+                self.node.declare_parameter(full, values[name], ParameterDescriptor(description=description),
+                                            ignore_override=False)
+            value = self.node.get_parameter(full).value
+
+            def fail(msg, full=full):
+                return ControllerError(f"parameter {full}: {msg}")
+
+            values[name] = check_parameter(full, typ, value, fail)
+        return values
+
+    def _open_view(self) -> None:
+        from tutorial.scene import Scene
+
+        if self.vis is None:
+            from tutorial.meshcat_server import start_server
+
+            self.server = start_server()
+            self.vis = self.server.visualizer()
+        self.scene = Scene(self.vis, self.model)
+        self.scene.build(self.data)
+        root = self.bodies[self.project.models[-1].name].root_pose()[0]
+        self.scene.set_camera(root + [-1.6, -1.6, 1.2], root)
+        self.output({"event": "meshcat", "node": self.node_fqn,
+                     "url": self.vis.url() if self.server is None else self.server.web_url})
+
+    def step(self, timeout: float = 1.0 / FRAME_RATE) -> bool:
+        """Run posted calls and draw one frame if one is due (owner thread).
+
+        Returns:
+            False when the app is done (duration reached, simulation ended or stop requested).
+        """
+        self.loop.run_once(timeout)
+        now = time.monotonic()
+        if now - self._last_frame >= 1.0 / FRAME_RATE:
+            self._last_frame = now
+            self._draw()
+        return not self.done()
+
+    def _draw(self) -> None:
+        if self.sim is not None:
+            snap = self.sim.snapshot()
+            if snap.step != self._drawn_step:
+                self._drawn_step = snap.step
+                self.data.qpos[:] = snap.qpos
+                self.data.time = snap.time
+                mujoco.mj_kinematics(self.model, self.data)
+        if self.scene is not None:
+            self.scene.update(self.data)
+
+    def done(self) -> bool:
+        if self.stop_requested:
+            return True
+        if self.sim is not None:
+            return self.sim.finished.is_set()
+        return self.duration is not None and time.monotonic() - self._started >= self.duration
+
+    def run(self) -> None:
+        """Step until done (owner thread); Ctrl-C propagates as KeyboardInterrupt."""
+        while self.step():
+            pass
+        self._draw()
+
+    def close(self) -> None:
+        """Stop the simulation, unconfigure the controllers, stop ROS and meshcat (owner thread)."""
+        if self.sim is not None:
+            self.sim.request_stop()
+            self.sim.join(5.0)
+        for name, controller in reversed(self.configured):
+            try:
+                controller.unconfigure()
+            except Exception as exc:  # noqa: BLE001 - close the rest anyway
+                self.log.error("controller %s failed to unconfigure: %r", name, exc)
+        self.configured.clear()
+        if self.spin is not None:
+            self.spin.stop()
+        if self._own_node and self.node is not None:
+            self.node.destroy_node()
+        if self.server is not None:
+            self.server.close()
+
+    # ---- monitoring ---------------------------------------------------------------
+    def check_node_name(self) -> None:
+        """Warn when another node on the graph has this node's name (main thread).
+
+        ROS 2 lets two nodes share a name, but tools cannot tell them apart and
+        their parameters collide: rename one with ``--ros-args -r __node:=NAME``.
+        """
+        me = (self.node.get_name(), self.node.get_namespace())
+        count = sum(1 for n in self.node.get_node_names_and_namespaces() if n == me)
+        if count > 1 and not self.warned_duplicate:
+            self.warned_duplicate = True
+            self.output({"event": "warning", "node": self.node_fqn,
+                         "message": f"{count} nodes are named {self.node_fqn}; "
+                                    "rename this one with --ros-args -r __node:=NAME"})
+        elif count <= 1:
+            self.warned_duplicate = False
+
+    def summary(self) -> dict:
+        """Exit summary: times, root poses and joint positions (owner thread, after run)."""
+        record: dict = {"event": "summary", "project": self.project.name,
+                        "node": getattr(self, "node_fqn", None)}
+        if self.sim is not None:
+            record.update(simulated_time=round(self.sim.steps * self.sim.time_step, 6),
+                          wall_time=round(self.sim.wall_time, 3),
+                          real_time_factor=round(self.sim.real_time_factor, 3),
+                          steps=self.sim.steps)
+            if self.sim.error:
+                record["error"] = self.sim.error
+        else:
+            record["wall_time"] = round(time.monotonic() - self._started, 3) if self._started else 0.0
+        bodies = {}
+        for entry in self.project.models:
+            body = self.bodies[entry.name]
+            if body.num_joints == 0 and not entry.controllers:
+                continue  # the room: nothing to report
+            pos, quat = body.root_pose()
+            w, x, y, z = (float(v) for v in quat)
+            bodies[entry.name] = {
+                "root_position": [round(float(v), 6) for v in pos],
+                "root_yaw": round(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)), 6),
+                "joint_positions": {k: round(v, 9) for k, v in body.joint_positions().items()},
+            }
+        record["bodies"] = bodies
+        controllers = {}
+        for name, controller, _ in self.controllers:
+            s = controller.summary()
+            if s:
+                controllers[name] = s
+        if controllers:
+            record["controllers"] = controllers
+        return record

@@ -1,0 +1,1 @@
+"""The tutorial's controllers, one per step (attached to bodies by project files)."""

@@ -1,0 +1,111 @@
+"""ROS 2 process set-up: localhost-only discovery by default, init and spin.
+
+ROS 2 Jazzy finds other nodes by multicast discovery.  Its reach is set by
+``ROS_AUTOMATIC_DISCOVERY_RANGE`` (``LOCALHOST``, ``SUBNET``, ``OFF``,
+``SYSTEM_DEFAULT``) and the group of nodes that see each other by
+``ROS_DOMAIN_ID`` (0-101).  This tutorial defaults to ``LOCALHOST``: its nodes
+only see nodes on the same machine.  That is the switch to flip for a real
+robot: ``export ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`` before starting.
+
+The variables are read by the middleware when ``rclpy.init`` creates a context,
+so :func:`use_localhost_by_default` must run before that; importing
+:mod:`tutorial` does it.
+"""
+
+from __future__ import annotations
+
+import os
+import threading
+from typing import MutableMapping, Sequence
+
+DISCOVERY_RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
+DEFAULT_DISCOVERY_RANGE = "LOCALHOST"
+
+
+def use_localhost_by_default(environ: MutableMapping[str, str] | None = None) -> str:
+    """Make localhost-only discovery the default unless the user chose otherwise.
+
+    Args:
+        environ: the environment to change; ``os.environ`` when None.
+
+    Returns:
+        The discovery range now in force (the user's, if one was set).
+
+    Any thread may call this, but it only matters before ``rclpy.init``.
+    """
+    env = os.environ if environ is None else environ
+    return env.setdefault(DISCOVERY_RANGE_VARIABLE, DEFAULT_DISCOVERY_RANGE)
+
+
+def discovery_summary() -> str:
+    """One line saying which ROS 2 peers this process can reach, for start-up logs."""
+    return "ROS 2 discovery: range={} domain={}".format(
+        os.environ.get(DISCOVERY_RANGE_VARIABLE, "SYSTEM_DEFAULT"),
+        os.environ.get("ROS_DOMAIN_ID", "0"),
+    )
+
+
+def init(args: Sequence[str] | None = None):
+    """Initialise rclpy for this process with localhost discovery by default.
+
+    Args:
+        args: the command line, ``--ros-args ...`` included (``sys.argv`` style).
+
+    Returns:
+        The command line with the ROS arguments removed, for argparse.
+
+    Call from the main thread, once per process (or once per ``try_shutdown``).
+    """
+    use_localhost_by_default()
+    import rclpy
+    from rclpy.utilities import remove_ros_args
+
+    rclpy.init(args=list(args) if args is not None else None)
+    return remove_ros_args(list(args) if args is not None else None)
+
+
+class SpinThread:
+    """Spins one node's callbacks on a background thread.
+
+    This is the analog of roscpp's ``AsyncSpinner``, which the original
+    tutorial relied on: subscription callbacks run on *this* thread, never on
+    the main thread or the simulation thread.  That is why a callback may not
+    touch state owned by another thread, and why Step 1 uses a lock and
+    Step 3 uses :func:`tutorial.call_later.call_later`.
+
+    Args:
+        node: the ``rclpy.node.Node`` whose callbacks to run.
+
+    ``start`` and ``stop`` are called from the thread that owns the node
+    (normally the main thread).
+    """
+
+    def __init__(self, node):
+        from rclpy.executors import SingleThreadedExecutor
+
+        self.node = node
+        # One thread, one executor: callbacks of this node never run in
+        # parallel with each other, only in parallel with the other threads.
+        self.executor = SingleThreadedExecutor(context=node.context)
+        self.executor.add_node(node)
+        self._thread = threading.Thread(target=self._spin, name="ros-spin", daemon=True)
+        self.error: BaseException | None = None
+
+    def _spin(self) -> None:
+        from rclpy.executors import ExternalShutdownException
+
+        try:
+            self.executor.spin()
+        except ExternalShutdownException:
+            pass
+        except BaseException as exc:  # noqa: BLE001 - kept for the owner to report
+            self.error = exc
+
+    def start(self) -> "SpinThread":
+        self._thread.start()
+        return self
+
+    def stop(self, timeout: float = 2.0) -> None:
+        """Stop spinning and wait for the thread (at most ``timeout`` s)."""
+        self.executor.shutdown(timeout_sec=timeout)
+        self._thread.join(timeout)

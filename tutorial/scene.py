@@ -1,0 +1,157 @@
+"""Draw a MuJoCo model in meshcat and move it from an ``MjData``.
+
+:class:`Scene` builds one meshcat object per visible geom, grouped under
+its body, once; afterwards a frame sends only the bodies whose world pose
+changed since the last frame (one ``set_transform`` each).  Static geoms
+(the room) are drawn once and never sent again.
+
+Geoms in group 3 and above are hidden, as in MuJoCo's own viewer (the tank's
+road wheels live there, inside the track covers).
+
+meshcat's connection is not thread-safe: a Scene belongs to the thread that
+created its visualizer, and only that thread may call its methods.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+HIDDEN_GEOM_GROUP = 3
+_PLANE_EXTENT = 20.0  # m, drawn size of an infinite plane
+# meshcat cylinders run along their local Y axis, MuJoCo's along Z.
+_Y_TO_Z = np.array([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]], dtype=float)
+
+
+def _pose(pos, mat) -> np.ndarray:
+    t = np.eye(4)
+    t[:3, :3] = np.asarray(mat).reshape(3, 3)
+    t[:3, 3] = pos
+    return t
+
+
+def _local_pose(pos, quat) -> np.ndarray:
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, np.asarray(quat, dtype=float))
+    return _pose(pos, mat)
+
+
+def _color(rgba) -> tuple[int, float]:
+    r, g, b, a = (float(x) for x in rgba)
+    return (int(r * 255) << 16) | (int(g * 255) << 8) | int(b * 255), a
+
+
+class Scene:
+    """A model drawn in one meshcat visualizer.
+
+    Args:
+        vis: a ``meshcat.Visualizer``; this Scene's thread must own it.
+        model: the ``MjModel`` to draw.
+        root: meshcat path under which everything is drawn.
+
+    Call :meth:`build` once, then :meth:`update` each frame.
+    """
+
+    def __init__(self, vis, model: mujoco.MjModel, root: str = "rtt"):
+        self.vis = vis
+        self.model = model
+        self.root = root
+        self.moving_bodies: list[int] = []
+        self._last: dict[int, np.ndarray] = {}
+        self.frames = 0
+        self.transforms_sent = 0
+
+    def body_path(self, body_id: int) -> str:
+        name = mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, body_id) or f"body{body_id}"
+        return f"{self.root}/{name}"
+
+    def build(self, data: mujoco.MjData) -> None:
+        """Create every visible geom; static ones are placed from ``data`` now."""
+        import meshcat.geometry as g
+
+        m = self.model
+        self.vis[self.root].delete()
+        self.vis["/Grid"].set_property("visible", False)  # our floor is the ground
+        moving = set()
+        for gid in range(m.ngeom):
+            if m.geom_group[gid] >= HIDDEN_GEOM_GROUP:
+                continue
+            body = int(m.geom_bodyid[gid])
+            static = m.body_weldid[body] == 0  # welded to the world: never moves
+            objects = self._geometry(g, gid)
+            if not objects:
+                continue
+            rgba = m.mat_rgba[m.geom_matid[gid]] if m.geom_matid[gid] >= 0 else m.geom_rgba[gid]
+            color, alpha = _color(rgba)
+            material = g.MeshLambertMaterial(color=color, opacity=alpha, transparent=alpha < 1.0)
+            if static:
+                base, parent = _pose(data.geom_xpos[gid], data.geom_xmat[gid]), f"{self.root}/static"
+            else:
+                base, parent = _local_pose(m.geom_pos[gid], m.geom_quat[gid]), self.body_path(body)
+                moving.add(body)
+            for k, (geometry, local) in enumerate(objects):
+                path = f"{parent}/geom{gid}" + (f"_{k}" if len(objects) > 1 else "")
+                self.vis[path].set_object(geometry, material)
+                self.vis[path].set_transform(base @ local)
+        self.moving_bodies = sorted(moving)
+        self._last.clear()
+        self.update(data)
+
+    def _geometry(self, g, gid: int) -> list:
+        """meshcat geometry objects with their poses in the geom frame."""
+        m = self.model
+        kind = m.geom_type[gid]
+        size = m.geom_size[gid]
+        eye = np.eye(4)
+        if kind == mujoco.mjtGeom.mjGEOM_BOX:
+            return [(g.Box(2 * size), eye)]
+        if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+            return [(g.Sphere(size[0]), eye)]
+        if kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
+            return [(g.Ellipsoid(size[:3]), eye)]
+        if kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            return [(g.Cylinder(2 * size[1], size[0]), _Y_TO_Z)]
+        if kind == mujoco.mjtGeom.mjGEOM_CAPSULE:
+            r, h = size[0], size[1]
+            ends = [np.eye(4), np.eye(4)]
+            ends[0][2, 3], ends[1][2, 3] = h, -h
+            return [(g.Cylinder(2 * h, r), _Y_TO_Z), (g.Sphere(r), ends[0]), (g.Sphere(r), ends[1])]
+        if kind == mujoco.mjtGeom.mjGEOM_PLANE:
+            sx = size[0] if size[0] > 0 else _PLANE_EXTENT / 2
+            sy = size[1] if size[1] > 0 else _PLANE_EXTENT / 2
+            t = np.eye(4)
+            t[2, 3] = -0.001
+            return [(g.Box([2 * sx, 2 * sy, 0.002]), t)]
+        if kind == mujoco.mjtGeom.mjGEOM_MESH:
+            mid = m.geom_dataid[gid]
+            v0, nv = m.mesh_vertadr[mid], m.mesh_vertnum[mid]
+            f0, nf = m.mesh_faceadr[mid], m.mesh_facenum[mid]
+            verts = np.array(m.mesh_vert[v0:v0 + nv])
+            faces = np.array(m.mesh_face[f0:f0 + nf])
+            return [(g.TriangularMeshGeometry(verts, faces), eye)]
+        return []  # heightfields, SDFs: not drawn
+
+    def update(self, data: mujoco.MjData) -> int:
+        """Send the poses of the bodies that moved; returns how many were sent.
+
+        ``data`` must hold current link poses (after ``mj_step`` or ``mj_kinematics``).
+        """
+        sent = 0
+        for b in self.moving_bodies:
+            pose = _pose(data.xpos[b], data.xmat[b])
+            last = self._last.get(b)
+            if last is not None and np.allclose(last, pose, rtol=0.0, atol=1e-7):
+                continue
+            self._last[b] = pose
+            self.vis[self.body_path(b)].set_transform(pose)
+            sent += 1
+        self.frames += 1
+        self.transforms_sent += sent
+        return sent
+
+    def set_camera(self, position, target=(0.0, 0.0, 0.0)) -> None:
+        """Place meshcat's default camera at ``position`` (m, world frame, Z up) looking at ``target``."""
+        x, y, z = (float(p) - float(t) for p, t in zip(position, target))
+        self.vis["/Cameras/default"].set_transform(_pose(target, np.eye(3)))
+        # meshcat's camera frame is Y-up: world (x, y, z) -> (x, z, -y)
+        self.vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
