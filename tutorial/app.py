@@ -220,14 +220,17 @@ class App:
         if self.sim is not None:
             self.sim.request_stop()
             self.sim.join(5.0)
+        if self.spin is not None:
+            self.spin.stop()
+        # Work handed over before the spin thread stopped still runs, so the
+        # last state received is the last state shown.
+        self.loop.process_pending()
         for name, controller in reversed(self.configured):
             try:
                 controller.unconfigure()
             except Exception as exc:  # noqa: BLE001 - close the rest anyway
                 self.log.error("controller %s failed to unconfigure: %r", name, exc)
         self.configured.clear()
-        if self.spin is not None:
-            self.spin.stop()
         if self._own_node and self.node is not None:
             self.node.destroy_node()
         if self.server is not None:

@@ -24,11 +24,14 @@ import sys
 from tutorial import ros_env
 from tutorial.app import DEFAULT_NODE_NAME, App, ControllerError
 from tutorial.project import ProjectError, load_project
+from tutorial.viewer_status import format_status
 
 
 def format_record(record: dict) -> str:
     """One status record as a human-readable line (or a few, for the summary)."""
     event = record.get("event")
+    if event in ("status", "stale", "recovered"):
+        return format_status(record, record.get("node", ""))
     if event == "meshcat":
         return f"[{record['node']}] meshcat: open {record['url']} in a browser"
     if event == "warning":
@@ -47,7 +50,7 @@ def format_record(record: dict) -> str:
             lines.append(f"{name}: " + ", ".join(f"{k}={v}" for k, v in s.items() if not isinstance(v, dict)))
             for k, v in s.items():
                 if isinstance(v, dict):
-                    lines.append(f"{name}: {k}: " + ", ".join(f"{a}={b}" for a, b in v.items()))
+                    lines.append(f"{name}: {k}: " + (", ".join(f"{a}={b}" for a, b in v.items()) or "none"))
         if record.get("error"):
             lines.append("ERROR:\n" + record["error"])
         return "\n".join(lines)

@@ -1,0 +1,23 @@
+"""Step 2: Step 1 plus the JointState publisher, and a plot of the turret joints.
+
+    python launch_py/step2_launch.py --demo
+"""
+
+import sys
+
+from _common import joy_node, simulation_node
+
+from tutorial.launch import LaunchDescription, Node, launch_parser, run
+
+
+def generate_launch_description(args) -> LaunchDescription:
+    plot_args = ["--output", "step2_plot.png"] if args.headless else []
+    return LaunchDescription([
+        joy_node(args),
+        simulation_node(args, "step2.yaml"),
+        Node("rtt_plot", "tutorial.plot_node", ["--body", "Tank", *plot_args]),
+    ])
+
+
+if __name__ == "__main__":
+    sys.exit(run(generate_launch_description(launch_parser(__doc__).parse_args())))

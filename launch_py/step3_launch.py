@@ -1,0 +1,24 @@
+"""Step 3: the simulation publishing joint state, the joystick, and a second,
+separately named viewer process (``rtt_viewer``) showing the joint state.
+
+    python launch_py/step3_launch.py --demo
+"""
+
+import sys
+
+from _common import PROJECT, joy_node, simulation_node
+
+from tutorial.launch import LaunchDescription, Node, launch_parser, run
+
+
+def generate_launch_description(args) -> LaunchDescription:
+    viewer_args = [str(PROJECT / "step3.yaml")] + (["--headless"] if args.headless else [])
+    return LaunchDescription([
+        joy_node(args),
+        simulation_node(args, "step2.yaml"),
+        Node("rtt_viewer", "tutorial.runner", viewer_args),
+    ])
+
+
+if __name__ == "__main__":
+    sys.exit(run(generate_launch_description(launch_parser(__doc__).parse_args())))

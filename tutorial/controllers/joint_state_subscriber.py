@@ -1,0 +1,84 @@
+"""Step 3: show a body's joint state received over ROS 2, in a second process.
+
+There is no simulation here: the controller does its work in ``configure``
+and ``unconfigure``, and the model it updates belongs to the main thread
+(it is what the viewer draws).  The subscription callback runs on the spin
+thread, so it must not touch the model.  It hands the message to the main
+thread with ``call_later`` and returns; the main thread then matches the
+joints, applies them and runs forward kinematics.
+
+``call_later`` coalesces: if messages arrive faster than the main thread
+draws, each new one replaces the one still waiting, so the view always
+shows the newest state and no backlog can build up.  The message object is
+handed over whole and nobody else keeps it, so no lock is needed for it.
+
+Received data is never trusted: :func:`tutorial.joint_matching.match_joint_state`
+decides what to apply, and the rejections are counted and reported.
+"""
+
+from __future__ import annotations
+
+from tutorial.controller import ControllerConfig, SimpleController
+from tutorial.controllers.joint_state_publisher import joint_state_qos, joint_state_topic
+from tutorial.joint_matching import match_joint_state
+from tutorial.viewer_status import ViewerStatus
+
+STATUS_PERIOD = 1.0  # s
+
+
+class RttJointStateSubscriber(SimpleController):
+    """Step 3 controller: subscribes ``/<body>/joint_state`` and poses the body to match."""
+
+    def configure(self, config: ControllerConfig) -> bool:
+        from sensor_msgs.msg import JointState
+
+        self.config = config
+        self.body = config.body
+        self.node = config.node
+        self.node_name = config.node.get_fully_qualified_name()
+        self.topic = joint_state_topic(config.body_name)
+        self.status = ViewerStatus(self.body.num_joints)
+        self.subscription = config.node.create_subscription(
+            JointState, self.topic, self.on_joint_state, joint_state_qos())
+        config.call_every(STATUS_PERIOD, self.report_status)
+        return True
+
+    # ---- spin thread ------------------------------------------------------------
+    def on_joint_state(self, msg) -> None:
+        """Subscription callback (spin thread): count it and hand it to the main thread."""
+        arrival = self.status.received()
+        self.config.call_later(self.update_joint_state, msg, arrival)
+
+    # ---- main thread --------------------------------------------------------------
+    def update_joint_state(self, msg, arrival: float):
+        """Apply one message to the model (main thread, via ``call_later``).
+
+        Returns:
+            the :class:`tutorial.joint_matching.MatchReport`.
+        """
+        report = match_joint_state(self.body.joint_infos, msg.name, msg.position)
+        for name, q in report.applied.items():
+            self.body.joint(name).q = q
+        self.body.notify_kinematic_state_change()
+        self.status.applied_message(arrival, report.matched, report.counts(), report.applied)
+        return report
+
+    def report_status(self) -> None:
+        for record in self.status.report():
+            record["node"] = self.node_name
+            self.config.output(record)
+
+    def unconfigure(self) -> None:
+        if self.subscription is not None:
+            self.node.destroy_subscription(self.subscription)
+            self.subscription = None
+
+    def summary(self) -> dict:
+        s = self.status
+        return {
+            "topic": self.topic,
+            "received": s.received_count(),
+            "applied": s.applied,
+            "rejected": dict(sorted(s.rejections.items())),
+            "last_positions": {k: round(v, 9) for k, v in s.last_positions.items()},
+        }
