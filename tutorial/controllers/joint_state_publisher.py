@@ -3,8 +3,9 @@
 ``control()`` runs every step (1 ms), but a subscriber needs far fewer
 states.  An accumulator adds the step to a clock and publishes each time a
 period has passed, carrying the remainder over, so the rate holds exactly on
-average.  It counts in integer nanoseconds: 0.001 s added twenty times is
-not 0.02 s in floating point, and a float accumulator slowly slips a step.
+average.  It counts in integer nanoseconds, so the comparison with the
+period is exact by construction: no floating-point rounding to reason about
+(0.001 added twenty times is not exactly 0.02 in binary floating point).
 
 Topic ``/<body name>/joint_state`` (``/Tank/joint_state``), type
 ``sensor_msgs/JointState``: one entry per numbered joint (see

@@ -147,9 +147,12 @@ class RttTankController(SimpleController):
         for i, (joint, rate) in enumerate(zip(self.turret, turret_rates(axes))):
             # The reference advances with the stick and stays inside the
             # joint's range, so holding the stick at a limit winds nothing up.
+            # The reference's rate is what it really moved: 0 at a limit.
             info = joint.info
-            self.q_ref[i] = min(max(self.q_ref[i] + rate * self.dt, info.lower), info.upper)
-            joint.u = pd_torque(self.q_ref[i], joint.q, rate, joint.dq)
+            q_ref = min(max(self.q_ref[i] + rate * self.dt, info.lower), info.upper)
+            dq_ref = (q_ref - self.q_ref[i]) / self.dt
+            self.q_ref[i] = q_ref
+            joint.u = pd_torque(q_ref, joint.q, dq_ref, joint.dq)
         return True
 
     def summary(self) -> dict:

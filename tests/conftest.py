@@ -1,0 +1,98 @@
+"""Test set-up: every ROS 2 participant of this session stays on this machine.
+
+``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` keeps discovery traffic on the
+loopback interface, and a ``ROS_DOMAIN_ID`` unique to this test session keeps
+it apart from any other session running here.  Both are set before rclpy is
+imported and are inherited by every process a test starts.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ["ROS_DOMAIN_ID"] = str(1 + (os.getpid() * 7919 + int(time.time())) % 100)
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+ROOT = Path(__file__).resolve().parent.parent
+PROJECT = ROOT / "project"
+MODEL = ROOT / "model"
+
+
+@pytest.fixture(scope="session")
+def ros():
+    """rclpy initialised once for the session's in-process tests."""
+    import rclpy
+
+    rclpy.init()
+    yield rclpy
+    rclpy.try_shutdown()
+
+
+@pytest.fixture
+def node(ros, request):
+    """A fresh node named after the test."""
+    n = ros.create_node("test_" + request.node.name.replace("[", "_").replace("]", "").replace("-", "_")[:40])
+    yield n
+    n.destroy_node()
+
+
+def module_command(module: str, *args: str) -> list[str]:
+    """``python -m module args`` with this interpreter."""
+    return [sys.executable, "-u", "-m", module, *args]
+
+
+class Proc:
+    """A child process whose output is collected; always killed at the end of the test."""
+
+    def __init__(self, cmd: list[str], **kw):
+        self.cmd = cmd
+        self.p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, **kw)
+        self.out = ""
+        self.err = ""
+
+    def wait(self, timeout: float) -> int:
+        try:
+            self.out, self.err = self.p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.p.kill()
+            self.out, self.err = self.p.communicate()
+            raise AssertionError(f"{self.cmd} did not finish in {timeout} s\n{self.out}\n{self.err}")
+        return self.p.returncode
+
+    def json_records(self) -> list[dict]:
+        return [json.loads(line) for line in self.out.splitlines() if line.startswith("{")]
+
+    def summary(self) -> dict:
+        records = [r for r in self.json_records() if r.get("event") == "summary"]
+        assert records, f"no summary from {self.cmd}:\n{self.out}\n{self.err}"
+        return records[-1]
+
+    def kill(self) -> None:
+        if self.p.poll() is None:
+            self.p.kill()
+            self.p.communicate()
+
+
+@pytest.fixture
+def procs():
+    """Start child processes with ``procs(cmd)``; any still running at the end are killed."""
+    started: list[Proc] = []
+
+    def start(cmd, **kw) -> Proc:
+        p = Proc(cmd, **kw)
+        started.append(p)
+        return p
+
+    yield start
+    for p in started:
+        p.kill()

@@ -1,0 +1,122 @@
+"""call_later: any thread posts, the owner thread runs, the newest state wins."""
+
+import threading
+
+import pytest
+
+from tutorial.call_later import LazyCaller, MainLoop, WrongThreadError
+
+
+def test_posted_calls_run_on_the_owner_thread_in_order():
+    loop = MainLoop()
+    ran = []
+    t = threading.Thread(target=lambda: [loop.call_later(ran.append, i, key=i) for i in range(3)])
+    t.start()
+    t.join(10)
+    assert ran == []  # posting never runs anything
+    assert loop.process_pending() == 3
+    assert ran == [0, 1, 2]
+
+
+def test_same_function_coalesces_newest_arguments_win():
+    loop = MainLoop()
+    seen = []
+
+    def update(state):
+        seen.append(state)
+
+    for k in range(100):
+        loop.call_later(update, k)
+    assert loop.pending() == 1
+    loop.process_pending()
+    assert seen == [99]
+    assert (loop.posted, loop.coalesced, loop.executed) == (100, 99, 1)
+
+
+def test_lazy_caller_coalesces():
+    loop = MainLoop()
+    seen = []
+    lazy = LazyCaller(loop, seen.append)
+    lazy(1)
+    lazy(2)
+    loop.process_pending()
+    lazy(3)
+    loop.process_pending()
+    assert seen == [2, 3]
+
+
+def test_only_the_owner_may_run_posted_calls():
+    loop = MainLoop()
+    errors = []
+
+    def other():
+        try:
+            loop.process_pending()
+        except WrongThreadError as exc:
+            errors.append(exc)
+
+    t = threading.Thread(target=other)
+    t.start()
+    t.join(10)
+    assert len(errors) == 1
+
+
+def test_an_error_in_a_call_does_not_stop_the_loop(capsys):
+    loop = MainLoop()
+    ran = []
+    loop.call_later(lambda: 1 / 0, key="bad")
+    loop.call_later(ran.append, "after", key="good")
+    loop.process_pending()
+    assert ran == ["after"]
+    assert len(loop.errors) == 1 and "ZeroDivisionError" in loop.errors[0]
+
+
+def test_no_backlog_under_a_flood_from_many_threads():
+    """Four threads post 20,000 states; the owner sees each thread's states in order and the queue never grows."""
+    loop = MainLoop()
+    errors: list[BaseException] = []
+    seen: dict[int, list[int]] = {i: [] for i in range(4)}
+    max_pending = 0
+
+    def update(thread_id, k):
+        seen[thread_id].append(k)
+
+    def flood(thread_id):
+        try:
+            for k in range(5000):
+                loop.call_later(update, thread_id, k, key=thread_id)
+        except BaseException as exc:  # noqa: BLE001
+            errors.append(exc)
+
+    threads = [threading.Thread(target=flood, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    while any(t.is_alive() for t in threads):
+        max_pending = max(max_pending, loop.pending())
+        loop.run_once(0.001)
+    for t in threads:
+        t.join(10)
+    loop.process_pending()
+    assert errors == []
+    assert max_pending <= 4  # one pending call per key, never a queue of states
+    for thread_id, states in seen.items():
+        assert states == sorted(states)  # never an older state after a newer one
+        assert states[-1] == 4999  # the newest state always arrives
+    assert loop.posted == 20000 and loop.executed + loop.coalesced == 20000
+
+
+def test_run_until_has_a_deadline():
+    loop = MainLoop()
+    assert loop.run_until(lambda: False, timeout=0.05) is False
+    loop.call_later(lambda: None)
+    assert loop.run_until(lambda: loop.executed == 1, timeout=5.0)
+
+
+def test_call_every_runs_on_schedule():
+    import time
+
+    loop = MainLoop()
+    ticks = []
+    loop.call_every(0.01, lambda: ticks.append(time.monotonic()))
+    loop.run_until(lambda: len(ticks) >= 3, timeout=5.0)
+    assert len(ticks) >= 3

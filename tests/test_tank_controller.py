@@ -1,0 +1,100 @@
+"""Step 1 controller: the math, the Joy convention, and bad input."""
+
+import math
+from types import SimpleNamespace
+
+import mujoco
+import pytest
+
+from tutorial.body import Body
+from tutorial.controller import ControllerIO
+from tutorial.controllers import tank_controller as tc
+from tutorial.world import ModelEntry, build_world
+from conftest import MODEL
+
+
+def axes(lh=0.0, lv=0.0, rh=0.0, rv=0.0):
+    return [lh, lv, rh, rv, 0.0, 0.0, 0.0, 0.0]
+
+
+def test_left_stick_up_drives_both_tracks_forward():
+    assert tc.track_velocities(axes(lv=1.0)) == (2.0, 2.0)
+
+
+def test_left_stick_left_turns_left():
+    left, right = tc.track_velocities(axes(lh=1.0))
+    assert left == -1.0 and right == 1.0  # right track faster: the tank turns left (counter-clockwise)
+
+
+def test_dead_zones_are_the_originals():
+    assert tc.track_velocities(axes(lv=0.19, lh=-0.19)) == (0.0, 0.0)
+    assert tc.track_velocities(axes(lv=0.2))[0] == pytest.approx(0.4)
+    assert tc.turret_rates(axes(rh=0.149, rv=-0.149)) == (0.0, 0.0)
+    assert tc.turret_rates(axes(rh=-0.15))[0] == pytest.approx(0.3)
+
+
+def test_turret_rate_is_0_002_rad_per_ms_at_full_stick():
+    yaw, pitch = tc.turret_rates(axes(rh=-1.0, rv=1.0))
+    assert yaw * 0.001 == pytest.approx(0.002)   # stick right: TURRET_Y reference grows (clockwise from above)
+    assert pitch * 0.001 == pytest.approx(-0.002)  # stick pushed forward: barrel goes down, as in the original
+
+
+def test_pd_torque_uses_the_original_gains():
+    assert tc.pd_torque(0.1, 0.0, 0.0, 0.0) == pytest.approx(20.0)
+    assert tc.pd_torque(0.0, 0.0, 0.0, 0.2) == pytest.approx(-10.0)
+
+
+@pytest.mark.parametrize("bad", [[], [0.5], [math.nan] * 8, [math.inf, -math.inf, 1e300, -1e300], [0.0] * 100])
+def test_bad_axes_never_raise_and_never_give_non_finite_commands(bad):
+    left, right = tc.track_velocities(bad)
+    yaw, pitch = tc.turret_rates(bad)
+    assert all(math.isfinite(v) and abs(v) <= 3.0 for v in (left, right))
+    assert all(math.isfinite(v) and abs(v) <= tc.TURRET_RATE for v in (yaw, pitch))
+
+
+def make_controller():
+    model = build_world([ModelEntry("Room", MODEL / "room.xml"), ModelEntry("Tank", MODEL / "tank.xml")])
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    controller = tc.RttTankController()
+    io = ControllerIO(body=Body(model, data, "Tank"), time_step=model.opt.timestep, node=None, data=data)
+    assert controller.initialize(io)
+    return controller, model, data
+
+
+def joy(axes_, buttons=(0,) * 8):
+    return SimpleNamespace(axes=list(axes_), buttons=list(buttons))
+
+
+def test_malformed_joy_is_counted_and_simulation_stays_finite():
+    controller, model, data = make_controller()
+    for msg in (joy([math.nan] * 8), joy([1.0]), joy([], []), joy(axes(lv=1.0), [1])):
+        controller.on_joy(msg)
+        for _ in range(50):
+            assert controller.control()
+            mujoco.mj_step(model, data)
+    assert controller.summary() == {"joy_received": 4, "joy_malformed": 4}
+    assert all(math.isfinite(v) for v in data.qpos)
+
+
+def test_full_stick_moves_the_tank_forward_and_the_turret():
+    controller, model, data = make_controller()
+    controller.on_joy(joy(axes(lv=0.5, rh=-0.5)))
+    x0 = data.qpos[0]
+    for _ in range(1000):
+        controller.control()
+        mujoco.mj_step(model, data)
+    body = Body(model, data, "Tank")
+    assert data.qpos[0] - x0 > 0.5
+    assert body.joint("TURRET_Y").q == pytest.approx(1.0, abs=0.1)  # 1 rad/s for 1 s
+
+
+def test_turret_reference_stays_inside_the_joint_range():
+    controller, model, data = make_controller()
+    controller.on_joy(joy(axes(rv=-1.0)))  # pull back: barrel up, held for 2 s
+    for _ in range(2000):
+        controller.control()
+        mujoco.mj_step(model, data)
+    pitch = Body(model, data, "Tank").joint("TURRET_P")
+    assert controller.q_ref[1] == pytest.approx(pitch.info.upper)
+    assert pitch.q == pytest.approx(pitch.info.upper, abs=0.02)
