@@ -52,21 +52,60 @@ def module_command(module: str, *args: str) -> list[str]:
 
 
 class Proc:
-    """A child process whose output is collected; always killed at the end of the test."""
+    """A child process whose output lines are collected as they come; killed at the end of the test."""
 
     def __init__(self, cmd: list[str], **kw):
+        import threading
+
         self.cmd = cmd
         self.p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, **kw)
-        self.out = ""
-        self.err = ""
+        self.lines: list[str] = []
+        self._cond = threading.Condition()
+        self._err: list[str] = []
+        self._threads = [threading.Thread(target=self._read, args=(self.p.stdout, self.lines), daemon=True),
+                         threading.Thread(target=self._read, args=(self.p.stderr, self._err), daemon=True)]
+        for t in self._threads:
+            t.start()
+
+    def _read(self, stream, sink) -> None:
+        for line in iter(stream.readline, ""):
+            with self._cond:
+                sink.append(line.rstrip("\n"))
+                self._cond.notify_all()
+        stream.close()
+
+    @property
+    def out(self) -> str:
+        with self._cond:
+            return "\n".join(self.lines)
+
+    @property
+    def err(self) -> str:
+        with self._cond:
+            return "\n".join(self._err)
+
+    def wait_for_line(self, predicate, timeout: float) -> str:
+        """The first output line for which ``predicate(line)`` is true; fails after ``timeout`` s."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while True:
+                for line in self.lines:
+                    if predicate(line):
+                        return line
+                left = deadline - time.monotonic()
+                if left <= 0 or (self.p.poll() is not None and not any(t.is_alive() for t in self._threads)):
+                    raise AssertionError(f"no such line from {self.cmd} in {timeout} s:\n{self.out}\n{self.err}")
+                self._cond.wait(min(left, 0.2))
 
     def wait(self, timeout: float) -> int:
         try:
-            self.out, self.err = self.p.communicate(timeout=timeout)
+            self.p.wait(timeout)
         except subprocess.TimeoutExpired:
             self.p.kill()
-            self.out, self.err = self.p.communicate()
+            self.p.wait()
             raise AssertionError(f"{self.cmd} did not finish in {timeout} s\n{self.out}\n{self.err}")
+        for t in self._threads:
+            t.join(10)
         return self.p.returncode
 
     def json_records(self) -> list[dict]:
@@ -80,7 +119,17 @@ class Proc:
     def kill(self) -> None:
         if self.p.poll() is None:
             self.p.kill()
-            self.p.communicate()
+            self.p.wait()
+
+
+def wait_until(predicate, timeout: float, poll: float = 0.05) -> bool:
+    """Poll ``predicate`` until true or ``timeout`` s; returns its last value."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() >= deadline:
+            return predicate()
+        time.sleep(poll)
+    return True
 
 
 @pytest.fixture

@@ -174,7 +174,7 @@ class App:
         self.scene = Scene(self.vis, self.model)
         self.scene.build(self.data)
         root = self.bodies[self.project.models[-1].name].root_pose()[0]
-        self.scene.set_camera(root + [-1.6, -1.6, 1.2], root)
+        self.scene.set_camera(root + [-1.1, -1.2, 0.8], root)
         self.output({"event": "meshcat", "node": self.node_fqn,
                      "url": self.vis.url() if self.server is None else self.server.web_url})
 

@@ -35,22 +35,30 @@ class DemoInput:
     """The scripted :data:`DEMO_SCRIPT`, from ``start`` (s, monotonic), looped.
 
     Args:
-        start: time the script starts.
+        start: time the script starts; None waits (sticks at rest) until :meth:`begin`.
         cycles: how many times to play it (None: forever); afterwards the sticks rest at 0.
     """
 
-    start: float
+    start: float | None = None
     cycles: int | None = None
+
+    @property
+    def waiting(self) -> bool:
+        return self.start is None
+
+    def begin(self, now: float) -> None:
+        """Start the script at ``now`` (the joy node calls it when /joy gets a subscriber)."""
+        self.start = now
 
     @property
     def period(self) -> float:
         return sum(d for d, _ in DEMO_SCRIPT)
 
     def finished(self, now: float) -> bool:
-        return self.cycles is not None and now - self.start >= self.cycles * self.period
+        return self.start is not None and self.cycles is not None and now - self.start >= self.cycles * self.period
 
     def read(self, now: float):
-        if self.finished(now):
+        if self.start is None or self.finished(now):
             return ZERO_AXES, ZERO_BUTTONS
         t = (now - self.start) % self.period
         for duration, (lh, lv, rh, rv) in DEMO_SCRIPT:

@@ -1,7 +1,8 @@
 """``rtt-joy``: publish ``sensor_msgs/Joy`` on ``/joy`` from a gamepad, the keyboard or a demo script.
 
     rtt-joy              # a gamepad if one is connected, else this terminal's keyboard
-    rtt-joy --demo       # scripted input: drive, turn, swing the turret (loops)
+    rtt-joy --demo       # scripted input: drive, turn, swing the turret (loops; starts
+                         # when /joy has a subscriber)
     rtt-joy --demo --duration 10
 
 Like ROS 2's ``joy_node`` it publishes when the input changes (at most
@@ -54,6 +55,10 @@ class JoyPublisher:
 
     def tick(self) -> None:
         now = time.monotonic()
+        if getattr(self.source, "waiting", False) and self.publisher.get_subscription_count() > 0:
+            # A scripted demo starts when someone listens, so no part of it is lost.
+            self.source.begin(now)
+            print(f"[{self.node.get_fully_qualified_name()}] {TOPIC} has a subscriber: the demo starts", flush=True)
         state = self.source.read(now)
         if state is None or (self.until is not None and now >= self.until):
             self.done = True
@@ -75,7 +80,7 @@ def choose_source(args, stack: contextlib.ExitStack):
     from tutorial.joy_input import KEYBOARD_HELP, DemoInput, GamepadInput, KeyboardInput
 
     if args.demo:
-        return DemoInput(time.monotonic()), "demo script"
+        return DemoInput(), "demo script (it starts when /joy has a subscriber)"
     try:
         pad = GamepadInput()
         return pad, f"gamepad {pad.name}"

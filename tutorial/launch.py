@@ -30,6 +30,7 @@ SHUTDOWN_TIMEOUT = 5.0  # s, from the stop request to the last child gone
 _SIGINT_GRACE = 3.0  # s before SIGINT escalates to SIGTERM
 _SIGTERM_GRACE = 1.5  # s before SIGTERM escalates to SIGKILL
 PR_SET_PDEATHSIG = 1
+_LIBRARY_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 @dataclass
@@ -94,6 +95,8 @@ class Launch:
     def start(self) -> None:
         env = dict(os.environ)
         env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        # The nodes import this library from wherever the launcher found it (a clone need not be installed).
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [_LIBRARY_ROOT, env.get("PYTHONPATH")]))
         env["PYTHONUNBUFFERED"] = "1"
         for node in self.description.nodes:
             proc = subprocess.Popen(node.command(), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,

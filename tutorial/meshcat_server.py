@@ -72,6 +72,7 @@ def start_server(timeout: float = 20.0) -> MeshcatServer:
     proc = subprocess.Popen(
         [sys.executable, "-u", "-m", "tutorial.meshcat_server", "--parent", str(os.getpid())],
         stdout=subprocess.PIPE,
+        bufsize=0,  # unbuffered: select() must see every line that readline() has not taken yet
         stderr=subprocess.DEVNULL,
         start_new_session=True,  # a Ctrl-C in a notebook or terminal is not sent to it; we stop it
     )

@@ -112,7 +112,7 @@ def main(argv: list[str] | None = None) -> int:
         app.run()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
-    except (ControllerError, ValueError) as exc:
+    except (ControllerError, ValueError, RuntimeError) as exc:
         print(f"rtt-run: {exc}", file=sys.stderr)
         status = 1
     finally:

@@ -72,6 +72,7 @@ class Scene:
         m = self.model
         self.vis[self.root].delete()
         self.vis["/Grid"].set_property("visible", False)  # our floor is the ground
+        self.vis["/Axes"].set_property("visible", False)
         moving = set()
         for gid in range(m.ngeom):
             if m.geom_group[gid] >= HIDDEN_GEOM_GROUP:

@@ -1,0 +1,134 @@
+"""``rtt-graph``: the ROS 2 graph, nodes and topics (rqt_graph's stand-in).
+
+    rtt-graph                       # text, after 2 s of discovery
+    rtt-graph --output graph.png    # and a picture
+
+Lists every node with the topics it publishes and subscribes, and draws the
+graph (node ellipses, topic boxes, arrows publisher -> topic -> subscriber)
+with networkx and matplotlib.  ROS 2's own ``/rosout`` and parameter-event
+topics are hidden unless ``--all``; this node hides itself.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from dataclasses import dataclass, field
+
+from tutorial import ros_env
+
+NODE_NAME = "rtt_graph"
+HIDDEN_TOPICS = {"/rosout", "/parameter_events"}
+
+
+@dataclass
+class Graph:
+    """Nodes (fully qualified names) and, per topic, its type, publishers and subscribers."""
+
+    nodes: list[str] = field(default_factory=list)
+    topics: dict[str, dict] = field(default_factory=dict)
+
+    def text(self) -> str:
+        lines = ["nodes:"] + [f"  {n}" for n in self.nodes] + ["topics:"]
+        for topic, t in sorted(self.topics.items()):
+            lines.append(f"  {topic} [{t['type']}]")
+            lines.append(f"    publishers:  {', '.join(sorted(t['publishers'])) or '-'}")
+            lines.append(f"    subscribers: {', '.join(sorted(t['subscribers'])) or '-'}")
+        return "\n".join(lines)
+
+    def as_dict(self) -> dict:
+        return {"nodes": self.nodes, "topics": self.topics}
+
+
+def read_graph(node, show_all: bool = False) -> Graph:
+    """The graph as ``node`` sees it now (the node's owner thread)."""
+    me = node.get_fully_qualified_name()
+    g = Graph()
+    for name, ns in sorted(node.get_node_names_and_namespaces()):
+        fq = (ns.rstrip("/") + "/" + name) if ns != "/" else "/" + name
+        if fq == me:
+            continue
+        g.nodes.append(fq)
+        for getter, role in ((node.get_publisher_names_and_types_by_node, "publishers"),
+                             (node.get_subscriber_names_and_types_by_node, "subscribers")):
+            for topic, types in getter(name, ns):
+                if not show_all and topic in HIDDEN_TOPICS:
+                    continue
+                t = g.topics.setdefault(topic, {"type": ", ".join(types), "publishers": [], "subscribers": []})
+                t[role].append(fq)
+    return g
+
+
+def draw_graph(graph: Graph, path: str) -> None:
+    """Save a picture of the graph: nodes as ellipses, topics as boxes (any thread; uses matplotlib Agg)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import networkx as nx
+
+    g = nx.DiGraph()
+    for n in graph.nodes:
+        g.add_node(n, kind="node")
+    for topic, t in graph.topics.items():
+        g.add_node(topic, kind="topic")
+        for p in t["publishers"]:
+            g.add_edge(p, topic)
+        for s in t["subscribers"]:
+            g.add_edge(topic, s)
+    if len(g) and nx.is_directed_acyclic_graph(g):
+        # left to right, as rqt_graph draws it: publishers, their topics, subscribers, ...
+        for layer, names in enumerate(nx.topological_generations(g)):
+            for n in names:
+                g.nodes[n]["layer"] = layer
+        pos = nx.multipartite_layout(g, subset_key="layer")
+    else:
+        pos = nx.spring_layout(g, seed=1)
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    nodes = [n for n, d in g.nodes(data=True) if d["kind"] == "node"]
+    topics = [n for n, d in g.nodes(data=True) if d["kind"] == "topic"]
+    nx.draw_networkx_edges(g, pos, ax=ax, arrows=True, arrowsize=16, node_size=2600, edge_color="#555")
+    nx.draw_networkx_nodes(g, pos, nodelist=nodes, ax=ax, node_shape="o", node_color="#9fd3a8", node_size=2600)
+    nx.draw_networkx_nodes(g, pos, nodelist=topics, ax=ax, node_shape="s", node_color="#f2d49b", node_size=2200)
+    nx.draw_networkx_labels(g, pos, ax=ax, font_size=9)
+    ax.set_title("ROS 2 graph: nodes (circles) and topics (squares)")
+    ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    import json
+
+    import rclpy
+    from rclpy.utilities import remove_ros_args
+
+    argv = list(sys.argv if argv is None else argv)
+    p = argparse.ArgumentParser(prog="rtt-graph", description="Show ROS 2 nodes and topics.")
+    p.add_argument("--wait", type=float, default=2.0, help="seconds of discovery before reading the graph")
+    p.add_argument("--output", default=None, help="also draw the graph into this PNG")
+    p.add_argument("--all", action="store_true", help="show /rosout and /parameter_events too")
+    p.add_argument("--json", action="store_true", help="print the graph as one JSON object")
+    args = p.parse_args(remove_ros_args(argv)[1:])
+    ros_env.use_localhost_by_default()
+    rclpy.init(args=argv)
+    node = rclpy.create_node(NODE_NAME)
+    try:
+        end = time.monotonic() + args.wait
+        while time.monotonic() < end:
+            rclpy.spin_once(node, timeout_sec=min(0.1, max(0.0, end - time.monotonic())))
+        graph = read_graph(node, show_all=args.all)
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    print(json.dumps(graph.as_dict()) if args.json else graph.text(), flush=True)
+    if args.output:
+        draw_graph(graph, args.output)
+        print(f"graph drawn to {args.output}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
