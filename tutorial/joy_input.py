@@ -19,12 +19,13 @@ ZERO_BUTTONS = (0,) * joy.NUM_BUTTONS
 
 # The demo: (seconds, (left H, left V, right H, right V)); looped.
 # It drives forward while turning the turret, spins on the spot while raising
-# the barrel, and comes back, so a headless run shows every motion.
+# the barrel, and comes back, so a headless run shows every motion.  The turret
+# turns 2 rad right and 1.25 rad back per cycle: it ends each cycle turned.
 DEMO_SCRIPT: tuple[tuple[float, tuple[float, float, float, float]], ...] = (
     (0.5, (0.0, 0.0, 0.0, 0.0)),   # still
     (2.5, (0.0, 0.4, -0.4, 0.0)),  # forward at 0.8 m/s, turret turning right
     (2.0, (0.8, 0.0, 0.0, -0.5)),  # turn left on the spot, barrel rising
-    (2.5, (0.0, 0.4, 0.4, 0.0)),   # forward, turret turning back left
+    (2.5, (0.0, 0.4, 0.25, 0.0)),  # forward, turret turning back left, part of the way
     (2.0, (-0.8, 0.0, 0.0, 0.5)),  # turn right on the spot, barrel lowering
     (1.0, (0.0, 0.0, 0.0, 0.0)),   # still
 )

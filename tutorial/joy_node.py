@@ -32,13 +32,14 @@ class JoyPublisher:
         source: an object with ``read(now) -> (axes, buttons) | None``.
         rate: how often the source is read, Hz.
         autorepeat: how often an unchanged state is published again, Hz (0: never).
-        until: monotonic time to stop at (None: never).
+        duration: stop after this many seconds (None: never), counted from the
+            start of a demo that waits for a subscriber, else from now.
 
     QoS: reliable, keep last 10 (the ROS 2 default): a Joy is small, and a
     subscriber with queue 1 drops what it does not need.
     """
 
-    def __init__(self, node, source, rate=60.0, autorepeat=20.0, until=None):
+    def __init__(self, node, source, rate=60.0, autorepeat=20.0, duration=None):
         from sensor_msgs.msg import Joy
 
         self.node = node
@@ -46,7 +47,8 @@ class JoyPublisher:
         self.msg_type = Joy
         self.publisher = node.create_publisher(Joy, TOPIC, 10)
         self.autorepeat = autorepeat
-        self.until = until
+        self.duration = duration
+        self.until = None if duration is None or getattr(source, "waiting", False) else time.monotonic() + duration
         self.last = None
         self.last_sent = 0.0
         self.published = 0
@@ -58,6 +60,8 @@ class JoyPublisher:
         if getattr(self.source, "waiting", False) and self.publisher.get_subscription_count() > 0:
             # A scripted demo starts when someone listens, so no part of it is lost.
             self.source.begin(now)
+            if self.duration is not None:
+                self.until = now + self.duration
             print(f"[{self.node.get_fully_qualified_name()}] {TOPIC} has a subscriber: the demo starts", flush=True)
         state = self.source.read(now)
         if state is None or (self.until is not None and now >= self.until):
@@ -101,7 +105,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv if argv is None else argv)
     parser = argparse.ArgumentParser(prog="rtt-joy", description="Publish sensor_msgs/Joy on /joy.")
     parser.add_argument("--demo", action="store_true", help="scripted input (drive, turn, turret), looped")
-    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS", help="stop after this long")
+    parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                        help="stop after this long (with --demo: this long after the demo starts)")
     parser.add_argument("--rate", type=float, default=60.0, help="input polling rate, Hz (default 60)")
     parser.add_argument("--autorepeat", type=float, default=20.0,
                         help="republish an unchanged state at this rate, Hz (default 20, 0: only on change)")
@@ -113,8 +118,7 @@ def main(argv: list[str] | None = None) -> int:
         source, what = choose_source(args, stack)
         rclpy.init(args=argv)
         node = rclpy.create_node(NODE_NAME)
-        until = None if args.duration is None else time.monotonic() + args.duration
-        pub = JoyPublisher(node, source, rate=args.rate, autorepeat=args.autorepeat, until=until)
+        pub = JoyPublisher(node, source, rate=args.rate, autorepeat=args.autorepeat, duration=args.duration)
         print(f"[{node.get_fully_qualified_name()}] publishing {TOPIC} from {what}", flush=True)
         try:
             while rclpy.ok() and not pub.done:

@@ -1,0 +1,122 @@
+"""Step 3 across real processes: simulation, joystick and viewer as separate programs."""
+
+import json
+import math
+import signal
+import time
+
+import pytest
+
+from conftest import module_command, wait_until
+
+
+def viewer(procs, project="project/step3.yaml", name="rtt_viewer", *extra):
+    return procs(module_command("tutorial.runner", project, "--headless", "--json", *extra,
+                                "--ros-args", "-r", f"__node:={name}"))
+
+
+def records(proc, event):
+    return [r for r in proc.json_records() if r.get("event") == event]
+
+
+def stop_when_stale(proc, timeout=30):
+    """Wait until the viewer says the data stopped (all delivered states applied), then Ctrl-C it."""
+    proc.wait_for_line(lambda line: '"event": "stale"' in line, timeout=timeout)
+    proc.p.send_signal(signal.SIGINT)
+    assert proc.wait(30) == 0, proc.err
+    return proc.summary()
+
+
+def test_viewer_ends_on_the_simulations_final_state(procs):
+    view = viewer(procs)
+    joy = procs(module_command("tutorial.joy_node", "--demo", "--duration", "4"))
+    sim = procs(module_command("tutorial.runner", "project/step2.yaml", "--headless", "--duration", "6", "--json"))
+    assert sim.wait(60) == 0, sim.err
+    assert joy.wait(30) == 0
+    sim_summary = sim.summary()
+    view_summary = stop_when_stale(view)
+    final = sim_summary["bodies"]["Tank"]["joint_positions"]
+    shown = view_summary["controllers"]["RttJointStateSubscriber"]["last_positions"]
+    assert set(shown) == {"TURRET_Y", "TURRET_P"}
+    for name in final:
+        assert abs(shown[name] - final[name]) <= 1e-6, (name, shown, final)
+    assert view_summary["bodies"]["Tank"]["joint_positions"] == pytest.approx(final, abs=1e-6)
+    assert abs(final["TURRET_Y"]) > 0.1  # the demo really moved it
+    counts = view_summary["controllers"]["RttJointStateSubscriber"]
+    assert counts["rejected"] == {}
+    assert counts["received"] > 100  # 50 Hz for most of 6 s
+    assert sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 300 + 1  # 50 Hz over 6 s (steps 0, 20, ..., 5980), and the final state
+
+
+HOSTILE = [
+    # (names, positions, expected rejections)
+    (["TURRET_P", "TURRET_Y"], [0.2, 0.3], {}),                                      # reordered
+    (["TURRET_Y", "GUN", "TURRET_P"], [0.1, 9.0, 0.2], {"unknown_name": 1}),        # unknown name
+    (["TURRET_Y", "TURRET_Y", "TURRET_P"], [0.1, 0.2, 0.3], {"duplicate_name": 2}),  # duplicate
+    (["TURRET_Y", "TURRET_P"], [0.4], {"no_position": 1}),                           # short positions
+    (["TURRET_Y"], [0.4, 0.5], {"no_name": 1}),                                      # short names
+    (["TURRET_Y", "TURRET_P"], [math.nan, 0.1], {"not_finite": 1}),                  # NaN
+    (["TURRET_Y", "TURRET_P"], [0.1, -math.inf], {"not_finite": 1}),                 # inf
+    (["TURRET_Y", "TURRET_P"], [1e300, 0.1], {"out_of_range": 1}),                   # huge
+    ([], [], {}),                                                                    # empty
+    (["TURRET_Y", "TURRET_P"], [0.5, 0.25], {}),                                     # a good one, last
+]
+
+
+def test_hostile_publisher_is_counted_exactly(procs, node):
+    from sensor_msgs.msg import JointState
+
+    from tutorial.controllers.joint_state_publisher import joint_state_qos
+
+    view = viewer(procs)
+    pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
+    assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
+    expected = {}
+    for names, positions, rejections in HOSTILE:
+        msg = JointState()
+        msg.name = names
+        msg.position = positions
+        pub.publish(msg)
+        for k, v in rejections.items():
+            expected[k] = expected.get(k, 0) + v
+        time.sleep(0.25)  # pacing, not synchronisation: one message per viewer frame, so none coalesce
+    summary = stop_when_stale(view)
+    counts = summary["controllers"]["RttJointStateSubscriber"]
+    assert counts["received"] == len(HOSTILE)
+    assert counts["applied"] == len(HOSTILE), "messages coalesced: the pacing was too fast for this machine"
+    assert counts["rejected"] == dict(sorted(expected.items()))
+    assert counts["last_positions"] == {"TURRET_Y": 0.5, "TURRET_P": 0.25}
+    assert summary["bodies"]["Tank"]["joint_positions"] == {"TURRET_Y": 0.5, "TURRET_P": 0.25}
+    status = records(view, "status")[-1]
+    assert status["rejected"] == counts["rejected"]
+
+
+def test_a_second_node_with_the_same_name_is_warned_about(procs):
+    a = viewer(procs, "project/step3.yaml", "rtt", "--duration", "6")
+    b = viewer(procs, "project/step3.yaml", "rtt", "--duration", "6")
+    assert a.wait(60) == 0 and b.wait(60) == 0
+    for p in (a, b):
+        warnings = records(p, "warning")
+        assert warnings and "2 nodes are named /rtt" in warnings[0]["message"], p.out
+
+
+def test_distinct_names_give_no_warning(procs):
+    a = viewer(procs, "project/step3.yaml", "rtt_a", "--duration", "5")
+    b = viewer(procs, "project/step3.yaml", "rtt_b", "--duration", "5")
+    assert a.wait(60) == 0 and b.wait(60) == 0
+    assert records(a, "warning") == [] and records(b, "warning") == []
+
+
+def test_any_model_publishes_and_shows_its_own_joints(procs):
+    view = viewer(procs, "tests/fixtures/crane_view.yaml")
+    sim = procs(module_command("tutorial.runner", "tests/fixtures/crane_sim.yaml", "--headless",
+                               "--duration", "3", "--json"))
+    assert sim.wait(60) == 0, sim.err
+    final = sim.summary()["bodies"]["Crane"]["joint_positions"]
+    assert list(final) == ["SLEW", "LUFF", "TROLLEY"]  # hinge, hinge, slide; the ball joint is not numbered
+    shown = stop_when_stale(view)["controllers"]["RttJointStateSubscriber"]
+    assert shown["topic"] == "/Crane/joint_state"
+    assert shown["rejected"] == {}
+    for name, q in final.items():
+        assert abs(shown["last_positions"][name] - q) <= 1e-6
+    assert max(abs(q) for q in final.values()) > 0.05  # it moved
