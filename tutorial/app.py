@@ -174,7 +174,10 @@ class App:
         self.scene = Scene(self.vis, self.model)
         self.scene.build(self.data)
         root = self.bodies[self.project.models[-1].name].root_pose()[0]
-        self.scene.set_camera(root + [-1.1, -1.2, 0.8], root)
+        if self.project.simulator is not None:
+            self.scene.set_camera(root + [-3.2, -3.4, 3.0], root + [0.8, 0.6, 0.0])  # the room, from above a corner
+        else:
+            self.scene.set_camera(root + [-1.1, -1.2, 0.8], root)  # the robot, close up
         self.output({"event": "meshcat", "node": self.node_fqn,
                      "url": self.vis.url() if self.server is None else self.server.web_url})
 

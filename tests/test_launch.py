@@ -1,0 +1,70 @@
+"""Launch files: one command starts every node; Ctrl-C or SIGTERM ends them all, cleanly, in time."""
+
+import os
+import signal
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT, wait_until
+from tutorial.launch import Launch, LaunchDescription, Node
+
+
+def processes_with_marker(marker: str) -> list[int]:
+    """Pids of live processes whose environment holds ``RTT_TEST_MARKER=marker`` (children and grandchildren)."""
+    found = []
+    needle = f"RTT_TEST_MARKER={marker}".encode()
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            if needle in (entry / "environ").read_bytes():
+                status = (entry / "status").read_text()
+                if "State:\tZ" not in status:
+                    found.append(int(entry.name))
+        except OSError:
+            continue
+    return found
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_step3_launch_stops_every_node_within_5_s(procs, sig):
+    marker = uuid.uuid4().hex
+    env = dict(os.environ, RTT_TEST_MARKER=marker)
+    launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"], env=env)
+    launch.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "meshcat: open" in line, timeout=60)
+    launch.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "2/2 joints matched" in line
+                         and not line.split("] ", 2)[-1].startswith("0.0 msg/s"), timeout=60)
+    assert len(processes_with_marker(marker)) >= 6  # launcher, 3 nodes, 2 meshcat servers
+    started = time.monotonic()
+    launch.p.send_signal(sig)
+    code = launch.wait(15)
+    elapsed = time.monotonic() - started
+    assert code == 0, launch.out
+    assert "[launch] all nodes stopped cleanly" in launch.out
+    assert elapsed < 5.0 + 1.0  # the launcher's own start-up of Python is not in its 5 s budget
+    assert wait_until(lambda: processes_with_marker(marker) == [], timeout=2.0), processes_with_marker(marker)
+    for name in ("rtt_joy", "rtt", "rtt_viewer"):
+        assert f"[{name}]" in launch.out
+    assert "[rtt_viewer] --- summary: project step3, node /rtt_viewer ---" in launch.out
+
+
+def test_a_failing_node_fails_the_launch_and_stops_the_others(capsys):
+    import io
+
+    out = io.StringIO()
+    launch = Launch(LaunchDescription([
+        Node("rtt_joy", "tutorial.joy_node", ["--demo"]),
+        Node("broken", "tutorial.runner", ["/nonexistent/project.yaml", "--headless"], required=True),
+    ]), out=out)
+    launch.start()
+    code = launch.wait()
+    text = out.getvalue()
+    assert code == 1
+    assert "[launch] broken exited with code 2" in text
+    assert "[launch] failed: broken" in text
+    assert all(p.poll() is not None for p in launch.procs.values())
+    assert "cannot read the project file" in text
