@@ -92,8 +92,8 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
 
 
 def test_a_second_node_with_the_same_name_is_warned_about(procs):
-    a = viewer(procs, "project/step3.yaml", "rtt", "--duration", "6")
-    b = viewer(procs, "project/step3.yaml", "rtt", "--duration", "6")
+    a = viewer(procs, "project/step3.yaml", "rtt", "--duration", "9")  # checks at 2, 4, 6, 8 s
+    b = viewer(procs, "project/step3.yaml", "rtt", "--duration", "9")
     assert a.wait(60) == 0 and b.wait(60) == 0
     for p in (a, b):
         warnings = records(p, "warning")

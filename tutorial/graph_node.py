@@ -1,6 +1,6 @@
 """``rtt-graph``: the ROS 2 graph, nodes and topics (rqt_graph's stand-in).
 
-    rtt-graph                       # text, after 2 s of discovery
+    rtt-graph                       # text, after 4 s of discovery
     rtt-graph --output graph.png    # and a picture
 
 Lists every node with the topics it publishes and subscribes, and draws the
@@ -107,7 +107,9 @@ def main(argv: list[str] | None = None) -> int:
 
     argv = list(sys.argv if argv is None else argv)
     p = argparse.ArgumentParser(prog="rtt-graph", description="Show ROS 2 nodes and topics.")
-    p.add_argument("--wait", type=float, default=2.0, help="seconds of discovery before reading the graph")
+    p.add_argument("--wait", type=float, default=4.0,
+                   help="seconds of discovery before reading the graph (default 4: on localhost, Fast DDS "
+                        "may need one 3 s announcement period to see every node)")
     p.add_argument("--output", default=None, help="also draw the graph into this PNG")
     p.add_argument("--all", action="store_true", help="show /rosout and /parameter_events too")
     p.add_argument("--json", action="store_true", help="print the graph as one JSON object")
