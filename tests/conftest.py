@@ -84,18 +84,27 @@ class Proc:
         with self._cond:
             return "\n".join(self._err)
 
-    def wait_for_line(self, predicate, timeout: float) -> str:
-        """The first output line for which ``predicate(line)`` is true; fails after ``timeout`` s."""
+    def count(self, predicate) -> int:
+        """How many output lines so far satisfy ``predicate``."""
+        with self._cond:
+            return sum(1 for line in self.lines if predicate(line))
+
+    def wait_for_count(self, predicate, n: int, timeout: float) -> str:
+        """Wait until ``n`` output lines satisfy ``predicate``; the n-th. Fails after ``timeout`` s."""
         deadline = time.monotonic() + timeout
         with self._cond:
             while True:
-                for line in self.lines:
-                    if predicate(line):
-                        return line
+                matches = [line for line in self.lines if predicate(line)]
+                if len(matches) >= n:
+                    return matches[n - 1]
                 left = deadline - time.monotonic()
                 if left <= 0 or (self.p.poll() is not None and not any(t.is_alive() for t in self._threads)):
-                    raise AssertionError(f"no such line from {self.cmd} in {timeout} s:\n{self.out}\n{self.err}")
+                    raise AssertionError(f"not {n} such lines from {self.cmd} in {timeout} s:\n{self.out}\n{self.err}")
                 self._cond.wait(min(left, 0.2))
+
+    def wait_for_line(self, predicate, timeout: float) -> str:
+        """The first output line for which ``predicate(line)`` is true; fails after ``timeout`` s."""
+        return self.wait_for_count(predicate, 1, timeout)
 
     def wait(self, timeout: float) -> int:
         try:

@@ -20,8 +20,13 @@ def records(proc, event):
 
 
 def stop_when_stale(proc, timeout=30):
-    """Wait until the viewer says the data stopped (all delivered states applied), then Ctrl-C it."""
-    proc.wait_for_line(lambda line: '"event": "stale"' in line, timeout=timeout)
+    """Wait until the viewer says the data stopped (all delivered states applied), then Ctrl-C it.
+
+    Call it after the publisher has ended: only a stale event that comes after
+    that says everything was delivered.
+    """
+    is_stale = lambda line: '"event": "stale"' in line  # noqa: E731
+    proc.wait_for_count(is_stale, proc.count(is_stale) + 1, timeout=timeout)
     proc.p.send_signal(signal.SIGINT)
     assert proc.wait(30) == 0, proc.err
     return proc.summary()

@@ -52,7 +52,10 @@ class App:
             project simulates, wall-clock time otherwise (None: until stopped).
         output: called with one dict per status line or event (main thread).
         vis: an existing ``meshcat.Visualizer`` to draw in (notebooks),
-            instead of starting a server.
+            instead of starting a server; the owner thread must own it.
+        attach: extra ``(body name, controller name, controller instance)``
+            to attach in code, before the project's own (as adding a
+            controller item in Choreonoid's GUI).
 
     Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
     becomes the owner of everything the main thread owns.
@@ -60,7 +63,7 @@ class App:
 
     def __init__(self, project: Project, node=None, node_name: str = DEFAULT_NODE_NAME, headless: bool = False,
                  realtime_sync: bool | None = None, duration: float | None = None,
-                 output: Callable[[dict], None] | None = None, vis=None):
+                 output: Callable[[dict], None] | None = None, vis=None, attach=()):
         self.project = project
         self.node = node
         self.node_name = node_name
@@ -69,6 +72,7 @@ class App:
         self.duration = duration
         self.output = output or (lambda record: print(record, flush=True))
         self.vis = vis
+        self.attach = list(attach)
         self.loop = MainLoop()
         self.log = logging.getLogger("rtt")
         self.server = None
@@ -105,9 +109,11 @@ class App:
 
             self.node = Node(self.node_name)
             self.spin = SpinThread(self.node)
+        for body_name, name, controller in self.attach:
+            self._configure_instance(body_name, name, controller, {})
         for entry in self.project.models:
             for c in entry.controllers:
-                self._configure(entry.name, c)
+                self._configure_instance(entry.name, c.name, c.cls(), self._ros_parameters(c))
         self.node_fqn = self.node.get_fully_qualified_name()
         if self.spin is not None:
             self.spin.start()
@@ -124,22 +130,31 @@ class App:
         self._started = time.monotonic()
         return self
 
-    def _configure(self, body_name: str, entry) -> None:
-        controller = entry.cls()
-        params = self._ros_parameters(entry)
+    def controller(self, name: str):
+        """A configured controller by name (any thread, after :meth:`open` has configured it).
+
+        Raises:
+            KeyError: no controller of that name.
+        """
+        for n, c in self.configured:
+            if n == name:
+                return c
+        raise KeyError(f"no controller named {name!r}")
+
+    def _configure_instance(self, body_name: str, name: str, controller, params: dict) -> None:
         config = ControllerConfig(
-            name=entry.name, body=self.bodies[body_name], node=self.node, parameters=params,
+            name=name, body=self.bodies[body_name], node=self.node, parameters=params,
             call_later=self.loop.call_later, call_every=self.loop.call_every, output=self.output,
-            log=logging.getLogger(f"rtt.{entry.name}"),
+            log=logging.getLogger(f"rtt.{name}"),
         )
         try:
             ok = controller.configure(config)
         except Exception as exc:
-            raise ControllerError(f"controller {entry.name} failed to configure: {exc!r}") from exc
+            raise ControllerError(f"controller {name} failed to configure: {exc!r}") from exc
         if not ok:
-            raise ControllerError(f"controller {entry.name} refused to configure")
-        self.configured.append((entry.name, controller))
-        self.controllers.append((entry.name, controller, body_name))
+            raise ControllerError(f"controller {name} refused to configure")
+        self.configured.append((name, controller))
+        self.controllers.append((name, controller, body_name))
 
     def _ros_parameters(self, entry) -> dict:
         """Declare the controller's parameters on the node: ``<controller>.<parameter>``.
@@ -194,7 +209,8 @@ class App:
             self._draw()
         return not self.done()
 
-    def _draw(self) -> None:
+    def _sync_from_simulation(self) -> None:
+        """Copy the simulation's newest snapshot into the main thread's data (owner thread)."""
         if self.sim is not None:
             snap = self.sim.snapshot()
             if snap.step != self._drawn_step:
@@ -202,6 +218,9 @@ class App:
                 self.data.qpos[:] = snap.qpos
                 self.data.time = snap.time
                 mujoco.mj_kinematics(self.model, self.data)
+
+    def _draw(self) -> None:
+        self._sync_from_simulation()
         if self.scene is not None:
             self.scene.update(self.data)
 
@@ -216,13 +235,14 @@ class App:
         """Step until done (owner thread); Ctrl-C propagates as KeyboardInterrupt."""
         while self.step():
             pass
-        self._draw()
+        self._draw()  # show the final state
 
     def close(self) -> None:
         """Stop the simulation, unconfigure the controllers, stop ROS and meshcat (owner thread)."""
         if self.sim is not None:
             self.sim.request_stop()
             self.sim.join(5.0)
+            self._sync_from_simulation()  # the bodies end in the simulation's final state
         if self.spin is not None:
             self.spin.stop()
         # Work handed over before the spin thread stopped still runs, so the

@@ -36,6 +36,11 @@ TURRET_JOINTS = ("TURRET_Y", "TURRET_P")  # driven by right stick H, V
 TRACKS = ("TRACK_L", "TRACK_R")
 
 
+def _choreonoid_sign(value: float) -> float:
+    """A stick value in Choreonoid's sign convention (up and left negative); 0 stays +0.0."""
+    return -value if value else 0.0
+
+
 def track_velocities(axes) -> tuple[float, float]:
     """Track surface velocities (left, right) in m/s from a Joy's axes.
 
@@ -48,11 +53,11 @@ def track_velocities(axes) -> tuple[float, float]:
 
     Any thread may call it.
     """
-    v = -joy.dead_zone(joy.axis(axes, joy.LEFT_STICK_V), TRACK_DEAD_ZONE)  # Choreonoid sign
-    h = -joy.dead_zone(joy.axis(axes, joy.LEFT_STICK_H), TRACK_DEAD_ZONE)
+    v = _choreonoid_sign(joy.dead_zone(joy.axis(axes, joy.LEFT_STICK_V), TRACK_DEAD_ZONE))
+    h = _choreonoid_sign(joy.dead_zone(joy.axis(axes, joy.LEFT_STICK_H), TRACK_DEAD_ZONE))
     left = -TRACK_SPEED_GAIN * v + TURN_SPEED_GAIN * h
     right = -TRACK_SPEED_GAIN * v - TURN_SPEED_GAIN * h
-    return left, right
+    return left + 0.0, right + 0.0  # + 0.0 turns a -0.0 into 0.0 for printing
 
 
 def turret_rates(axes) -> tuple[float, float]:
@@ -66,8 +71,8 @@ def turret_rates(axes) -> tuple[float, float]:
     Args:
         axes: ``Joy.axes`` (any length; missing or non-finite axes count as 0).
     """
-    yaw = -joy.dead_zone(joy.axis(axes, joy.RIGHT_STICK_H), TURRET_DEAD_ZONE)
-    pitch = -joy.dead_zone(joy.axis(axes, joy.RIGHT_STICK_V), TURRET_DEAD_ZONE)
+    yaw = _choreonoid_sign(joy.dead_zone(joy.axis(axes, joy.RIGHT_STICK_H), TURRET_DEAD_ZONE))
+    pitch = _choreonoid_sign(joy.dead_zone(joy.axis(axes, joy.RIGHT_STICK_V), TURRET_DEAD_ZONE))
     return TURRET_RATE * yaw, TURRET_RATE * pitch
 
 

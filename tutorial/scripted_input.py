@@ -1,0 +1,49 @@
+"""Deterministic joystick input for notebooks, tests and snapshots.
+
+:class:`ScriptedJoy` is a controller that plays :data:`tutorial.joy_input.DEMO_SCRIPT`
+by *simulated* time and hands each new stick state to the tank controller's
+``on_joy``, the same callback the ``/joy`` subscription calls.  No network is
+involved, so the same script gives the same trajectory on every run: that is
+what lets a notebook show exact numbers.  (Over ROS, messages arrive at
+slightly different steps each run.)
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from tutorial.controller import SimpleController
+from tutorial.joy_input import DemoInput
+
+
+class ScriptedJoy(SimpleController):
+    """Feeds a target controller's ``on_joy`` from the demo script, by simulated time.
+
+    Args:
+        target: the controller whose ``on_joy(msg)`` receives the input, or a
+            function returning it (called in ``initialize``, when every
+            controller of the project has been configured).
+        cycles: how many times to play the script (None: forever).
+
+    Attach it before the target, so both see the same step.  Runs on the simulation thread.
+    """
+
+    def __init__(self, target, cycles: int | None = None):
+        self.target = target
+        self.source = DemoInput(start=0.0, cycles=cycles)
+        self.last = None
+        self.sent = 0
+
+    def initialize(self, io) -> bool:
+        self.io = io
+        if callable(self.target) and not hasattr(self.target, "on_joy"):
+            self.target = self.target()
+        return True
+
+    def control(self) -> bool:
+        axes, buttons = self.source.read(self.io.current_time)
+        if (axes, buttons) != self.last:
+            self.last = (axes, buttons)
+            self.target.on_joy(SimpleNamespace(axes=list(axes), buttons=list(buttons)))
+            self.sent += 1
+        return True
