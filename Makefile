@@ -1,17 +1,18 @@
 # Two commands a newcomer needs (see README):
 #   make demo   - the main job: Step 3 (simulation, demo joystick, viewer) in two meshcat pages
-#   make test   - the whole test suite
+#   make test   - the whole test suite: library, cross-process, launch, browser, and the notebooks (nbval)
 # Both create the virtual environment .venv on first use and reuse it after.
+# More: make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors).
 
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test venv clean
+.PHONY: demo test notebooks book venv clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[notebook,test,book]"
 	touch $@
 
 venv: $(VENV)/.installed
@@ -21,7 +22,14 @@ demo: $(VENV)/.installed
 
 test: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
-	$(PY) -m pytest
+	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
+
+notebooks: $(VENV)/.installed
+	$(VENV)/bin/jupyter lab notebooks/
+
+book: $(VENV)/.installed
+	ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST $(PY) book/make_snapshots.py
+	$(VENV)/bin/jupyter-book build book --warningiserror --keep-going
 
 clean:
-	rm -rf $(VENV) .pytest_cache book/_build
+	rm -rf $(VENV) .pytest_cache book/_build book/_static/snapshots
