@@ -21,7 +21,6 @@ os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ["ROS_DOMAIN_ID"] = str(1 + (os.getpid() * 7919 + int(time.time())) % 100)
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
-os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("RTT_TEST_MODE", "1")  # notebooks run under nbval: shorter interactive runs
 
 ROOT = Path(__file__).resolve().parent.parent

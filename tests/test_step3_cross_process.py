@@ -19,14 +19,18 @@ def records(proc, event):
     return [r for r in proc.json_records() if r.get("event") == event]
 
 
-def stop_when_stale(proc, timeout=30):
+def is_stale(line: str) -> bool:
+    return '"event": "stale"' in line
+
+
+def stop_when_stale(proc, stale_before: int, timeout=30):
     """Wait until the viewer says the data stopped (all delivered states applied), then Ctrl-C it.
 
-    Call it after the publisher has ended: only a stale event that comes after
-    that says everything was delivered.
+    ``stale_before`` is the viewer's count of stale events taken while the
+    publisher was still running: only a stale event after those says that
+    everything the publisher sent has been delivered and applied.
     """
-    is_stale = lambda line: '"event": "stale"' in line  # noqa: E731
-    proc.wait_for_count(is_stale, proc.count(is_stale) + 1, timeout=timeout)
+    proc.wait_for_count(is_stale, stale_before + 1, timeout=timeout)
     proc.p.send_signal(signal.SIGINT)
     assert proc.wait(30) == 0, proc.err
     return proc.summary()
@@ -36,10 +40,11 @@ def test_viewer_ends_on_the_simulations_final_state(procs):
     view = viewer(procs)
     joy = procs(module_command("tutorial.joy_node", "--demo", "--duration", "4"))
     sim = procs(module_command("tutorial.runner", "project/step2.yaml", "--headless", "--duration", "6", "--json"))
+    stale_before = view.count(is_stale)  # the simulation is still starting or running
     assert sim.wait(60) == 0, sim.err
     assert joy.wait(30) == 0
     sim_summary = sim.summary()
-    view_summary = stop_when_stale(view)
+    view_summary = stop_when_stale(view, stale_before)
     final = sim_summary["bodies"]["Tank"]["joint_positions"]
     shown = view_summary["controllers"]["RttJointStateSubscriber"]["last_positions"]
     assert set(shown) == {"TURRET_Y", "TURRET_P"}
@@ -85,7 +90,7 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
         for k, v in rejections.items():
             expected[k] = expected.get(k, 0) + v
         time.sleep(0.25)  # pacing, not synchronisation: one message per viewer frame, so none coalesce
-    summary = stop_when_stale(view)
+    summary = stop_when_stale(view, 0)  # no stale before the first message
     counts = summary["controllers"]["RttJointStateSubscriber"]
     assert counts["received"] == len(HOSTILE)
     assert counts["applied"] == len(HOSTILE), "messages coalesced: the pacing was too fast for this machine"
@@ -116,10 +121,11 @@ def test_any_model_publishes_and_shows_its_own_joints(procs):
     view = viewer(procs, "tests/fixtures/crane_view.yaml")
     sim = procs(module_command("tutorial.runner", "tests/fixtures/crane_sim.yaml", "--headless",
                                "--duration", "3", "--json"))
+    stale_before = view.count(is_stale)
     assert sim.wait(60) == 0, sim.err
     final = sim.summary()["bodies"]["Crane"]["joint_positions"]
     assert list(final) == ["SLEW", "LUFF", "TROLLEY"]  # hinge, hinge, slide; the ball joint is not numbered
-    shown = stop_when_stale(view)["controllers"]["RttJointStateSubscriber"]
+    shown = stop_when_stale(view, stale_before)["controllers"]["RttJointStateSubscriber"]
     assert shown["topic"] == "/Crane/joint_state"
     assert shown["rejected"] == {}
     for name, q in final.items():

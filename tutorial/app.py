@@ -56,6 +56,7 @@ class App:
         attach: extra ``(body name, controller name, controller instance)``
             to attach in code, before the project's own (as adding a
             controller item in Choreonoid's GUI).
+        record_timing: keep each step's lateness in ``sim.lateness`` (benchmarks).
 
     Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
     becomes the owner of everything the main thread owns.
@@ -63,7 +64,7 @@ class App:
 
     def __init__(self, project: Project, node=None, node_name: str = DEFAULT_NODE_NAME, headless: bool = False,
                  realtime_sync: bool | None = None, duration: float | None = None,
-                 output: Callable[[dict], None] | None = None, vis=None, attach=()):
+                 output: Callable[[dict], None] | None = None, vis=None, attach=(), record_timing: bool = False):
         self.project = project
         self.node = node
         self.node_name = node_name
@@ -73,6 +74,7 @@ class App:
         self.output = output or (lambda record: print(record, flush=True))
         self.vis = vis
         self.attach = list(attach)
+        self.record_timing = record_timing
         self.loop = MainLoop()
         self.log = logging.getLogger("rtt")
         self.server = None
@@ -126,7 +128,8 @@ class App:
             mujoco.mj_forward(self.model, sim_data)
             attachments = [Attachment(n, c, b) for n, c, b in self.controllers]
             self.sim = Simulator(self.model, sim_data, attachments, node=self.node,
-                                 realtime_sync=realtime, duration=self.duration).start()
+                                 realtime_sync=realtime, duration=self.duration,
+                                 record_timing=self.record_timing).start()
         self._started = time.monotonic()
         return self
 
@@ -224,6 +227,11 @@ class App:
         if self.scene is not None:
             self.scene.update(self.data)
 
+    def request_stop(self) -> None:
+        """Ask the app to finish its current step and end (any thread, or a signal handler)."""
+        self.stop_requested = True
+        self.loop.wake()
+
     def done(self) -> bool:
         if self.stop_requested:
             return True
@@ -256,6 +264,8 @@ class App:
         self.configured.clear()
         if self._own_node and self.node is not None:
             self.node.destroy_node()
+        if self.scene is not None:
+            self.scene.close()
         if self.server is not None:
             self.server.close()
 

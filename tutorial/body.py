@@ -63,11 +63,14 @@ class Joint:
     Only the thread that owns the ``MjData`` may use it.
     """
 
-    __slots__ = ("info", "_data")
+    # The MjData arrays are fixed buffers: their numpy views are taken once,
+    # which makes each access several times cheaper (controllers run every 1 ms).
+    __slots__ = ("info", "_qpos", "_qvel", "_ctrl", "_force", "_qadr", "_vadr", "_motor", "_gear")
 
     def __init__(self, info: JointInfo, data: mujoco.MjData):
         self.info = info
-        self._data = data
+        self._qpos, self._qvel, self._ctrl, self._force = data.qpos, data.qvel, data.ctrl, data.actuator_force
+        self._qadr, self._vadr, self._motor, self._gear = info.qpos_adr, info.dof_adr, info.motor, info.gear
 
     @property
     def name(self) -> str:
@@ -75,28 +78,28 @@ class Joint:
 
     @property
     def q(self) -> float:
-        return float(self._data.qpos[self.info.qpos_adr])
+        return float(self._qpos[self._qadr])
 
     @q.setter
     def q(self, value: float) -> None:
-        self._data.qpos[self.info.qpos_adr] = value
+        self._qpos[self._qadr] = value
 
     @property
     def dq(self) -> float:
-        return float(self._data.qvel[self.info.dof_adr])
+        return float(self._qvel[self._vadr])
 
     @property
     def u(self) -> float:
         """Torque (N*m) or force (N) from the motor; 0 when the joint has none."""
-        if self.info.motor < 0:
+        if self._motor < 0:
             return 0.0
-        return float(self._data.actuator_force[self.info.motor])
+        return float(self._force[self._motor])
 
     @u.setter
     def u(self, value: float) -> None:
-        if self.info.motor < 0:
+        if self._motor < 0:
             raise AttributeError(f"joint {self.info.name} has no motor actuator to take a torque")
-        self._data.ctrl[self.info.motor] = value / self.info.gear
+        self._ctrl[self._motor] = value / self._gear
 
 
 class Track:
@@ -107,21 +110,21 @@ class Track:
     Only the thread that owns the ``MjData`` may use it.
     """
 
-    __slots__ = ("name", "actuator_id", "_data")
+    __slots__ = ("name", "actuator_id", "_ctrl")
 
     def __init__(self, name: str, actuator_id: int, data: mujoco.MjData):
         self.name = name
         self.actuator_id = actuator_id
-        self._data = data
+        self._ctrl = data.ctrl
 
     @property
     def dq_target(self) -> float:
         """Commanded surface velocity, m/s (forward positive)."""
-        return float(self._data.ctrl[self.actuator_id])
+        return float(self._ctrl[self.actuator_id])
 
     @dq_target.setter
     def dq_target(self, value: float) -> None:
-        self._data.ctrl[self.actuator_id] = value
+        self._ctrl[self.actuator_id] = value
 
 
 class Body:

@@ -47,6 +47,7 @@ class MainLoop:
         self.posted = 0
         self.coalesced = 0
         self.executed = 0
+        self.max_pending = 0  # the longest the queue has been: stays at the number of keys, never grows
         self.errors: list[str] = []
 
     # ---- any thread ------------------------------------------------------
@@ -68,6 +69,7 @@ class MainLoop:
             if k in self._pending:
                 self.coalesced += 1
             self._pending[k] = (func, args, kwargs)
+            self.max_pending = max(self.max_pending, len(self._pending))
         self._wakeup.set()
 
     def pending(self) -> int:

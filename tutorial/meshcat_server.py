@@ -38,13 +38,9 @@ class MeshcatServer:
 
         Its zmq socket is not thread-safe: the thread that calls this owns it.
         """
-        import contextlib
-        import io
-
         import meshcat
 
-        with contextlib.redirect_stdout(io.StringIO()):  # it prints the URL; we print our own line
-            return meshcat.Visualizer(zmq_url=self.zmq_url)
+        return meshcat.Visualizer(window=_quiet_window(self.zmq_url))
 
     def close(self, timeout: float = 3.0) -> None:
         """Stop the server process (any thread)."""
@@ -55,6 +51,26 @@ class MeshcatServer:
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait(timeout)
+
+
+def _quiet_window(zmq_url: str):
+    """meshcat's ``ViewerWindow`` for an existing server, without its print of the URL.
+
+    (Silencing it by swapping ``sys.stdout`` would swallow other threads'
+    output too: in a notebook, the kernel's.)  The steps are meshcat's own:
+    connect, ask the server for its page URL, connect again.
+    """
+    from meshcat.visualizer import ViewerWindow
+
+    class QuietWindow(ViewerWindow):
+        def __init__(self, url: str):  # noqa: D401 - mirrors ViewerWindow.__init__ with start_server=False
+            self.server_proc = None
+            self.zmq_url = url
+            self.connect_zmq()
+            self.web_url = self.request_web_url()
+            self.connect_zmq()
+
+    return QuietWindow(zmq_url)
 
 
 def start_server(timeout: float = 20.0) -> MeshcatServer:

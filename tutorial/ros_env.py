@@ -86,6 +86,8 @@ class SpinThread:
         self.node = node
         # One thread, one executor: callbacks of this node never run in
         # parallel with each other, only in parallel with the other threads.
+        # (rclpy.experimental.EventsExecutor has less Python overhead, but in
+        # this rclpy its shutdown() from another thread hangs: not usable here.)
         self.executor = SingleThreadedExecutor(context=node.context)
         self.executor.add_node(node)
         self._thread = threading.Thread(target=self._spin, name="ros-spin", daemon=True)

@@ -30,7 +30,7 @@ from tutorial.viewer_status import format_status
 def format_record(record: dict) -> str:
     """One status record as a human-readable line (or a few, for the summary)."""
     event = record.get("event")
-    if event in ("status", "stale", "recovered"):
+    if event in ("status", "stale", "recovered", "first_state"):
         return format_status(record, record.get("node", ""))
     if event == "meshcat":
         return f"[{record['node']}] meshcat: open {record['url']} in a browser"
@@ -60,10 +60,14 @@ def format_record(record: dict) -> str:
 
 
 def make_output(json_lines: bool):
-    """A printer for status records: JSON lines, or :func:`format_record` text."""
+    """A printer for status records: JSON lines, or :func:`format_record` text.
+
+    Each record goes out in one write, newline included, so lines never mix.
+    """
     def output(record: dict) -> None:
         text = json.dumps(record, sort_keys=False) if json_lines else format_record(record)
-        print(text, flush=True)
+        sys.stdout.write(text + "\n")
+        sys.stdout.flush()
     return output
 
 
@@ -79,8 +83,19 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _raise_interrupt(signum, frame):
-    raise KeyboardInterrupt
+def _stop_on_signal(app: App) -> None:
+    """Ctrl-C or SIGTERM asks the app to stop at the end of its current step; a second one interrupts at once.
+
+    A stop request instead of an exception raised at an arbitrary point keeps
+    output lines and the meshcat connection whole.
+    """
+    def handler(signum, frame):
+        if app.stop_requested:
+            raise KeyboardInterrupt
+        app.request_stop()
+
+    signal.signal(signal.SIGINT, handler)
+    signal.signal(signal.SIGTERM, handler)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -96,8 +111,6 @@ def main(argv: list[str] | None = None) -> int:
     except ProjectError as exc:
         print(f"rtt-run: {exc}", file=sys.stderr)
         return 2
-    # SIGTERM (a launcher stopping us) ends the run like Ctrl-C: cleanly.
-    signal.signal(signal.SIGTERM, _raise_interrupt)
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.signals import SignalHandlerOptions
@@ -106,6 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     app = App(project, node_name=DEFAULT_NODE_NAME, headless=args.headless,
               realtime_sync=False if args.fast else None, duration=args.duration, output=output)
+    _stop_on_signal(app)  # SIGTERM (a launcher stopping us) ends the run like Ctrl-C: cleanly
     status = 0
     try:
         app.open()

@@ -52,12 +52,15 @@ class Simulator:
         realtime_sync: keep simulation time in step with wall-clock time;
             False runs as fast as possible.
         duration: stop after this much simulated time, s (None: until :meth:`request_stop`).
+        record_timing: keep every step's lateness (wall time behind simulated
+            time, s, 0 when on time) in :attr:`lateness`, for benchmarks.
 
     ``start``, ``request_stop``, ``join`` and ``snapshot`` may be called from
     any thread; everything else runs on the simulation thread.
     """
 
-    def __init__(self, model, data, attachments, node=None, realtime_sync=True, duration=None, log=None):
+    def __init__(self, model, data, attachments, node=None, realtime_sync=True, duration=None, log=None,
+                 record_timing=False):
         self.model = model
         self.data = data
         self.attachments = list(attachments)
@@ -68,9 +71,11 @@ class Simulator:
         self.time_step = float(model.opt.timestep)
         self.steps = 0
         self.wall_time = 0.0
+        self.cpu_time = 0.0  # s of CPU the simulation thread used while stepping
         self.error: str | None = None
         self.dropped: list[str] = []  # controllers whose control() returned False
         self.max_overrun = 0.0  # s, the most wall time fell behind simulated time
+        self.lateness: list[float] | None = [] if record_timing else None
         self._stop = threading.Event()
         self.finished = threading.Event()
         self._snapshot_lock = threading.Lock()
@@ -135,27 +140,40 @@ class Simulator:
     def _loop(self, active: list[Attachment]) -> None:
         m, d, dt = self.model, self.data, self.time_step
         active = list(active)
-        t0_sim = float(d.time)
+        controls = [(a, a.controller.control) for a in active]  # bound once: this loop runs every 1 ms
+        stop, snapshot_wanted, step = self._stop.is_set, self._snapshot_wanted.is_set, mujoco.mj_step
+        t0_sim = t = float(d.time)
         wall0 = time.perf_counter()
-        end = None if self.duration is None else t0_sim + self.duration - 0.5 * dt
-        while not self._stop.is_set() and (end is None or d.time < end):
-            for a in list(active):
-                if not a.controller.control():
-                    active.remove(a)
+        cpu0 = time.thread_time()
+        end = float("inf") if self.duration is None else t0_sim + self.duration - 0.5 * dt
+        while t < end and not stop():
+            for a, control in controls:
+                if not control():
+                    controls = [(b, c) for b, c in controls if b is not a]
                     self.dropped.append(a.name)
-            mujoco.mj_step(m, d)
+            step(m, d)
+            t_next = d.time
+            if t_next < t:
+                # MuJoCo resets MjData (time back to 0) when accelerations blow up;
+                # carrying on would hide it and a --duration run would never end.
+                raise RuntimeError(f"the simulation became unstable near t = {t:.3f} s "
+                                   "(NaN or huge acceleration): check controller gains, armature and the time step")
+            t = t_next
             self.steps += 1
-            if self._snapshot_wanted.is_set():
+            if snapshot_wanted():
                 self._snapshot_wanted.clear()
                 self._publish_snapshot()
             if self.realtime_sync:
-                ahead = (d.time - t0_sim) - (time.perf_counter() - wall0)
+                ahead = (t - t0_sim) - (time.perf_counter() - wall0)
+                if self.lateness is not None:
+                    self.lateness.append(max(0.0, -ahead))
                 if ahead > 0.002:
-                    # Sleep in ~2 ms slices: finer sleeps cost more than they gain.
+                    # Sleep when 2 ms or more ahead: finer sleeps cost more than they gain.
                     time.sleep(ahead)
                 elif -ahead > self.max_overrun:
                     self.max_overrun = -ahead
         self.wall_time = time.perf_counter() - wall0
+        self.cpu_time = time.thread_time() - cpu0
 
     def _publish_snapshot(self) -> None:
         snap = Snapshot(float(self.data.time), self.data.qpos.copy(), self.steps)

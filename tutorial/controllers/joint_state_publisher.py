@@ -20,6 +20,8 @@ instead of being lost on a busy link.
 
 from __future__ import annotations
 
+from array import array
+
 from tutorial.controller import ControllerConfig, ControllerIO, SimpleController
 
 DEFAULT_RATE = 50.0  # Hz
@@ -85,11 +87,19 @@ class RttJointStatePublisher(SimpleController):
         return True
 
     def initialize(self, io: ControllerIO) -> bool:
+        import numpy as np
+
         self.io = io
         self.data = io.data
         self.joints = io.body.joint_infos
-        self.names = [j.name for j in self.joints]
         self.accumulator = PeriodAccumulator(io.time_step, self.rate)
+        # One message, reused: the names never change, and rclpy serialises the
+        # message inside publish(), so refilling it afterwards is safe.  Positions,
+        # velocities and efforts are gathered with one NumPy index each.
+        self.msg = self.msg_type()
+        self.msg.name = [j.name for j in self.joints]
+        self.qpos_index = np.array([j.qpos_adr for j in self.joints], dtype=int)
+        self.dof_index = np.array([j.dof_adr for j in self.joints], dtype=int)
         return True
 
     def control(self) -> bool:
@@ -102,17 +112,15 @@ class RttJointStatePublisher(SimpleController):
         self.publish()
 
     def publish(self) -> None:
-        """Build and publish one JointState from the current simulation state (simulation thread)."""
-        d = self.data
-        msg = self.msg_type()
+        """Fill the JointState from the current simulation state and publish it (simulation thread)."""
+        d, msg = self.data, self.msg
         t = d.time
         sec = int(t)
         msg.header.stamp.sec = sec
         msg.header.stamp.nanosec = min(999_999_999, int(round((t - sec) * 1e9)))
-        msg.name = self.names
-        msg.position = [float(d.qpos[j.qpos_adr]) for j in self.joints]
-        msg.velocity = [float(d.qvel[j.dof_adr]) for j in self.joints]
-        msg.effort = [float(d.qfrc_actuator[j.dof_adr]) for j in self.joints]
+        msg.position = array("d", d.qpos[self.qpos_index].tobytes())
+        msg.velocity = array("d", d.qvel[self.dof_index].tobytes())
+        msg.effort = array("d", d.qfrc_actuator[self.dof_index].tobytes())
         self.publisher.publish(msg)
         self.published += 1
 

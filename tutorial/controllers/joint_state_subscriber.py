@@ -60,7 +60,11 @@ class RttJointStateSubscriber(SimpleController):
         for name, q in report.applied.items():
             self.body.joint(name).q = q
         self.body.notify_kinematic_state_change()
+        first = self.status.applied == 0
         self.status.applied_message(arrival, report.matched, report.counts(), report.applied)
+        if first:
+            self.config.output({"event": "first_state", "node": self.node_name, "topic": self.topic,
+                                "matched": report.matched, "joints": self.body.num_joints})
         return report
 
     def report_status(self) -> None:

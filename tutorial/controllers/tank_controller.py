@@ -142,21 +142,30 @@ class RttTankController(SimpleController):
         self.turret = [io.body.joint(name) for name in TURRET_JOINTS]
         self.tracks = [io.body.track(name) for name in TRACKS]
         self.q_ref = [j.q for j in self.turret]
+        self.axes_in_use = None
+        self.rates = (0.0, 0.0)
         return True
 
     def control(self) -> bool:
         axes, _buttons = self.take_input()  # lock held only inside take_input
-        left, right = track_velocities(axes)
-        self.tracks[0].dq_target = left
-        self.tracks[1].dq_target = right
-        for i, (joint, rate) in enumerate(zip(self.turret, turret_rates(axes))):
-            # The reference advances with the stick and stays inside the
-            # joint's range, so holding the stick at a limit winds nothing up.
-            # The reference's rate is what it really moved: 0 at a limit.
-            info = joint.info
-            q_ref = min(max(self.q_ref[i] + rate * self.dt, info.lower), info.upper)
-            dq_ref = (q_ref - self.q_ref[i]) / self.dt
-            self.q_ref[i] = q_ref
+        if axes is not self.axes_in_use:
+            # A new message: work out the commands once, not every millisecond.
+            self.axes_in_use = axes
+            left, right = track_velocities(axes)
+            self.tracks[0].dq_target = left  # stays in force until changed
+            self.tracks[1].dq_target = right
+            self.rates = turret_rates(axes)
+        for i, (joint, rate) in enumerate(zip(self.turret, self.rates)):
+            q_ref = self.q_ref[i]
+            dq_ref = 0.0
+            if rate:
+                # The reference advances with the stick and stays inside the joint's
+                # range, so holding the stick at a limit winds nothing up.  Its rate
+                # is what it really moved: 0 at a limit.
+                info = joint.info
+                q_ref = min(max(q_ref + rate * self.dt, info.lower), info.upper)
+                dq_ref = (q_ref - self.q_ref[i]) / self.dt
+                self.q_ref[i] = q_ref
             joint.u = pd_torque(q_ref, joint.q, dq_ref, joint.dq)
         return True
 

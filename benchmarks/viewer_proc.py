@@ -1,0 +1,54 @@
+"""The Step 3 viewer as ``rtt-run`` runs it, with its scene updates timed (benchmark use).
+
+    python -m benchmarks.viewer_proc PROJECT --duration S [--headless]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import rclpy
+from rclpy.signals import SignalHandlerOptions
+
+from tutorial import ros_env
+from tutorial.app import App
+from tutorial.project import load_project
+
+
+def main() -> int:
+    p = argparse.ArgumentParser()
+    p.add_argument("project")
+    p.add_argument("--duration", type=float, required=True)
+    p.add_argument("--headless", action="store_true")
+    p.add_argument("--name", default="rtt_viewer")
+    args = p.parse_args()
+    ros_env.use_localhost_by_default()
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    app = App(load_project(args.project), node_name=args.name, headless=args.headless, duration=args.duration,
+              output=lambda record: print(record, flush=True) if record.get("event") != "status" else None)
+    try:
+        app.open()
+        probe = next(c for _, c in app.configured if hasattr(c, "frame_drawn"))
+        if app.scene is not None:
+            update = app.scene.update
+
+            def timed_update(data):
+                t0 = time.perf_counter()
+                sent = update(data)
+                probe.frame_drawn(time.perf_counter() - t0)
+                return sent
+
+            app.scene.update = timed_update
+        else:
+            app.loop.call_every(1 / 60, lambda: probe.frame_drawn(0.0))
+        app.run()
+    finally:
+        app.close()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
