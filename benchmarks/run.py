@@ -274,6 +274,45 @@ def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int) -> di
     return {"rate_hz": rate, "latency_ms": pct(lat, 1e-6), "received": len(received), "cpu_cores": round(cpu, 3)}
 
 
+# ---------------------------------------------------------------- 3b. meshcat cost per frame
+def scene_update_cost(model_file: str, frames: int) -> dict:
+    """ms per frame to move every body of a model in meshcat: pipelined (the library) vs a round trip per body.
+
+    The baseline is meshcat-python's own ``set_transform``, which waits for
+    the server's reply after each command; both run against one server, interleaved.
+    """
+    import mujoco
+
+    from tutorial.meshcat_server import start_server
+    from tutorial.scene import Scene
+    from tutorial.world import ModelEntry, build_world
+
+    model = build_world([ModelEntry("M", ROOT / model_file)])
+    data = mujoco.MjData(model)
+    server = start_server()
+    try:
+        scene = Scene(server.visualizer(), model)
+        scene.build(data)
+        pipe = scene._pipe
+        times = {"pipelined": [], "round_trip_per_body": []}
+        for i in range(frames):
+            for label, p in (("pipelined", pipe), ("round_trip_per_body", None)):
+                scene._pipe = p
+                data.qpos[:] = 0.001 * (2 * i + (p is None))
+                mujoco.mj_kinematics(model, data)
+                t0 = time.perf_counter()
+                scene.update(data)
+                times[label].append(time.perf_counter() - t0)
+        scene._pipe = pipe
+        scene.close()
+    finally:
+        server.close()
+    out = {k: pct(v, 1000.0) for k, v in times.items()}
+    out["bodies"] = len(scene.moving_bodies)
+    out["speedup_p50"] = round(out["round_trip_per_body"]["p50"] / out["pipelined"]["p50"], 2)
+    return out
+
+
 # ---------------------------------------------------------------- 4. start-up
 def startup(repeats: int) -> dict:
     """Seconds from starting ``launch_py/step3_launch.py --demo`` to the viewer's first applied state."""
@@ -361,6 +400,11 @@ def print_report(r: dict) -> None:
               f"p99 {run['scene_update_ms']['p99']:.3f} ms; messages applied {m['applied']}, coalesced {m['coalesced']}, "
               f"max pending {m['max_pending']}; CPU cores sim {run['cpu_cores']['simulation']}, viewer "
               f"{run['cpu_cores']['viewer']}, total {run['cpu_cores']['total']} (bare pair {r['bare'][key]['cpu_cores']})")
+    print("\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, same server, interleaved")
+    for name, u in r["scene_update"].items():
+        print(f"  {name:6s} {u['bodies']} bodies: pipelined p50 {u['pipelined']['p50']:.3f} p99 {u['pipelined']['p99']:.3f}; "
+              f"round trip per body p50 {u['round_trip_per_body']['p50']:.3f} p99 {u['round_trip_per_body']['p99']:.3f} "
+              f"({u['speedup_p50']}x)")
     print(f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, median {r['startup']['median_s']} s")
     print("\n== targets")
     for name, ok, figure in r["targets"]:
@@ -399,6 +443,8 @@ def main(argv=None) -> int:
     ):
         r["bare"][key] = bare_pair_run(rate, seconds, warmup, joints)
         r["pipeline"][key] = pipeline_run(sim_p, view_p, rate, seconds, warmup)
+    r["scene_update"] = {"tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
+                         "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200)}
     r["startup"] = startup(1 if args.quick else 3)
     r["targets"] = targets(r)
     print_report(r)
