@@ -102,22 +102,38 @@ class SimpleController:
     PARAMETERS: dict[str, tuple[type, Any, str]] = {}
 
     def configure(self, config: ControllerConfig) -> bool:
+        """Attached to a body, before any simulation (main thread). False refuses.
+
+        Create subscriptions and publishers here; with no simulator, this is
+        where the controller does its work (Step 3).
+        """
         return True
 
     def initialize(self, io: ControllerIO) -> bool:
+        """The simulation is about to start (simulation thread). False refuses.
+
+        Take the joints and tracks from ``io.body``: they read and write the
+        simulation's ``MjData``, which only this thread may touch.
+        """
         return True
 
     def start(self) -> bool:
+        """Just before the first step (simulation thread). False refuses."""
         return True
 
     def control(self) -> bool:
+        """One simulation step, before physics advances (simulation thread, every ``time_step`` s).
+
+        Read sensors and joints, write torques or track velocities. Return
+        False to drop out of the simulation.
+        """
         return True
 
     def stop(self) -> None:
-        pass
+        """The simulation has ended (simulation thread)."""
 
     def unconfigure(self) -> None:
-        pass
+        """Detached from the body, at program exit (main thread): undo ``configure``."""
 
     def summary(self) -> dict:
         """Figures for the program's exit summary (main thread, after ``stop``)."""

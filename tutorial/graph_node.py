@@ -100,6 +100,7 @@ def draw_graph(graph: Graph, path: str) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``rtt-graph``: discover for ``--wait`` s, print the graph (and draw it); the exit status."""
     import json
 
     import rclpy

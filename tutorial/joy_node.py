@@ -98,6 +98,7 @@ def choose_source(args, stack: contextlib.ExitStack):
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``rtt-joy``: choose the input source, publish ``/joy`` until stopped; the exit status."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.utilities import remove_ros_args

@@ -50,6 +50,7 @@ class Node:
     required: bool = False
 
     def command(self) -> list[str]:
+        """The node's command line: ``python -m module arguments --ros-args -r __node:=name``."""
         return [sys.executable, "-u", "-m", self.module, *self.arguments, "--ros-args", "-r", f"__node:={self.name}"]
 
 
@@ -93,6 +94,7 @@ class Launch:
         stream.close()
 
     def start(self) -> None:
+        """Start every node of the description, in order, with its output prefixed (main thread)."""
         env = dict(os.environ)
         env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
         # The nodes import this library from wherever the launcher found it (a clone need not be installed).

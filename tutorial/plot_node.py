@@ -77,10 +77,12 @@ def draw(ax, series: dict, topic: str) -> None:
 
 
 def has_display() -> bool:
+    """Whether a graphical display is available for a live window."""
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``rtt-plot``: record ``/<body>/joint_state`` and plot it (a window, or a PNG); the exit status."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.utilities import remove_ros_args

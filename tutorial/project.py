@@ -79,10 +79,6 @@ class Project:
     models: list[ModelEntry]
     simulator: SimulatorSettings | None
 
-    @property
-    def controlled_models(self) -> list[ModelEntry]:
-        return [m for m in self.models if m.controllers]
-
 
 class _Reader:
     """Walks the YAML tree, raising ProjectError with the file and key path."""

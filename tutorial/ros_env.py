@@ -104,6 +104,7 @@ class SpinThread:
             self.error = exc
 
     def start(self) -> "SpinThread":
+        """Start spinning on the background thread; returns self."""
         self._thread.start()
         return self
 

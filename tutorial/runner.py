@@ -72,6 +72,7 @@ def make_output(json_lines: bool):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The command line of ``rtt-run`` (ROS arguments are removed before it parses)."""
     p = argparse.ArgumentParser(prog="rtt-run", description="Open a tutorial project file and run it.",
                                 epilog="ROS arguments go after --ros-args, e.g. --ros-args -r __node:=rtt_viewer")
     p.add_argument("project", help="project file, e.g. project/step1.yaml")
@@ -99,6 +100,7 @@ def _stop_on_signal(app: App) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``rtt-run``: parse the command line, run the project, print the summary; the exit status (main thread)."""
     from rclpy.utilities import remove_ros_args
 
     argv = list(sys.argv if argv is None else argv)

@@ -71,6 +71,7 @@ class Scene:
         self._pipe = _Pipeline(zmq_url) if zmq_url else None
 
     def body_path(self, body_id: int) -> str:
+        """The meshcat path of a body's frame, e.g. ``rtt/Tank/TURRET_Y``."""
         name = mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, body_id) or f"body{body_id}"
         return f"{self.root}/{name}"
 
@@ -166,6 +167,7 @@ class Scene:
         return sent
 
     def close(self) -> None:
+        """Close the scene's own zmq socket (the owner thread, once drawing is over)."""
         if self._pipe is not None:
             self._pipe.close()
 

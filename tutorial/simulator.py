@@ -85,10 +85,12 @@ class Simulator:
 
     # ---- any thread ---------------------------------------------------------
     def start(self) -> "Simulator":
+        """Start the simulation thread (any thread, once)."""
         self._thread.start()
         return self
 
     def request_stop(self) -> None:
+        """Ask the simulation thread to end after its current step (any thread)."""
         self._stop.set()
 
     def join(self, timeout: float | None = None) -> bool:
