@@ -30,7 +30,7 @@ def main() -> int:
               output=lambda record: print(record, flush=True) if record.get("event") != "status" else None)
     try:
         app.open()
-        probe = next(c for _, c in app.configured if hasattr(c, "frame_drawn"))
+        probe = next(c for _, c, _ in app.controllers if hasattr(c, "frame_drawn"))
         if app.scene is not None:
             update = app.scene.update
 

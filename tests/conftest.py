@@ -23,6 +23,8 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("RTT_TEST_MODE", "1")  # notebooks run under nbval: shorter interactive runs
 
+from tutorial.notebook import wait_until  # noqa: E402,F401 - after the environment; one polling helper for all
+
 ROOT = Path(__file__).resolve().parent.parent
 PROJECT = ROOT / "project"
 MODEL = ROOT / "model"
@@ -129,16 +131,6 @@ class Proc:
         if self.p.poll() is None:
             self.p.kill()
             self.p.wait()
-
-
-def wait_until(predicate, timeout: float, poll: float = 0.05) -> bool:
-    """Poll ``predicate`` until true or ``timeout`` s; returns its last value."""
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() >= deadline:
-            return predicate()
-        time.sleep(poll)
-    return True
 
 
 @pytest.fixture

@@ -11,11 +11,6 @@ from conftest import module_command, wait_until
 pytestmark = pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
 
 
-def applied_count(proc) -> int:
-    counts = [r["applied"] for r in proc.json_records() if r.get("event") == "status"]
-    return counts[-1] if counts else 0
-
-
 def publish_and_wait_applied(pub, view, names, positions, expect_applied):
     from sensor_msgs.msg import JointState
 

@@ -2,7 +2,6 @@
 
 import threading
 
-import pytest
 
 from tutorial.call_later import LazyCaller, MainLoop, WrongThreadError
 

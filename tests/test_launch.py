@@ -52,7 +52,7 @@ def test_step3_launch_stops_every_node_within_5_s(procs, sig):
     assert "[rtt_viewer] --- summary: project step3, node /rtt_viewer ---" in launch.out
 
 
-def test_a_failing_node_fails_the_launch_and_stops_the_others(capsys):
+def test_a_failing_node_fails_the_launch_and_stops_the_others():
     import io
 
     out = io.StringIO()

@@ -2,7 +2,6 @@
 
 import threading
 
-import pytest
 
 from tests.fixtures import recording_controller as rec
 from tutorial.app import App
@@ -65,7 +64,7 @@ def test_parameters_reach_configure(tmp_path, node):
     app = App(project, node=node, headless=True, duration=0.01, output=lambda r: None)
     app.open()
     try:
-        controller = app.configured[0][1]
+        controller = app.controller("Rec")
         assert controller.params == {"gain": 3.0, "label": "x"}
     finally:
         app.close()

@@ -2,7 +2,6 @@
 
 import mujoco
 
-from tutorial.body import Body
 from tutorial.controller import SimpleController
 from tutorial.simulator import Attachment, Simulator
 from tutorial.world import ModelEntry, build_world

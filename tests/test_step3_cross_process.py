@@ -1,6 +1,5 @@
 """Step 3 across real processes: simulation, joystick and viewer as separate programs."""
 
-import json
 import math
 import signal
 import time

@@ -82,8 +82,8 @@ class App:
         self.sim: Simulator | None = None
         self.spin = None
         self._own_node = node is None
-        self.controllers: list[tuple[str, object, str]] = []  # (name, controller, body name)
-        self.configured: list[tuple[str, object]] = []
+        self.controllers: list[tuple[str, object, str]] = []  # (name, controller, body name), configured
+        self._unconfigured = False
         self.warned_duplicate = False
         self._started = None
         self._last_frame = 0.0
@@ -139,7 +139,7 @@ class App:
         Raises:
             KeyError: no controller of that name.
         """
-        for n, c in self.configured:
+        for n, c, _ in self.controllers:
             if n == name:
                 return c
         raise KeyError(f"no controller named {name!r}")
@@ -156,7 +156,6 @@ class App:
             raise ControllerError(f"controller {name} failed to configure: {exc!r}") from exc
         if not ok:
             raise ControllerError(f"controller {name} refused to configure")
-        self.configured.append((name, controller))
         self.controllers.append((name, controller, body_name))
 
     def _ros_parameters(self, entry) -> dict:
@@ -178,7 +177,7 @@ class App:
             def fail(msg, full=full):
                 return ControllerError(f"parameter {full}: {msg}")
 
-            values[name] = check_parameter(full, typ, value, fail)
+            values[name] = check_parameter(typ, value, fail)
         return values
 
     def _open_view(self) -> None:
@@ -256,12 +255,13 @@ class App:
         # Work handed over before the spin thread stopped still runs, so the
         # last state received is the last state shown.
         self.loop.process_pending()
-        for name, controller in reversed(self.configured):
-            try:
-                controller.unconfigure()
-            except Exception as exc:  # noqa: BLE001 - close the rest anyway
-                self.log.error("controller %s failed to unconfigure: %r", name, exc)
-        self.configured.clear()
+        if not self._unconfigured:
+            self._unconfigured = True
+            for name, controller, _ in reversed(self.controllers):
+                try:
+                    controller.unconfigure()
+                except Exception as exc:  # noqa: BLE001 - close the rest anyway
+                    self.log.error("controller %s failed to unconfigure: %r", name, exc)
         if self._own_node and self.node is not None:
             self.node.destroy_node()
         if self.scene is not None:

@@ -228,11 +228,11 @@ def _parameters(r: _Reader, cls: type, given: Any, key: str) -> dict:
             known = ", ".join(cls.PARAMETERS) or "none"
             raise r.fail(_join(key, str(name)), f"unknown parameter of {cls.__name__}; known: {known}")
         typ = cls.PARAMETERS[name][0]
-        values[name] = check_parameter(name, typ, value, lambda msg: r.fail(_join(key, name), msg))
+        values[name] = check_parameter(typ, value, lambda msg: r.fail(_join(key, name), msg))
     return values
 
 
-def check_parameter(name: str, typ: type, value: Any, fail) -> Any:
+def check_parameter(typ: type, value: Any, fail) -> Any:
     """Validate one controller parameter value (used for project values and ROS overrides).
 
     Raises:

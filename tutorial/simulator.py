@@ -74,7 +74,6 @@ class Simulator:
         self.cpu_time = 0.0  # s of CPU the simulation thread used while stepping
         self.error: str | None = None
         self.dropped: list[str] = []  # controllers whose control() returned False
-        self.max_overrun = 0.0  # s, the most wall time fell behind simulated time
         self.lateness: list[float] | None = [] if record_timing else None
         self._stop = threading.Event()
         self.finished = threading.Event()
@@ -172,8 +171,6 @@ class Simulator:
                 if ahead > 0.002:
                     # Sleep when 2 ms or more ahead: finer sleeps cost more than they gain.
                     time.sleep(ahead)
-                elif -ahead > self.max_overrun:
-                    self.max_overrun = -ahead
         self.wall_time = time.perf_counter() - wall0
         self.cpu_time = time.thread_time() - cpu0
 
