@@ -164,11 +164,11 @@ class App:
         The project's value is the default; ``--ros-args -p RttJointStatePublisher.rate:=100``
         overrides it.  A wrong type is a ControllerError naming the parameter.
         """
+        from rcl_interfaces.msg import ParameterDescriptor
+
         values = dict(entry.parameters)
         for name, (typ, _default, description) in entry.cls.PARAMETERS.items():
             full = f"{entry.name}.{name}"
-            from rcl_interfaces.msg import ParameterDescriptor
-
             if not self.node.has_parameter(full):
                 self.node.declare_parameter(full, values[name], ParameterDescriptor(description=description),
                                             ignore_override=False)

@@ -259,9 +259,9 @@ class BackgroundApp:
 
     def stop(self, timeout: float = 10.0) -> dict | None:
         """Stop the run and wait for its summary (None if it did not end in ``timeout`` s)."""
-        self._stop.set()
+        self._stop.set()  # also covers a stop asked for before the thread has built its App
         if self.app is not None:
-            self.app.loop.wake()
+            self.app.request_stop()
         if self.thread is not None:
             self.thread.join(timeout)
         return self.summary
