@@ -76,3 +76,23 @@ def test_a_controller_that_refuses_to_initialize_is_reported(tmp_path, node):
     summary = app.summary()
     assert "refused to initialize" in summary["error"]
     assert app.sim.steps == 0
+
+
+def test_a_callback_that_raises_ends_the_run_and_is_reported(tmp_path, node):
+    from std_msgs.msg import String
+
+    from conftest import wait_until
+
+    project = write_project(tmp_path, "tests.fixtures.recording_controller:BrokenCallbackController",
+                            simulate=False)
+    app = App(project, node_name="broken_callback_app", headless=True, duration=60.0, output=lambda r: None)
+    pub = node.create_publisher(String, "/broken_callback", 10)
+    try:
+        app.open()
+        assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
+        pub.publish(String(data="x"))
+        assert app.loop.run_until(app.done, timeout=10)  # ended long before its 60 s duration
+    finally:
+        app.close()
+    assert "a subscription callback raised" in app.summary()["error"]
+    assert "cannot handle 'x'" in app.summary()["error"]

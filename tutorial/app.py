@@ -234,6 +234,8 @@ class App:
     def done(self) -> bool:
         if self.stop_requested:
             return True
+        if self.spin is not None and self.spin.error is not None:
+            return True  # a subscription callback raised and spinning ended: summary() reports it
         if self.sim is not None:
             return self.sim.finished.is_set()
         return self.duration is not None and time.monotonic() - self._started >= self.duration
@@ -312,6 +314,12 @@ class App:
                 "joint_positions": {k: round(v, 9) for k, v in body.joint_positions().items()},
             }
         record["bodies"] = bodies
+        if self.spin is not None and self.spin.error is not None:
+            import traceback
+
+            text = "a subscription callback raised; callbacks stopped:\n" + "".join(
+                traceback.format_exception(self.spin.error))
+            record["error"] = record["error"] + "\n" + text if record.get("error") else text
         controllers = {}
         for name, controller, _ in self.controllers:
             s = controller.summary()

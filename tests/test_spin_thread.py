@@ -1,0 +1,69 @@
+"""The spin thread: callbacks run on it, and it stops cleanly however it is asked to."""
+
+import threading
+
+import pytest
+from std_msgs.msg import String
+
+from conftest import wait_until
+from tutorial.ros_env import SPIN_POLL, SpinThread, make_executor
+
+
+def test_the_executor_is_the_events_executor_where_rclpy_has_it(node):
+    pytest.importorskip("rclpy.experimental")
+    assert type(make_executor(node.context)).__name__ == "EventsExecutor"
+
+
+def test_callbacks_run_on_the_spin_thread_and_stop_ends_it(node):
+    threads = []
+    node.create_subscription(String, "/spin_thread_test", lambda msg: threads.append(threading.get_ident()), 10)
+    pub = node.create_publisher(String, "/spin_thread_test", 10)
+    spin = SpinThread(node).start()
+    try:
+        assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
+        for _ in range(5):
+            pub.publish(String(data="x"))
+        assert wait_until(lambda: len(threads) == 5, timeout=10), threads
+        assert set(threads) == {spin._thread.ident} and spin._thread.ident != threading.get_ident()
+        # A subscription added while spinning is served too (the executor is woken from this thread).
+        later = []
+        node.create_subscription(String, "/spin_thread_test", lambda msg: later.append(msg.data), 10)
+        assert wait_until(lambda: pub.get_subscription_count() > 1, timeout=10)
+        pub.publish(String(data="y"))
+        assert wait_until(lambda: later == ["y"], timeout=10), later
+    finally:
+        assert spin.stop(timeout=10 * SPIN_POLL + 2.0)
+    assert spin.error is None
+    # One spin thread per node in its life: a second one is refused, not silently lossy.
+    with pytest.raises(RuntimeError, match="already spun"):
+        SpinThread(node)
+
+
+def test_a_ros_shutdown_ends_the_spin_thread():
+    import rclpy
+
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    node = rclpy.create_node("spin_thread_shutdown", context=context)
+    spin = SpinThread(node).start()
+    rclpy.try_shutdown(context=context)
+    assert wait_until(lambda: not spin._thread.is_alive(), timeout=10)
+    assert spin.error is None
+    spin.stop()
+    node.destroy_node()
+
+
+def test_an_exception_in_a_callback_is_kept_for_the_owner(node):
+    def broken(msg):
+        raise ValueError("broken callback")
+
+    node.create_subscription(String, "/spin_thread_broken", broken, 10)
+    pub = node.create_publisher(String, "/spin_thread_broken", 10)
+    spin = SpinThread(node).start()
+    try:
+        assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
+        pub.publish(String(data="x"))
+        assert wait_until(lambda: spin.error is not None, timeout=10)
+        assert isinstance(spin.error, ValueError)
+    finally:
+        assert spin.stop()
