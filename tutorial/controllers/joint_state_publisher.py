@@ -87,19 +87,21 @@ class RttJointStatePublisher(SimpleController):
         return True
 
     def initialize(self, io: ControllerIO) -> bool:
-        import numpy as np
-
         self.io = io
         self.data = io.data
         self.joints = io.body.joint_infos
         self.accumulator = PeriodAccumulator(io.time_step, self.rate)
-        # One message, reused: the names never change, and rclpy serialises the
-        # message inside publish(), so refilling it afterwards is safe.  Positions,
-        # velocities and efforts are gathered with one NumPy index each.
+        # One message, reused, with its three arrays allocated once and refilled
+        # in place: the names never change, and rclpy copies the message inside
+        # publish(), so refilling it afterwards is safe.  The values are read
+        # through memoryviews of the MjData arrays (see tutorial.body.Joint).
+        n = len(self.joints)
         self.msg = self.msg_type()
         self.msg.name = [j.name for j in self.joints]
-        self.qpos_index = np.array([j.qpos_adr for j in self.joints], dtype=int)
-        self.dof_index = np.array([j.dof_adr for j in self.joints], dtype=int)
+        self.msg.position, self.msg.velocity, self.msg.effort = (array("d", bytes(8 * n)) for _ in range(3))
+        self.stamp = self.msg.header.stamp
+        self.sources = (memoryview(io.data.qpos), memoryview(io.data.qvel), memoryview(io.data.qfrc_actuator))
+        self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(self.joints)]
         return True
 
     def control(self) -> bool:
@@ -113,14 +115,17 @@ class RttJointStatePublisher(SimpleController):
 
     def publish(self) -> None:
         """Fill the JointState from the current simulation state and publish it (simulation thread)."""
-        d, msg = self.data, self.msg
-        t = d.time
+        t = self.data.time
         sec = int(t)
-        msg.header.stamp.sec = sec
-        msg.header.stamp.nanosec = min(999_999_999, int(round((t - sec) * 1e9)))
-        msg.position = array("d", d.qpos[self.qpos_index].tobytes())
-        msg.velocity = array("d", d.qvel[self.dof_index].tobytes())
-        msg.effort = array("d", d.qfrc_actuator[self.dof_index].tobytes())
+        self.stamp.sec = sec
+        self.stamp.nanosec = min(999_999_999, int(round((t - sec) * 1e9)))
+        msg = self.msg
+        position, velocity, effort = msg.position, msg.velocity, msg.effort
+        qpos, qvel, qfrc = self.sources
+        for i, qpos_adr, dof_adr in self.addresses:
+            position[i] = qpos[qpos_adr]  # rad (hinge) or m (slide)
+            velocity[i] = qvel[dof_adr]  # rad/s or m/s
+            effort[i] = qfrc[dof_adr]  # N*m or N, from the actuators
         self.publisher.publish(msg)
         self.published += 1
 

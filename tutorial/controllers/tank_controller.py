@@ -155,15 +155,15 @@ class RttTankController(SimpleController):
             self.tracks[0].dq_target = left  # stays in force until changed
             self.tracks[1].dq_target = right
             self.rates = turret_rates(axes)
-        q_refs, dt = self.q_ref, self.dt
+        q_refs, rates, dt = self.q_ref, self.rates, self.dt
         for i, joint in enumerate(self.turret):
-            rate, q_ref, dq_ref = self.rates[i], q_refs[i], 0.0
-            if rate:
+            q_ref, dq_ref = q_refs[i], 0.0
+            if rates[i]:
                 # The reference advances with the stick and stays inside the joint's
                 # range, so holding the stick at a limit winds nothing up.  Its rate
                 # is what it really moved: 0 at a limit.
                 info = joint.info
-                q_ref = min(max(q_ref + rate * dt, info.lower), info.upper)
+                q_ref = min(max(q_ref + rates[i] * dt, info.lower), info.upper)
                 dq_ref = (q_ref - q_refs[i]) / dt
                 q_refs[i] = q_ref
             joint.u = pd_torque(q_ref, joint.q, dq_ref, joint.dq)
