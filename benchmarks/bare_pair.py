@@ -1,7 +1,7 @@
 """The baseline: a bare rclpy publisher and subscriber of ``sensor_msgs/JointState``.
 
     python -m benchmarks.bare_pair pub --rate 1000 --duration 8 --joints 2
-    python -m benchmarks.bare_pair sub --duration 10          # writes RTT_PROBE_FILE
+    python -m benchmarks.bare_pair sub --duration 10 [--executor events]   # writes RTT_PROBE_FILE
 
 Same message, same topic name pattern and same QoS as the tutorial's
 publisher and viewer, nothing else: the publisher stamps each message with
@@ -32,11 +32,18 @@ def main() -> int:
     p.add_argument("--rate", type=float, default=1000.0)
     p.add_argument("--duration", type=float, default=8.0)
     p.add_argument("--joints", type=int, default=2)
+    p.add_argument("--executor", choices=["single", "events"], default="single",
+                   help="single: rclpy's default SingleThreadedExecutor (the baseline); events: EventsExecutor")
     args = p.parse_args()
     ros_env.use_localhost_by_default()
     rclpy.init()
     node = rclpy.create_node(f"bare_{args.role}")
-    executor = SingleThreadedExecutor()
+    if args.executor == "events":
+        from rclpy.experimental import EventsExecutor
+
+        executor = EventsExecutor()
+    else:
+        executor = SingleThreadedExecutor()
     executor.add_node(node)
     log: list[tuple[int, int]] = []
     if args.role == "pub":

@@ -202,7 +202,7 @@ def realtime_mode(project: str, seconds: float) -> dict:
 # ---------------------------------------------------------------- 2-3. across processes
 def pipeline_run(sim_project: str, view_project: str, rate: float, seconds: float, warmup: float,
                  headless_view: bool = False) -> dict:
-    """Simulation and viewer as two processes; latencies joined on the state's stamp."""
+    """One run of simulation and viewer as two processes: raw samples, joined on the state's stamp."""
     with tempfile.TemporaryDirectory() as d:
         sim_probe, view_probe = Path(d) / "sim.json", Path(d) / "view.json"
         view_cmd = py("benchmarks.viewer_proc", view_project)
@@ -231,33 +231,57 @@ def pipeline_run(sim_project: str, view_project: str, rate: float, seconds: floa
     end_ns = s["wall_ns"][-1]
     window = [(step_wall[round(stamp / 1000)], arrived, applied) for stamp, arrived, applied in v["applied"]
               if round(stamp / 1000) in step_wall and start_ns <= applied <= end_ns]
-    lat = [applied - step for step, _, applied in window]
     frames = [(t, stamp, cost) for t, stamp, cost in v["frames"]
               if start_ns <= t <= end_ns and round(stamp / 1000) in step_wall]
     ages = [t - step_wall[round(stamp / 1000)] for t, stamp, _ in frames]
-    half = len(ages) // 2
-    cpu = {k: round((cpu1[k] - cpu0[k]) / span, 3) for k in cpu0}
     return {
-        "rate_hz": rate,
-        "latency_ms": pct(lat, 1e-6),
-        "step_to_callback_ms": pct([arrived - step for step, arrived, _ in window], 1e-6),
-        "callback_to_applied_ms": pct([applied - arrived for _, arrived, applied in window], 1e-6),
-        "displayed_age_ms": pct(ages, 1e-6),
-        "displayed_age_p99_ms_first_half": pct(ages[:half], 1e-6)["p99"],
-        "displayed_age_p99_ms_second_half": pct(ages[half:], 1e-6)["p99"],
-        "frames_per_s": round(len(frames) / ((frames[-1][0] - frames[0][0]) * 1e-9), 1) if len(frames) > 1 else 0.0,
-        "scene_update_ms": pct([c for _, _, c in frames], 1000.0),
+        "latency": [applied - step for step, _, applied in window],
+        "step_to_callback": [arrived - step for step, arrived, _ in window],
+        "callback_to_applied": [applied - arrived for _, arrived, applied in window],
+        "ages": ages,
+        "frames": len(frames),
+        "frame_span_s": (frames[-1][0] - frames[0][0]) * 1e-9 if len(frames) > 1 else 0.0,
+        "scene_update_s": [c for _, _, c in frames],
         "messages": {"applied": len(v["applied"]), "posted": v["posted"], "coalesced": v["coalesced"],
                      "max_pending": v["max_pending"]},
+        "cpu_cores": {k: (cpu1[k] - cpu0[k]) / span for k in cpu0},
+    }
+
+
+def pool_pipeline(runs: list[dict], rate: float) -> dict:
+    """The pipeline's figures over interleaved runs: samples pooled, CPU averaged, counts summed."""
+    ages_first = [a for r in runs for a in r["ages"][: len(r["ages"]) // 2]]
+    ages_second = [a for r in runs for a in r["ages"][len(r["ages"]) // 2:]]
+    span = sum(r["frame_span_s"] for r in runs)
+    cpu = {k: round(statistics.mean(r["cpu_cores"][k] for r in runs), 3) for k in runs[0]["cpu_cores"]}
+    return {
+        "rate_hz": rate,
+        "runs": len(runs),
+        "latency_ms": pct([x for r in runs for x in r["latency"]], 1e-6),
+        "step_to_callback_ms": pct([x for r in runs for x in r["step_to_callback"]], 1e-6),
+        "callback_to_applied_ms": pct([x for r in runs for x in r["callback_to_applied"]], 1e-6),
+        "displayed_age_ms": pct(ages_first + ages_second, 1e-6),
+        "displayed_age_p99_ms_first_half": pct(ages_first, 1e-6)["p99"],
+        "displayed_age_p99_ms_second_half": pct(ages_second, 1e-6)["p99"],
+        "frames_per_s": round(sum(r["frames"] for r in runs) / span, 1) if span > 0 else 0.0,
+        "scene_update_ms": pct([c for r in runs for c in r["scene_update_s"]], 1000.0),
+        "messages": {"applied": sum(r["messages"]["applied"] for r in runs),
+                     "posted": sum(r["messages"]["posted"] for r in runs),
+                     "coalesced": sum(r["messages"]["coalesced"] for r in runs),
+                     "max_pending": max(r["messages"]["max_pending"] for r in runs)},
         "cpu_cores": {**cpu, "total": round(sum(cpu.values()), 3)},
     }
 
 
-def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int) -> dict:
-    """The bare rclpy pair at the same rate, same message and QoS."""
+def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, executor: str = "single") -> dict:
+    """One run of the bare rclpy pair at the same rate, same message and QoS: raw samples.
+
+    ``executor`` is the subscriber's: ``single`` (rclpy's default, the baseline)
+    or ``events`` (the one the tutorial's spin threads use, for comparison).
+    """
     with tempfile.TemporaryDirectory() as d:
         probe = Path(d) / "bare.json"
-        sub = start(py("benchmarks.bare_pair", "sub", "--duration", str(seconds + 8.0)), probe)
+        sub = start(py("benchmarks.bare_pair", "sub", "--duration", str(seconds + 8.0), "--executor", executor), probe)
         time.sleep(1.0)  # not synchronisation: the subscriber starts first so it misses nothing
         pub = start(py("benchmarks.bare_pair", "pub", "--rate", str(rate), "--duration", str(seconds),
                        "--joints", str(joints)))
@@ -270,8 +294,14 @@ def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int) -> di
         finish(sub, seconds + 30)
         received = json.loads(probe.read_text())["received"]
     first = received[0][1] if received else 0
-    lat = [r - s for s, r in received if r >= first + int(warmup * 1e9)]
-    return {"rate_hz": rate, "latency_ms": pct(lat, 1e-6), "received": len(received), "cpu_cores": round(cpu, 3)}
+    return {"latency": [r - s for s, r in received if r >= first + int(warmup * 1e9)], "received": len(received),
+            "cpu_cores": cpu}
+
+
+def pool_bare(runs: list[dict], rate: float) -> dict:
+    return {"rate_hz": rate, "runs": len(runs), "latency_ms": pct([x for r in runs for x in r["latency"]], 1e-6),
+            "received": sum(r["received"] for r in runs),
+            "cpu_cores": round(statistics.mean(r["cpu_cores"] for r in runs), 3)}
 
 
 # ---------------------------------------------------------------- 3b. meshcat cost per frame
@@ -380,13 +410,18 @@ def print_report(r: dict) -> None:
     rt = r["realtime"]
     print(f"  real-time mode (tank, all controllers): real-time factor {rt['real_time_factor']}, "
           f"step overrun p50 {rt['overrun_ms']['p50']} ms, p99 {rt['overrun_ms']['p99']} ms, max {rt['overrun_ms']['max']} ms")
-    print("\n== end-to-end latency across processes (ms): step -> applied on the viewer's main thread; bare pair: publish -> callback")
+    print(f"\n== end-to-end latency across processes (ms): step -> applied on the viewer's main thread; bare pair: "
+          f"publish -> callback ({r['rounds']} interleaved rounds of {r['seconds_per_run']:g} s each, samples pooled)")
     print(f"  {'run':14s} {'p50':>7s} {'p90':>7s} {'p99':>7s} {'max':>8s}   {'bare p50':>8s} {'bare p99':>8s}  ratio p50/p99")
     for key, run in r["pipeline"].items():
         bare = r["bare"][key]["latency_ms"]
         lat = run["latency_ms"]
         print(f"  {key:14s} {lat['p50']:7.3f} {lat['p90']:7.3f} {lat['p99']:7.3f} {lat['max']:8.3f}   {bare['p50']:8.3f} "
               f"{bare['p99']:8.3f}  {lat['p50'] / bare['p50']:.2f} / {lat['p99'] / bare['p99']:.2f}")
+    for key, bare in r.get("bare_events_executor", {}).items():
+        lat = bare["latency_ms"]
+        print(f"  (for comparison, not a target: {key} bare pair with the subscriber on rclpy's EventsExecutor, "
+              f"as the tutorial's spin threads: p50 {lat['p50']:.3f}, p99 {lat['p99']:.3f})")
     print("  where it goes (p50 / p99 ms): step -> viewer's callback | callback -> applied on the main thread")
     for key, run in r["pipeline"].items():
         a, b = run["step_to_callback_ms"], run["callback_to_applied_ms"]
@@ -413,25 +448,28 @@ def print_report(r: dict) -> None:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--seconds", type=float, default=10.0, help="length of each cross-process run (default 10)")
+    p.add_argument("--seconds", type=float, default=8.0, help="length of each cross-process run (default 8)")
+    p.add_argument("--rounds", type=int, default=3,
+                   help="interleaved rounds of bare pair and pipeline per cross-process figure (default 3)")
     p.add_argument("--quick", action="store_true", help="shorter runs, fewer repeats (a smoke test of the suite)")
     p.add_argument("--output", default=str(RESULTS / "latest.json"))
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
     seconds, warmup = (5.0, 1.0) if args.quick else (args.seconds, 2.0)
+    rounds = 1 if args.quick else args.rounds
 
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     r: dict = {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(), "platform": platform.platform()},
-               "when": time.strftime("%Y-%m-%d %H:%M:%S"), "seconds_per_run": seconds}
-    pairs = 8 if args.quick else 40
+               "when": time.strftime("%Y-%m-%d %H:%M:%S"), "seconds_per_run": seconds, "rounds": rounds}
+    pairs = 8 if args.quick else 60
     rates = {"publisher_50Hz": 50.0, "publisher_every_step": 0.0}
     r["simulation_speed"] = {
-        "tank": simulation_speed("project/step2.yaml", rates, pairs, 400),
-        "arm24": simulation_speed("benchmarks/projects/arm_sim.yaml", rates, pairs, 400),
+        "tank": simulation_speed("project/step2.yaml", rates, pairs, 1000),
+        "arm24": simulation_speed("benchmarks/projects/arm_sim.yaml", rates, pairs, 1000),
     }
     r["realtime"] = realtime_mode("project/step2.yaml", 2.0 if args.quick else 5.0)
     rclpy.try_shutdown()
@@ -441,8 +479,18 @@ def main(argv=None) -> int:
         ("tank_1kHz", "benchmarks/projects/tank_sim.yaml", "benchmarks/projects/tank_view.yaml", 1000.0, 2),
         ("arm24_1kHz", "benchmarks/projects/arm_sim.yaml", "benchmarks/projects/arm_view.yaml", 1000.0, 24),
     ):
-        r["bare"][key] = bare_pair_run(rate, seconds, warmup, joints)
-        r["pipeline"][key] = pipeline_run(sim_p, view_p, rate, seconds, warmup)
+        # Interleaved rounds (bare, pipeline, bare, ...), samples pooled: the machine's speed
+        # drifts, and this way both sides see the same mix of fast and slow moments.
+        bare_runs, pipe_runs, events_runs = [], [], []
+        for _ in range(rounds):
+            bare_runs.append(bare_pair_run(rate, seconds, warmup, joints))
+            pipe_runs.append(pipeline_run(sim_p, view_p, rate, seconds, warmup))
+            if key == "tank_1kHz":  # for comparison, not a target: the bare pair on the tutorial's executor
+                events_runs.append(bare_pair_run(rate, seconds, warmup, joints, executor="events"))
+        r["bare"][key] = pool_bare(bare_runs, rate)
+        r["pipeline"][key] = pool_pipeline(pipe_runs, rate)
+        if events_runs:
+            r["bare_events_executor"] = {key: pool_bare(events_runs, rate)}
     r["scene_update"] = {"tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
                          "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200)}
     r["startup"] = startup(1 if args.quick else 3)
