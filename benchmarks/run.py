@@ -7,7 +7,8 @@ because absolute times on a shared machine vary:
   a bare ``mj_step`` loop on the same model;
 * end-to-end latency across processes (simulation step -> state applied on
   the viewer's main thread) against a bare rclpy publisher/subscriber pair
-  of the same ``sensor_msgs/JointState`` with the same QoS;
+  of the same ``sensor_msgs/JointState`` with the same QoS, in interleaved
+  rounds whose samples are pooled;
 * the viewer under a 1 kHz flood: age of the displayed state, backlog,
   meshcat cost per frame, frames per second, CPU per process;
 * start-up: from the launch command to the first state shown;
@@ -96,8 +97,8 @@ def simulation_speed(project: str, rates: dict[str, float], pairs: int, steps: i
 
     This machine's CPU speed drifts by tens of percent within seconds, so
     single runs cannot be compared.  The two are measured in short
-    interleaved runs (bare, pipeline, bare, ...) on the same kind of
-    thread; each pipeline run is divided by the mean of the bare runs on
+    interleaved runs of ``steps`` steps (bare, pipeline, bare, ...) on the
+    same kind of thread; each pipeline run is divided by the mean of the bare runs on
     either side, and the median of those ratios is reported with its
     quartiles.
     """

@@ -118,8 +118,10 @@ def test_distinct_names_give_no_warning(procs):
 
 def test_any_model_publishes_and_shows_its_own_joints(procs):
     view = viewer(procs, "tests/fixtures/crane_view.yaml")
+    # 5 s: long enough that the two nodes have found each other well before the final
+    # state is sent, even when discovery takes one of Fast DDS's ~3 s announcement periods.
     sim = procs(module_command("tutorial.runner", "tests/fixtures/crane_sim.yaml", "--headless",
-                               "--duration", "3", "--json"))
+                               "--duration", "5", "--json"))
     stale_before = view.count(is_stale)
     assert sim.wait(60) == 0, sim.err
     final = sim.summary()["bodies"]["Crane"]["joint_positions"]
