@@ -277,8 +277,9 @@ def pool_pipeline(runs: list[dict], rate: float) -> dict:
 def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, executor: str = "single") -> dict:
     """One run of the bare rclpy pair at the same rate, same message and QoS: raw samples.
 
-    ``executor`` is the subscriber's: ``single`` (rclpy's default, the baseline)
-    or ``events`` (the one the tutorial's spin threads use, for comparison).
+    ``executor`` is the subscriber's: ``single`` (rclpy's default, the baseline
+    and what the tutorial uses) or ``events`` (the experimental EventsExecutor,
+    for comparison).
     """
     with tempfile.TemporaryDirectory() as d:
         probe = Path(d) / "bare.json"
@@ -421,8 +422,8 @@ def print_report(r: dict) -> None:
               f"{bare['p99']:8.3f}  {lat['p50'] / bare['p50']:.2f} / {lat['p99'] / bare['p99']:.2f}")
     for key, bare in r.get("bare_events_executor", {}).items():
         lat = bare["latency_ms"]
-        print(f"  (for comparison, not a target: {key} bare pair with the subscriber on rclpy's EventsExecutor, "
-              f"as the tutorial's spin threads: p50 {lat['p50']:.3f}, p99 {lat['p99']:.3f})")
+        print(f"  (for comparison, not a target: {key} bare pair with the subscriber on rclpy's experimental "
+              f"EventsExecutor, which the tutorial does not use: p50 {lat['p50']:.3f}, p99 {lat['p99']:.3f})")
     print("  where it goes (p50 / p99 ms): step -> viewer's callback | callback -> applied on the main thread")
     for key, run in r["pipeline"].items():
         a, b = run["step_to_callback_ms"], run["callback_to_applied_ms"]
@@ -486,7 +487,7 @@ def main(argv=None) -> int:
         for _ in range(rounds):
             bare_runs.append(bare_pair_run(rate, seconds, warmup, joints))
             pipe_runs.append(pipeline_run(sim_p, view_p, rate, seconds, warmup))
-            if key == "tank_1kHz":  # for comparison, not a target: the bare pair on the tutorial's executor
+            if key == "tank_1kHz":  # for comparison, not a target: how much a faster executor gives the bare pair
                 events_runs.append(bare_pair_run(rate, seconds, warmup, joints, executor="events"))
         r["bare"][key] = pool_bare(bare_runs, rate)
         r["pipeline"][key] = pool_pipeline(pipe_runs, rate)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -21,6 +22,7 @@ os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ["ROS_DOMAIN_ID"] = str(1 + (os.getpid() * 7919 + int(time.time())) % 100)
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+os.environ.setdefault("PYTHONFAULTHANDLER", "1")  # a hung child prints its threads' stacks on SIGABRT
 os.environ.setdefault("RTT_TEST_MODE", "1")  # notebooks run under nbval: shorter interactive runs
 
 from tutorial.notebook import wait_until  # noqa: E402,F401 - after the environment; one polling helper for all
@@ -112,8 +114,16 @@ class Proc:
         try:
             self.p.wait(timeout)
         except subprocess.TimeoutExpired:
-            self.p.kill()
-            self.p.wait()
+            # SIGABRT first: with faulthandler on (PYTHONFAULTHANDLER, set above),
+            # Python prints every thread's stack, which says where it hung.
+            self.p.send_signal(signal.SIGABRT)
+            try:
+                self.p.wait(5)
+            except subprocess.TimeoutExpired:
+                self.p.kill()
+                self.p.wait()
+            for t in self._threads:
+                t.join(5)
             raise AssertionError(f"{self.cmd} did not finish in {timeout} s\n{self.out}\n{self.err}")
         for t in self._threads:
             t.join(10)

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 import threading
-import weakref
 from typing import MutableMapping, Sequence
 
 DISCOVERY_RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
@@ -65,36 +64,26 @@ def init(args: Sequence[str] | None = None):
     return remove_ros_args(list(args) if args is not None else None)
 
 
-_spun_nodes: "weakref.WeakSet" = weakref.WeakSet()  # nodes given to a SpinThread, see SpinThread
-
 SPIN_POLL = 0.1  # s: how often the spin thread checks whether it should stop
 
 
 def make_executor(context):
-    """The executor a :class:`SpinThread` uses: rclpy's ``EventsExecutor`` when available.
+    """The executor a :class:`SpinThread` uses: rclpy's ``SingleThreadedExecutor``.
 
-    Chosen on purpose, by measurement (``book/benchmarks.md``): the
-    ``EventsExecutor`` dispatches callbacks from C++, while the default
-    ``SingleThreadedExecutor`` rebuilds its wait set in Python before every
-    callback.  In the Step 3 viewer at 1 kHz it cut the viewer's CPU time by
-    40 % and the delay from a state's callback to the main thread showing it
-    from 0.42 to 0.17 ms (median).
-    It is marked experimental in Jazzy, and two of its calls hang when made
-    from another thread while it spins (``shutdown()`` and ``create_task()``,
-    which completing a ``Future`` uses), so :class:`SpinThread` never makes
-    them.  Where it is missing (older rclpy), the ``SingleThreadedExecutor``
-    is used the same way.
+    Chosen on purpose.  rclpy's experimental ``EventsExecutor`` dispatches
+    from C++ and was measured faster here (``book/benchmarks.md``: end-to-end
+    latency at 1 kHz 0.99 -> 0.63 ms p50, the viewer's CPU 40 % lower), but in
+    this rclpy two of its calls hang when made from another thread while it
+    spins (``shutdown()``, ``create_task()``), and with it a viewer once hung
+    on Ctrl-C in the test suite, cause not found.  A tutorial's programs must
+    stop cleanly every time, so the default executor stays.
 
     Args:
         context: the ``rclpy.context.Context`` of the node(s) to spin.
     """
-    try:
-        from rclpy.experimental import EventsExecutor
-    except ImportError:
-        from rclpy.executors import SingleThreadedExecutor
+    from rclpy.executors import SingleThreadedExecutor
 
-        return SingleThreadedExecutor(context=context)
-    return EventsExecutor(context=context)
+    return SingleThreadedExecutor(context=context)
 
 
 class SpinThread:
@@ -107,15 +96,12 @@ class SpinThread:
     Step 3 uses :func:`tutorial.call_later.call_later`.
 
     The thread calls ``spin_once`` until :meth:`stop` sets its stop flag, so
-    stopping never calls into the executor from another thread (see
-    :func:`make_executor`) and takes at most ``SPIN_POLL`` s.  If the ROS
-    context is shut down first, the thread ends too.
+    stopping never calls into the executor from another thread and takes at
+    most ``SPIN_POLL`` s.  If the ROS context is shut down first, the thread
+    ends too.
 
     Args:
         node: the ``rclpy.node.Node`` whose callbacks to run.
-
-    Raises:
-        RuntimeError: the node was already given to a SpinThread (one per node).
 
     ``start`` and ``stop`` are called from the thread that owns the node
     (normally the main thread).  An exception raised by a callback ends the
@@ -126,12 +112,6 @@ class SpinThread:
         self.node = node
         # One thread, one executor: callbacks of this node never run in
         # parallel with each other, only in parallel with the other threads.
-        if node in _spun_nodes:
-            # Moved to a second EventsExecutor, a node can miss the messages that
-            # arrive in its first moments there: a silent loss, so refuse instead.
-            raise RuntimeError(f"node {node.get_fully_qualified_name()} was already spun by a SpinThread; "
-                               "create a new node to spin it again")
-        _spun_nodes.add(node)
         self.executor = make_executor(node.context)
         self.executor.add_node(node)
         self._stop = threading.Event()
@@ -157,8 +137,8 @@ class SpinThread:
     def stop(self, timeout: float = 2.0) -> bool:
         """Stop spinning and wait for the thread (at most ``timeout`` s); True when it ended.
 
-        Afterwards the node is removed from the executor (which then ends its
-        own threads) and may be destroyed; a node is spun by one SpinThread in its life.
+        Afterwards the node is removed from the executor, so it may be
+        destroyed or spun again by a new SpinThread.
         """
         self._stop.set()
         if self._thread.ident is not None:
