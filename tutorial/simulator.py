@@ -22,12 +22,11 @@ from tutorial.body import Body
 from tutorial.controller import ControllerIO, SimpleController
 
 
-# In real-time mode the simulation thread sleeps until each step is due, so steps,
-# and what controllers publish, come evenly spaced in wall-clock time rather than
-# in bursts (measured in book/benchmarks.md: end-to-end latency at 1 kHz 0.63 ->
-# 0.50 ms p50, for 0.07 to 0.13 more CPU cores, mostly the viewer applying states
-# it used to skip).  A shorter sleep than this would overshoot more than it waits.
-REALTIME_MIN_SLEEP = 0.0001  # s
+# In real-time mode the simulation thread sleeps only when it is this far ahead of
+# wall-clock time, so steps come in short bursts.  Sleeping before every step was
+# measured (book/benchmarks.md): with the default executor the viewer then applied
+# more states one by one, and the 1 kHz pipeline went over one CPU core.
+REALTIME_MIN_SLEEP = 0.002  # s
 
 
 @dataclass
