@@ -201,6 +201,21 @@ def realtime_mode(project: str, seconds: float) -> dict:
 
 
 # ---------------------------------------------------------------- 2-3. across processes
+def steady_cpu_cores(procs: dict[str, subprocess.Popen], seconds: float, warmup: float) -> dict[str, float]:
+    """CPU cores each running process (with its children) uses over the steady part of a run.
+
+    Waits out discovery and the warm-up first (not synchronisation: the
+    sample simply starts later), then samples for the rest of the run.
+    """
+    time.sleep(warmup + 2.0)
+    cpu0 = {k: cpu_seconds(p.pid) for k, p in procs.items()}
+    t0 = time.monotonic()
+    time.sleep(max(1.0, seconds - warmup - 3.0))
+    cpu1 = {k: cpu_seconds(p.pid) for k, p in procs.items()}
+    span = time.monotonic() - t0
+    return {k: (cpu1[k] - cpu0[k]) / span for k in procs}
+
+
 def pipeline_run(sim_project: str, view_project: str, rate: float, seconds: float, warmup: float,
                  headless_view: bool = False) -> dict:
     """One run of simulation and viewer as two processes: raw samples, joined on the state's stamp."""
@@ -213,12 +228,7 @@ def pipeline_run(sim_project: str, view_project: str, rate: float, seconds: floa
         time.sleep(1.0)  # not synchronisation: the viewer starts first so it misses nothing
         sim = start(py("tutorial.runner", sim_project, "--headless", "--duration", str(seconds), "--json",
                        "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}"), sim_probe)
-        time.sleep(warmup + 2.0)  # not synchronisation: CPU is sampled over the steady part only (after discovery)
-        cpu0 = {"simulation": cpu_seconds(sim.pid), "viewer": cpu_seconds(viewer.pid)}
-        t0 = time.monotonic()
-        time.sleep(max(1.0, seconds - warmup - 3.0))
-        cpu1 = {"simulation": cpu_seconds(sim.pid), "viewer": cpu_seconds(viewer.pid)}
-        span = time.monotonic() - t0
+        cpu = steady_cpu_cores({"simulation": sim, "viewer": viewer}, seconds, warmup)
         finish(sim, seconds + 30)
         finish(viewer, seconds + 30)
         s = json.loads(sim_probe.read_text())
@@ -245,7 +255,7 @@ def pipeline_run(sim_project: str, view_project: str, rate: float, seconds: floa
         "scene_update_s": [c for _, _, c in frames],
         "messages": {"applied": len(v["applied"]), "posted": v["posted"], "coalesced": v["coalesced"],
                      "max_pending": v["max_pending"]},
-        "cpu_cores": {k: (cpu1[k] - cpu0[k]) / span for k in cpu0},
+        "cpu_cores": cpu,
     }
 
 
@@ -287,11 +297,7 @@ def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, execu
         time.sleep(1.0)  # not synchronisation: the subscriber starts first so it misses nothing
         pub = start(py("benchmarks.bare_pair", "pub", "--rate", str(rate), "--duration", str(seconds),
                        "--joints", str(joints)))
-        time.sleep(warmup + 2.0)  # not synchronisation: after discovery, as for the pipeline
-        cpu0 = cpu_seconds(pub.pid) + cpu_seconds(sub.pid)
-        t0 = time.monotonic()
-        time.sleep(max(1.0, seconds - warmup - 3.0))
-        cpu = (cpu_seconds(pub.pid) + cpu_seconds(sub.pid) - cpu0) / (time.monotonic() - t0)
+        cpu = sum(steady_cpu_cores({"pub": pub, "sub": sub}, seconds, warmup).values())
         finish(pub, seconds + 30)
         finish(sub, seconds + 30)
         received = json.loads(probe.read_text())["received"]

@@ -137,7 +137,8 @@ class SpinThread:
     def stop(self, timeout: float = 2.0) -> bool:
         """Stop spinning and wait for the thread (at most ``timeout`` s); True when it ended.
 
-        Afterwards the node is removed from the executor, so it may be
+        Afterwards the node is removed from the executor and the executor is
+        shut down (its guard conditions released), so the node may be
         destroyed or spun again by a new SpinThread.
         """
         self._stop.set()
@@ -145,5 +146,7 @@ class SpinThread:
             self._thread.join(timeout)
         ended = not self._thread.is_alive()
         if ended:
+            # Safe only now: the spinning thread has ended, nothing else uses the executor.
             self.executor.remove_node(self.node)
+            self.executor.shutdown(timeout_sec=0)
         return ended
