@@ -68,8 +68,8 @@ def cpu_seconds(pid: int) -> float:
         return float("nan")
 
 
-def start(cmd: list[str], probe: Path | None = None) -> subprocess.Popen:
-    env = dict(os.environ)
+def start(cmd: list[str], probe: Path | None = None, extra_env: dict | None = None) -> subprocess.Popen:
+    env = {**os.environ, **(extra_env or {})}
     if probe is not None:
         env["RTT_PROBE_FILE"] = str(probe)
     return subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -217,17 +217,22 @@ def steady_cpu_cores(procs: dict[str, subprocess.Popen], seconds: float, warmup:
 
 
 def pipeline_run(sim_project: str, view_project: str, rate: float, seconds: float, warmup: float,
-                 headless_view: bool = False) -> dict:
-    """One run of simulation and viewer as two processes: raw samples, joined on the state's stamp."""
+                 headless_view: bool = False, executor: str = "events") -> dict:
+    """One run of simulation and viewer as two processes: raw samples, joined on the state's stamp.
+
+    ``executor`` is the spin threads' (``RTT_EXECUTOR``): ``events``, the
+    tutorial's choice, or ``single``, rclpy's default, for the before/after figure.
+    """
+    env = {"RTT_EXECUTOR": executor}
     with tempfile.TemporaryDirectory() as d:
         sim_probe, view_probe = Path(d) / "sim.json", Path(d) / "view.json"
         view_cmd = py("benchmarks.viewer_proc", view_project)
         if headless_view:
             view_cmd.append("--headless")
-        viewer = start(view_cmd + ["--duration", str(seconds + 8.0)], view_probe)
+        viewer = start(view_cmd + ["--duration", str(seconds + 8.0)], view_probe, env)
         time.sleep(1.0)  # not synchronisation: the viewer starts first so it misses nothing
         sim = start(py("tutorial.runner", sim_project, "--headless", "--duration", str(seconds), "--json",
-                       "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}"), sim_probe)
+                       "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}"), sim_probe, env)
         cpu = steady_cpu_cores({"simulation": sim, "viewer": viewer}, seconds, warmup)
         finish(sim, seconds + 30)
         finish(viewer, seconds + 30)
@@ -427,9 +432,17 @@ def print_report(r: dict) -> None:
         print(f"  {key:14s} {lat['p50']:7.3f} {lat['p90']:7.3f} {lat['p99']:7.3f} {lat['max']:8.3f}   {bare['p50']:8.3f} "
               f"{bare['p99']:8.3f}  {lat['p50'] / bare['p50']:.2f} / {lat['p99'] / bare['p99']:.2f}")
     for key, bare in r.get("bare_events_executor", {}).items():
-        lat = bare["latency_ms"]
-        print(f"  (for comparison, not a target: {key} bare pair with the subscriber on rclpy's experimental "
-              f"EventsExecutor, which the tutorial does not use: p50 {lat['p50']:.3f}, p99 {lat['p99']:.3f})")
+        lat, mine = bare["latency_ms"], r["pipeline"][key]["latency_ms"]
+        print(f"  (not a target: {key} bare pair with its subscriber on the EventsExecutor, as the tutorial's "
+              f"spin threads: p50 {lat['p50']:.3f}, p99 {lat['p99']:.3f}; the pipeline's ratio to it "
+              f"{mine['p50'] / lat['p50']:.2f} / {mine['p99'] / lat['p99']:.2f})")
+    for key, run in r.get("pipeline_single_executor", {}).items():
+        lat, cpu = run["latency_ms"], run["cpu_cores"]
+        print(f"  (before: {key} pipeline with RTT_EXECUTOR=single, rclpy's default executor: p50 {lat['p50']:.3f}, "
+              f"p99 {lat['p99']:.3f} ({lat['p50'] / r['bare'][key]['latency_ms']['p50']:.2f}x / "
+              f"{lat['p99'] / r['bare'][key]['latency_ms']['p99']:.2f}x the bare pair); callback -> applied p50 "
+              f"{run['callback_to_applied_ms']['p50']:.3f}; CPU cores sim {cpu['simulation']}, viewer "
+              f"{cpu['viewer']}, total {cpu['total']})")
     print("  where it goes (p50 / p99 ms): step -> viewer's callback | callback -> applied on the main thread")
     for key, run in r["pipeline"].items():
         a, b = run["step_to_callback_ms"], run["callback_to_applied_ms"]
@@ -489,16 +502,20 @@ def main(argv=None) -> int:
     ):
         # Interleaved rounds (bare, pipeline, bare, ...), samples pooled: the machine's speed
         # drifts, and this way both sides see the same mix of fast and slow moments.
-        bare_runs, pipe_runs, events_runs = [], [], []
+        bare_runs, pipe_runs, events_runs, single_runs = [], [], [], []
         for _ in range(rounds):
             bare_runs.append(bare_pair_run(rate, seconds, warmup, joints))
             pipe_runs.append(pipeline_run(sim_p, view_p, rate, seconds, warmup))
-            if key == "tank_1kHz":  # for comparison, not a target: how much a faster executor gives the bare pair
+            if key == "tank_1kHz":
+                # Not targets: the bare pair on the tutorial's executor, and the tutorial
+                # on rclpy's default executor (the "before" of choosing the executor).
                 events_runs.append(bare_pair_run(rate, seconds, warmup, joints, executor="events"))
+                single_runs.append(pipeline_run(sim_p, view_p, rate, seconds, warmup, executor="single"))
         r["bare"][key] = pool_bare(bare_runs, rate)
         r["pipeline"][key] = pool_pipeline(pipe_runs, rate)
         if events_runs:
             r["bare_events_executor"] = {key: pool_bare(events_runs, rate)}
+            r["pipeline_single_executor"] = {key: pool_pipeline(single_runs, rate)}
     r["scene_update"] = {"tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
                          "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200)}
     r["startup"] = startup(1 if args.quick else 3)

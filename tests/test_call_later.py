@@ -119,3 +119,44 @@ def test_call_every_runs_on_schedule():
     loop.call_every(0.01, lambda: ticks.append(time.monotonic()))
     loop.run_until(lambda: len(ticks) >= 3, timeout=5.0)
     assert len(ticks) >= 3
+
+
+def test_wake_on_the_owner_thread_takes_no_lock():
+    """Ctrl-C's handler wakes the loop on the owner thread, maybe inside Event.wait with the event's lock held.
+
+    Before the fix, wake() called Event.set() there and waited forever for a
+    lock its own thread held (a viewer hung on Ctrl-C this way).
+    """
+    import time
+
+    errors, finished, waited = [], threading.Event(), []
+
+    def owner():
+        try:
+            loop = MainLoop()
+            with loop._wakeup._cond:  # the state a signal handler can interrupt run_once in
+                loop.wake()
+            t0 = time.monotonic()
+            loop.run_once(5.0)  # the wake is not lost: it returns without waiting its timeout
+            waited.append(time.monotonic() - t0)
+        except Exception as exc:  # noqa: BLE001 - asserted below
+            errors.append(exc)
+        finally:
+            finished.set()
+
+    threading.Thread(target=owner, daemon=True).start()
+    assert finished.wait(10), "wake() on the owner thread blocked on the event's own lock"
+    assert errors == []
+    assert waited[0] < 2.5
+
+
+def test_wake_from_another_thread_ends_a_wait():
+    import time
+
+    loop = MainLoop()
+    t = threading.Timer(0.2, loop.wake)
+    t.start()
+    t0 = time.monotonic()
+    loop.run_once(10.0)
+    assert time.monotonic() - t0 < 5.0
+    t.join(10)

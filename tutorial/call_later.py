@@ -43,6 +43,7 @@ class MainLoop:
         self._lock = threading.Lock()
         self._pending: "OrderedDict[Hashable, tuple[Callable, tuple, dict]]" = OrderedDict()
         self._wakeup = threading.Event()
+        self._wake_requested = False  # set by wake() on the owner thread (a signal handler), see wake()
         self._timers: list[list] = []  # [next_due, period, func]
         self.posted = 0
         self.coalesced = 0
@@ -78,8 +79,22 @@ class MainLoop:
             return len(self._pending)
 
     def wake(self) -> None:
-        """Make a waiting :meth:`run_once` return early (any thread)."""
-        self._wakeup.set()
+        """Make a waiting :meth:`run_once` return early (any thread, and signal handlers).
+
+        A signal handler runs on the main thread, between two bytecodes of
+        whatever that thread was doing, and that can be inside
+        ``self._wakeup.wait()`` at a moment it holds the event's internal lock.
+        ``Event.set()`` takes that lock, so calling it there waits for the
+        thread it is running on: a deadlock (a viewer once hung on Ctrl-C this
+        way).  So on the owner thread, where nothing can be waiting anyway,
+        wake only sets a flag, a plain store that takes no lock;
+        :meth:`run_once` checks it before it waits.  If the signal lands after
+        that check, the wait simply ends at its timeout.
+        """
+        if threading.get_ident() == self._owner:
+            self._wake_requested = True
+        else:
+            self._wakeup.set()
 
     # ---- owner thread only -------------------------------------------------
     def _check_owner(self) -> None:
@@ -116,11 +131,12 @@ class MainLoop:
     def run_once(self, timeout: float) -> int:
         """Wait up to ``timeout`` s for posted calls, then run them (owner thread)."""
         self._check_owner()
-        if timeout > 0:
+        if timeout > 0 and not self._wake_requested:
             due = min((t[0] for t in self._timers), default=None)
             if due is not None:
                 timeout = max(0.0, min(timeout, due - time.monotonic()))
             self._wakeup.wait(timeout)
+        self._wake_requested = False
         self._wakeup.clear()
         return self.process_pending()
 

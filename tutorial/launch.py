@@ -82,7 +82,9 @@ class Launch:
         self.procs: dict[str, subprocess.Popen] = {}
         self._print_lock = threading.Lock()
         self._threads: list[threading.Thread] = []
-        self.stop_requested = threading.Event()
+        # A plain flag, set by the signal handler in run(): a handler must not take a
+        # lock (threading.Event.set() does) that the interrupted main thread may hold.
+        self.stop_requested = False
         self.stopping = False
         self.failed: list[str] = []
 
@@ -118,7 +120,7 @@ class Launch:
         """Wait until a required node exits, a node fails, or a stop is requested; then shut down."""
         required = {n.name for n in self.description.nodes if n.required}
         reported: set[str] = set()
-        while not self.stop_requested.wait(poll):
+        while not self.stop_requested:
             finished = {name: p.returncode for name, p in self.procs.items() if p.poll() is not None}
             for name, code in finished.items():
                 if name not in reported:
@@ -128,6 +130,7 @@ class Launch:
                         self.failed.append(name)
             if self.failed or required & finished.keys() or len(finished) == len(self.procs):
                 break
+            time.sleep(poll)  # polling the children and the flag: a stop is seen within `poll` s
         return self.shutdown()
 
     def shutdown(self) -> int:
@@ -178,7 +181,7 @@ def run(description: LaunchDescription) -> int:
     launch = Launch(description)
 
     def request_stop(signum, frame):
-        launch.stop_requested.set()
+        launch.stop_requested = True  # no lock taken here: see Launch.__init__
 
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)

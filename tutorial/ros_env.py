@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import threading
+import weakref
 from typing import MutableMapping, Sequence
 
 DISCOVERY_RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
@@ -66,21 +67,43 @@ def init(args: Sequence[str] | None = None):
 
 SPIN_POLL = 0.1  # s: how often the spin thread checks whether it should stop
 
+EXECUTOR_VARIABLE = "RTT_EXECUTOR"  # "events" (the default) or "single"
+_spun_nodes: "weakref.WeakSet" = weakref.WeakSet()  # nodes given to a SpinThread, see SpinThread
+
 
 def make_executor(context):
-    """The executor a :class:`SpinThread` uses: rclpy's ``SingleThreadedExecutor``.
+    """The executor a :class:`SpinThread` uses: rclpy's ``EventsExecutor``, chosen on purpose.
 
-    Chosen on purpose.  rclpy's experimental ``EventsExecutor`` dispatches
-    from C++ and was measured faster here (``book/benchmarks.md``: end-to-end
-    latency at 1 kHz 0.99 -> 0.63 ms p50, the viewer's CPU 40 % lower), but in
-    this rclpy two of its calls hang when made from another thread while it
-    spins (``shutdown()``, ``create_task()``), and with it a viewer once hung
-    on Ctrl-C in the test suite, cause not found.  A tutorial's programs must
-    stop cleanly every time, so the default executor stays.
+    rclpy's default ``SingleThreadedExecutor`` rebuilds its wait set in
+    Python before every callback, holding the interpreter lock that the
+    viewer's main thread needs to show the state just handed to it.  The
+    ``EventsExecutor`` (``rclpy.experimental`` in Jazzy) dispatches from C++.
+    Measured in ``book/benchmarks.md``: the viewer at 1 kHz uses less CPU and
+    shows each state sooner.
+
+    It is experimental, and in this rclpy two of its calls hang when made
+    from another thread while it spins (``shutdown()``, and ``create_task()``,
+    which completing a ``Future`` uses), so :class:`SpinThread` never makes
+    them.  ``RTT_EXECUTOR=single`` in the environment switches every spin
+    thread back to the ``SingleThreadedExecutor``, as does an rclpy without
+    the ``EventsExecutor``.
 
     Args:
         context: the ``rclpy.context.Context`` of the node(s) to spin.
+
+    Raises:
+        ValueError: ``RTT_EXECUTOR`` is neither ``events`` nor ``single``.
     """
+    choice = os.environ.get(EXECUTOR_VARIABLE, "events")
+    if choice not in ("events", "single"):
+        raise ValueError(f"{EXECUTOR_VARIABLE}={choice!r}: use 'events' or 'single'")
+    if choice == "events":
+        try:
+            from rclpy.experimental import EventsExecutor
+        except ImportError:
+            pass
+        else:
+            return EventsExecutor(context=context)
     from rclpy.executors import SingleThreadedExecutor
 
     return SingleThreadedExecutor(context=context)
@@ -103,6 +126,11 @@ class SpinThread:
     Args:
         node: the ``rclpy.node.Node`` whose callbacks to run.
 
+    Raises:
+        RuntimeError: the node was already given to a SpinThread (one per node
+            in its life: moved to a second ``EventsExecutor``, a node missed the
+            messages of its first moments there, a silent loss).
+
     ``start`` and ``stop`` are called from the thread that owns the node
     (normally the main thread).  An exception raised by a callback ends the
     spinning; it is kept in :attr:`error` for the owner to report.
@@ -112,7 +140,11 @@ class SpinThread:
         self.node = node
         # One thread, one executor: callbacks of this node never run in
         # parallel with each other, only in parallel with the other threads.
+        if node in _spun_nodes:
+            raise RuntimeError(f"node {node.get_fully_qualified_name()} was already spun by a SpinThread; "
+                               "create a new node to spin it again")
         self.executor = make_executor(node.context)
+        _spun_nodes.add(node)
         self.executor.add_node(node)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._spin, name="ros-spin", daemon=True)
@@ -138,8 +170,8 @@ class SpinThread:
         """Stop spinning and wait for the thread (at most ``timeout`` s); True when it ended.
 
         Afterwards the node is removed from the executor and the executor is
-        shut down (its guard conditions released), so the node may be
-        destroyed or spun again by a new SpinThread.
+        shut down (its guard conditions and threads released), so the node
+        may be destroyed.
         """
         self._stop.set()
         if self._thread.ident is not None:
