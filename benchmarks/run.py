@@ -8,7 +8,9 @@ because absolute times on a shared machine vary:
 * end-to-end latency across processes (simulation step -> state applied on
   the viewer's main thread) against a bare rclpy publisher/subscriber pair
   of the same ``sensor_msgs/JointState`` with the same QoS, in interleaved
-  rounds whose samples are pooled;
+  rounds whose samples are pooled; at 1 kHz the same rounds also run the
+  tutorial on rclpy's default executor (``RTT_EXECUTOR=single``, the
+  "before" of the executor choice) and the bare pair on the EventsExecutor;
 * the viewer under a 1 kHz flood: age of the displayed state, backlog,
   meshcat cost per frame, frames per second, CPU per process;
 * start-up: from the launch command to the first state shown;
