@@ -392,7 +392,7 @@ def targets(r: dict) -> list[tuple[str, bool, str]]:
     sim = r["simulation_speed"]["tank"]
     out = [
         ("simulation with 50 Hz publisher >= 0.8x bare mj_step", sim["publisher_50Hz_ratio"] >= 0.8,
-         f"{sim['publisher_50Hz_ratio']:.2f}x"),
+         f"{sim['publisher_50Hz_ratio']:.3f}x"),
         ("end-to-end p50 <= 1.5x bare rclpy pair at 1 kHz",
          tank1k["latency_ms"]["p50"] <= 1.5 * bare1k["latency_ms"]["p50"],
          f"{tank1k['latency_ms']['p50']:.3f} ms vs {bare1k['latency_ms']['p50']:.3f} ms "
