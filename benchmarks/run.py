@@ -294,9 +294,9 @@ def pool_pipeline(runs: list[dict], rate: float) -> dict:
 def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, executor: str = "single") -> dict:
     """One run of the bare rclpy pair at the same rate, same message and QoS: raw samples.
 
-    ``executor`` is the subscriber's: ``single`` (rclpy's default, the baseline
-    and what the tutorial uses) or ``events`` (the experimental EventsExecutor,
-    for comparison).
+    ``executor`` is the subscriber's: ``single`` (rclpy's default, the
+    baseline) or ``events`` (the EventsExecutor the tutorial's spin threads
+    use, for comparison).
     """
     with tempfile.TemporaryDirectory() as d:
         probe = Path(d) / "bare.json"
