@@ -22,13 +22,11 @@ from tutorial.body import Body
 from tutorial.controller import ControllerIO, SimpleController
 
 
-# In real-time mode the simulation thread sleeps until each step is due, so steps,
-# and what controllers publish, come evenly spaced in wall-clock time rather than in
-# bursts.  Measured in book/benchmarks.md (1 kHz, same run): end-to-end latency p50
-# 0.54 -> 0.43 ms for 0.07 more CPU cores, mostly the viewer applying states it used
-# to skip.  (With rclpy's default executor, RTT_EXECUTOR=single, the same pacing put
-# the pipeline over one core.)  A sleep shorter than this would overshoot more than it waits.
-REALTIME_MIN_SLEEP = 0.0001  # s
+# In real-time mode the simulation thread sleeps only when it is this far ahead of
+# wall-clock time, so steps come in short bursts.  Sleeping before every step was
+# measured (book/benchmarks.md): with the default executor the viewer then applied
+# more states one by one, and the 1 kHz pipeline went over one CPU core.
+REALTIME_MIN_SLEEP = 0.002  # s
 
 
 @dataclass
