@@ -65,6 +65,6 @@ def test_a_failing_node_fails_the_launch_and_stops_the_others():
     text = out.getvalue()
     assert code == 1
     assert "[launch] broken exited with code 2" in text
-    assert "[launch] failed: broken" in text
+    assert "[launch] failed: broken (exit 2)" in text
     assert all(p.poll() is not None for p in launch.procs.values())
     assert "cannot read the project file" in text

@@ -157,10 +157,18 @@ class Launch:
             if code not in (0, None) and name not in self.failed and code != -signal.SIGINT:
                 self.failed.append(name)
         if self.failed:
-            self._say("failed: " + ", ".join(sorted(set(self.failed))))
+            self._say("failed: " + ", ".join(f"{name} ({_exit_status(self.procs[name].returncode)})"
+                                             for name in sorted(set(self.failed))))
             return 1
         self._say("all nodes stopped cleanly")
         return 0
+
+
+def _exit_status(code: int | None) -> str:
+    """How a child ended, for the launcher's report: ``exit 1``, ``killed by SIGKILL``."""
+    if code is not None and code < 0:
+        return f"killed by {signal.Signals(-code).name}"
+    return f"exit {code}"
 
 
 def launch_parser(description: str) -> argparse.ArgumentParser:
