@@ -31,6 +31,8 @@ def test_viewer_page_draws_the_tank_and_follows_the_turret(procs, node, tmp_path
     assert url.startswith("http://127.0.0.1:")
     pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
+    # and the viewer's side: until it has matched the publisher, what is sent is dropped
+    view.wait_for_line(lambda line: '"event": "publishers"' in line and '"count": 1' in line, timeout=30)
 
     publish_and_wait_applied(pub, view, ["TURRET_Y", "TURRET_P"], [0.0, 0.0], 1)
     before = screenshot(url, tmp_path / "before.png")

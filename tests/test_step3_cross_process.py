@@ -18,6 +18,12 @@ def records(proc, event):
     return [r for r in proc.json_records() if r.get("event") == event]
 
 
+def publishers_seen(proc) -> int:
+    """The newest publisher count the viewer reported (its ``publishers`` records), 0 before any."""
+    seen = records(proc, "publishers")
+    return seen[-1]["count"] if seen else 0
+
+
 def is_stale(line: str) -> bool:
     return '"event": "stale"' in line
 
@@ -79,7 +85,10 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
 
     view = viewer(procs)
     pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
+    # Both sides must have matched: the publisher counting the viewer is not enough, a message
+    # sent before the viewer has matched the publisher is dropped (discovery is not symmetric).
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
+    assert wait_until(lambda: publishers_seen(view) >= 1, timeout=30), view.out
     expected = {}
     for names, positions, rejections in HOSTILE:
         msg = JointState()
@@ -98,6 +107,21 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
     assert summary["bodies"]["Tank"]["joint_positions"] == {"TURRET_Y": 0.5, "TURRET_P": 0.25}
     status = records(view, "status")[-1]
     assert status["rejected"] == counts["rejected"]
+
+
+def test_viewer_reports_publishers_that_come_and_go(procs, node):
+    from sensor_msgs.msg import JointState
+
+    from tutorial.controllers.joint_state_publisher import joint_state_qos
+
+    view = viewer(procs)
+    pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
+    assert wait_until(lambda: publishers_seen(view) == 1, timeout=30), view.out
+    node.destroy_publisher(pub)
+    assert wait_until(lambda: publishers_seen(view) == 0, timeout=30), view.out
+    view.p.send_signal(signal.SIGINT)
+    assert view.wait(30) == 0, view.err
+    assert [r["topic"] for r in records(view, "publishers")] == ["/Tank/joint_state"] * 2
 
 
 def test_a_second_node_with_the_same_name_is_warned_about(procs):
@@ -132,3 +156,11 @@ def test_any_model_publishes_and_shows_its_own_joints(procs):
     for name, q in final.items():
         assert abs(shown["last_positions"][name] - q) <= 1e-6
     assert max(abs(q) for q in final.values()) > 0.05  # it moved
+
+
+def test_publishers_record_reads_as_a_line():
+    from tutorial.runner import format_record
+
+    line = format_record({"event": "publishers", "node": "/rtt_viewer", "topic": "/Tank/joint_state", "count": 1})
+    assert line == "[/rtt_viewer] /Tank/joint_state: matched with 1 publisher"
+    assert format_record({"event": "publishers", "topic": "/Tank/joint_state", "count": 0}).endswith("with 0 publishers")

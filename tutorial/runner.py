@@ -30,7 +30,7 @@ from tutorial.viewer_status import format_status
 def format_record(record: dict) -> str:
     """One status record as a human-readable line (or a few, for the summary)."""
     event = record.get("event")
-    if event in ("status", "stale", "recovered", "first_state"):
+    if event in ("status", "stale", "recovered", "first_state", "publishers"):
         return format_status(record, record.get("node", ""))
     if event == "meshcat":
         return f"[{record['node']}] meshcat: open {record['url']} in a browser"

@@ -102,6 +102,9 @@ def format_status(record: dict, node: str = "") -> str:
         return f"{tag}WARNING: no joint state for {record['silent_s']:.1f} s: the view is stale"
     if event == "first_state":
         return f"{tag}first joint state on {record['topic']}: {record['matched']}/{record['joints']} joints matched"
+    if event == "publishers":
+        count = record["count"]
+        return f"{tag}{record['topic']}: matched with {count} publisher{'' if count == 1 else 's'}"
     if event == "recovered":
         return f"{tag}joint state is arriving again: the view is live"
     age = "no state yet" if record["age_ms"] is None else f"newest state {record['age_ms']:.0f} ms old"

@@ -14,6 +14,13 @@ handed over whole and nobody else keeps it, so no lock is needed for it.
 
 Received data is never trusted: :func:`tutorial.joint_matching.match_joint_state`
 decides what to apply, and the rejections are counted and reported.
+
+The viewer also says when a publisher of its topic appears or goes (the
+subscription's "matched" event).  Discovery is not instant and not
+symmetric: a publisher may already count this subscription while this side
+has not yet matched the publisher, and whatever it sends in between is
+dropped.  Only this side's ``publishers`` record says that the next message
+will arrive.
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ class RttJointStateSubscriber(SimpleController):
     """Step 3 controller: subscribes ``/<body>/joint_state`` and poses the body to match."""
 
     def configure(self, config: ControllerConfig) -> bool:
+        from rclpy.event_handler import SubscriptionEventCallbacks
         from sensor_msgs.msg import JointState
 
         self.config = config
@@ -39,7 +47,8 @@ class RttJointStateSubscriber(SimpleController):
         self.topic = joint_state_topic(config.body_name)
         self.status = ViewerStatus(self.body.num_joints)
         self.subscription = config.node.create_subscription(
-            JointState, self.topic, self.on_joint_state, joint_state_qos())
+            JointState, self.topic, self.on_joint_state, joint_state_qos(),
+            event_callbacks=SubscriptionEventCallbacks(matched=self.on_matched))
         config.call_every(STATUS_PERIOD, self.report_status)
         return True
 
@@ -49,7 +58,19 @@ class RttJointStateSubscriber(SimpleController):
         arrival = self.status.received()
         self.config.call_later(self.update_joint_state, msg, arrival)
 
+    def on_matched(self, status) -> None:
+        """"Matched" event (spin thread): a publisher of the topic appeared or went.
+
+        ``status.current_count`` is how many publishers this subscription is
+        matched with now; the record is written on the main thread.
+        """
+        self.config.call_later(self.report_publishers, status.current_count)
+
     # ---- main thread --------------------------------------------------------------
+    def report_publishers(self, count: int) -> None:
+        """Output a ``publishers`` record: how many publishers the subscription is matched with."""
+        self.config.output({"event": "publishers", "node": self.node_name, "topic": self.topic, "count": count})
+
     def update_joint_state(self, msg, arrival: float):
         """Apply one message to the model (main thread, via ``call_later``).
 
