@@ -76,12 +76,13 @@ def make_executor(context):
 
     rclpy's experimental ``EventsExecutor`` dispatches from C++ and measured
     faster here (``book/benchmarks.md``: the viewer at 1 kHz uses less CPU
-    and shows each state sooner), but with it a viewer lost messages: in
-    this rclpy, 4 of 5 runs of 100 JointStates 20 ms apart lost 2 to 17 of
-    them (1 of 5 runs, 3 messages, with the default executor), and once 1 of
-    10 messages sent 250 ms apart.  A tutorial that counts every received
-    message must not lose any, so ``RTT_EXECUTOR=events`` is an opt-in, for
-    measuring.  ``SpinThread`` never calls its ``shutdown()`` or
+    and shows each state sooner), but with it a viewer dropped about one
+    message in 1,500 to 2,000 in the middle of a stream, on an idle link,
+    where the default executor dropped none (messages sent only after both
+    sides had matched; the cause is not known).  A tutorial that counts
+    every received message, and whose last message is the simulation's
+    final state, must not lose any, so ``RTT_EXECUTOR=events`` is an
+    opt-in, for measuring.  ``SpinThread`` never calls its ``shutdown()`` or
     ``create_task()`` from another thread while it spins: in this rclpy they hang.
 
     Args:
