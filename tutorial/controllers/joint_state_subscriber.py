@@ -19,8 +19,8 @@ The viewer also says when a publisher of its topic appears or goes (the
 subscription's "matched" event).  Discovery is not instant and not
 symmetric: a publisher may already count this subscription while this side
 has not yet matched the publisher, and whatever it sends in between is
-dropped.  Only this side's ``publishers`` record says that the next message
-will arrive.
+dropped.  Only this side's ``publishers`` record says that what is sent
+from then on can reach the viewer.
 """
 
 from __future__ import annotations
@@ -59,10 +59,11 @@ class RttJointStateSubscriber(SimpleController):
         self.config.call_later(self.update_joint_state, msg, arrival)
 
     def on_matched(self, status) -> None:
-        """"Matched" event (spin thread): a publisher of the topic appeared or went.
+        """The subscription's "matched" event (spin thread): a publisher appeared or went.
 
         ``status.current_count`` is how many publishers this subscription is
-        matched with now; the record is written on the main thread.
+        matched with now.  The record is written on the main thread; if the
+        count changes twice before it runs, the newest count wins.
         """
         self.config.call_later(self.report_publishers, status.current_count)
 
