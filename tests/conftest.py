@@ -50,6 +50,17 @@ def node(ros, request):
     n.destroy_node()
 
 
+def publishers_seen(proc) -> int:
+    """The newest publisher count a viewer reported (its ``publishers`` records), 0 before any.
+
+    Waiting for it is how a test knows the viewer's side has matched a
+    publisher: discovery is not symmetric, and a publisher that already
+    counts the viewer may still send into the void.
+    """
+    seen = [r for r in proc.json_records() if r.get("event") == "publishers"]
+    return seen[-1]["count"] if seen else 0
+
+
 def module_command(module: str, *args: str) -> list[str]:
     """``python -m module args`` with this interpreter."""
     return [sys.executable, "-u", "-m", module, *args]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from browser import chromium, greenish_pixels, screenshot
-from conftest import module_command, wait_until
+from conftest import module_command, publishers_seen, wait_until
 
 pytestmark = pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
 
@@ -32,7 +32,7 @@ def test_viewer_page_draws_the_tank_and_follows_the_turret(procs, node, tmp_path
     pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
     # and the viewer's side: until it has matched the publisher, what is sent is dropped
-    view.wait_for_line(lambda line: '"event": "publishers"' in line and '"count": 1' in line, timeout=30)
+    assert wait_until(lambda: publishers_seen(view) >= 1, timeout=30), view.out
 
     publish_and_wait_applied(pub, view, ["TURRET_Y", "TURRET_P"], [0.0, 0.0], 1)
     before = screenshot(url, tmp_path / "before.png")

@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from conftest import module_command, wait_until
+from conftest import module_command, publishers_seen, wait_until
 
 
 def viewer(procs, project="project/step3.yaml", name="rtt_viewer", *extra):
@@ -16,12 +16,6 @@ def viewer(procs, project="project/step3.yaml", name="rtt_viewer", *extra):
 
 def records(proc, event):
     return [r for r in proc.json_records() if r.get("event") == event]
-
-
-def publishers_seen(proc) -> int:
-    """The newest publisher count the viewer reported (its ``publishers`` records), 0 before any."""
-    seen = records(proc, "publishers")
-    return seen[-1]["count"] if seen else 0
 
 
 def is_stale(line: str) -> bool:
