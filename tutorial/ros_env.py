@@ -67,33 +67,41 @@ def init(args: Sequence[str] | None = None):
 
 SPIN_POLL = 0.1  # s: how often the spin thread checks whether it should stop
 
-EXECUTOR_VARIABLE = "RTT_EXECUTOR"  # "single" (the default) or "events"
+EXECUTOR_VARIABLE = "RTT_EXECUTOR"  # "events" (the default) or "single"
 _spun_nodes: "weakref.WeakSet" = weakref.WeakSet()  # nodes given to a SpinThread, see SpinThread
 
 
 def make_executor(context):
-    """The executor a :class:`SpinThread` uses: rclpy's ``SingleThreadedExecutor``, chosen on purpose.
+    """The executor a :class:`SpinThread` uses: rclpy's ``EventsExecutor``, chosen on purpose.
 
-    rclpy's experimental ``EventsExecutor`` dispatches from C++ and measured
-    faster here (``book/benchmarks.md``: the viewer at 1 kHz uses less CPU
-    and shows each state sooner), but with it a viewer dropped about one
-    message in 1,500 to 2,000 in the middle of a stream, on an idle link,
-    where the default executor dropped none (messages sent only after both
-    sides had matched; the cause is not known).  A tutorial that counts
-    every received message, and whose last message is the simulation's
-    final state, must not lose any, so ``RTT_EXECUTOR=events`` is an
-    opt-in, for measuring.  ``SpinThread`` never calls its ``shutdown()`` or
-    ``create_task()`` from another thread while it spins: in this rclpy they hang.
+    rclpy's default ``SingleThreadedExecutor`` rebuilds its wait set in
+    Python before every callback.  On the viewer's spin thread that work
+    holds the interpreter lock, and the main thread needs that lock to show
+    the state the callback has just handed over.  The ``EventsExecutor``
+    (experimental in Jazzy) dispatches from C++: at 1 kHz the viewer shows
+    each state sooner and uses less CPU (``book/benchmarks.md``).
+
+    It loses nothing the default executor keeps.  With a deep history, both
+    delivered every one of 6,000 messages.  With the tutorial's keep-last-1
+    QoS, both let a newer state replace an unread one when the subscriber
+    falls more than one message behind; that is what the QoS is chosen for.
+    ``RTT_EXECUTOR=single`` selects rclpy's default executor instead.
+
+    Two limits of this rclpy, which :class:`SpinThread` respects: the
+    executor's ``shutdown()`` and ``create_task()`` hang when called from
+    another thread while it spins, and a node with guard conditions
+    (``Node.create_guard_condition``) stops its spin thread with
+    "Guard conditions not supported".
 
     Args:
         context: the ``rclpy.context.Context`` of the node(s) to spin.
 
     Raises:
-        ValueError: ``RTT_EXECUTOR`` is neither ``single`` nor ``events``.
+        ValueError: ``RTT_EXECUTOR`` is neither ``events`` nor ``single``.
     """
-    choice = os.environ.get(EXECUTOR_VARIABLE, "single")
-    if choice not in ("single", "events"):
-        raise ValueError(f"{EXECUTOR_VARIABLE}={choice!r}: use 'single' or 'events'")
+    choice = os.environ.get(EXECUTOR_VARIABLE, "events")
+    if choice not in ("events", "single"):
+        raise ValueError(f"{EXECUTOR_VARIABLE}={choice!r}: use 'events' or 'single'")
     if choice == "events":
         from rclpy.experimental import EventsExecutor
 

@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 HIDDEN_GEOM_GROUP = 3
+POSE_TOLERANCE = 1e-7  # m, and rotation-matrix entries: a body that moved less is not sent again
 _PLANE_EXTENT = 20.0  # m, drawn size of an infinite plane
 # meshcat cylinders run along their local Y axis, MuJoCo's along Z.
 _Y_TO_Z = np.array([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]], dtype=float)
@@ -64,7 +65,8 @@ class Scene:
         self.model = model
         self.root = root
         self.moving_bodies: list[int] = []
-        self._last: dict[int, np.ndarray] = {}
+        # The pose last sent for each moving body, one row each: position (3) and rotation matrix (9).
+        self._sent = np.empty((0, 12))
         self.frames = 0
         self.transforms_sent = 0
         zmq_url = getattr(getattr(vis, "window", None), "zmq_url", None)
@@ -105,7 +107,8 @@ class Scene:
                 self.vis[path].set_object(geometry, material)
                 self.vis[path].set_transform(base @ local)
         self.moving_bodies = sorted(moving)
-        self._last.clear()
+        self._paths = [self.vis[self.body_path(b)] for b in self.moving_bodies]  # meshcat handles, made once
+        self._sent = np.full((len(self.moving_bodies), 12), np.nan)  # NaN: never sent
         self.update(data)
 
     def _geometry(self, g, gid: int) -> list:
@@ -147,19 +150,20 @@ class Scene:
 
         ``data`` must hold current link poses (after ``mj_step`` or ``mj_kinematics``).
         """
-        sent = 0
-        xpos, xmat = data.xpos, data.xmat
-        for b in self.moving_bodies:
-            pose = _pose(xpos[b], xmat[b])
-            last = self._last.get(b)
-            if last is not None and np.allclose(last, pose, rtol=0.0, atol=1e-7):
-                continue
-            self._last[b] = pose
+        # One vectorised comparison for all moving bodies: a body is sent when any
+        # of its 12 numbers differs from what was last sent by more than the
+        # tolerance (NaN never compares equal, so a body never sent is sent).
+        ids = self.moving_bodies
+        now = np.concatenate((data.xpos[ids], data.xmat[ids]), axis=1)  # (bodies, 12)
+        changed = np.flatnonzero(~(np.abs(now - self._sent) <= POSE_TOLERANCE).all(axis=1))
+        self._sent[changed] = now[changed]
+        for i in changed:
+            pose = _pose(now[i, :3], now[i, 3:])
             if self._pipe is not None:
-                self._pipe.send(self.vis[self.body_path(b)].path, pose)
+                self._pipe.send(self._paths[i].path, pose)
             else:
-                self.vis[self.body_path(b)].set_transform(pose)
-            sent += 1
+                self._paths[i].set_transform(pose)
+        sent = len(changed)
         if self._pipe is not None:
             self._pipe.wait()
         self.frames += 1
