@@ -22,13 +22,6 @@ from tutorial.body import Body
 from tutorial.controller import ControllerIO, SimpleController
 
 
-# In real-time mode the simulation thread sleeps only when it is this far ahead of
-# wall-clock time, so steps come in short bursts.  Sleeping before every step was
-# measured (book/benchmarks.md): with the default executor the viewer then applied
-# more states one by one, and the 1 kHz pipeline went over one CPU core.
-REALTIME_MIN_SLEEP = 0.002  # s
-
-
 @dataclass
 class Snapshot:
     """The simulation state at one step: ``time`` (s), ``qpos`` (nq,) copy, ``step`` count."""
@@ -175,7 +168,9 @@ class Simulator:
                 ahead = (t - t0_sim) - (time.perf_counter() - wall0)
                 if self.lateness is not None:
                     self.lateness.append(max(0.0, -ahead))
-                if ahead > REALTIME_MIN_SLEEP:
+                if ahead > 0:
+                    # Paced step by step: each state is published when its step is due,
+                    # evenly spaced, not in bursts (book/benchmarks.md measures both).
                     time.sleep(ahead)
         self.wall_time = time.perf_counter() - wall0
         self.cpu_time = time.thread_time() - cpu0
