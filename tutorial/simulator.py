@@ -22,6 +22,14 @@ from tutorial.body import Body
 from tutorial.controller import ControllerIO, SimpleController
 
 
+# In real-time mode the simulation thread sleeps only when it is this far ahead of
+# wall-clock time, so steps come in short bursts.  Sleeping before every step was
+# measured (book/benchmarks.md): with rclpy's SingleThreadedExecutor the 1 kHz
+# pipeline then went over one CPU core; with the EventsExecutor it used more CPU
+# and its latency tail grew, for a median gain seen in one comparison of two.
+REALTIME_MIN_SLEEP = 0.002  # s
+
+
 @dataclass
 class Snapshot:
     """The simulation state at one step: ``time`` (s), ``qpos`` (nq,) copy, ``step`` count."""
@@ -168,9 +176,7 @@ class Simulator:
                 ahead = (t - t0_sim) - (time.perf_counter() - wall0)
                 if self.lateness is not None:
                     self.lateness.append(max(0.0, -ahead))
-                if ahead > 0:
-                    # Paced step by step: each state is published when its step is due,
-                    # evenly spaced, not in bursts (book/benchmarks.md measures both).
+                if ahead > REALTIME_MIN_SLEEP:
                     time.sleep(ahead)
         self.wall_time = time.perf_counter() - wall0
         self.cpu_time = time.thread_time() - cpu0
