@@ -1,0 +1,171 @@
+"""Which messages arrive? Numbered JointStates through each executor (not part of ``make bench``).
+
+    python -m benchmarks.delivery --messages 2000 --gap 0.01 --rounds 4            # the tutorial's QoS
+    python -m benchmarks.delivery --messages 3000 --gap 0.005 --rounds 2 --depth 500
+
+A publisher process sends ``--messages`` JointStates ``--gap`` s apart, each
+numbered in ``header.frame_id``, and a subscriber process spun by
+:class:`tutorial.ros_env.SpinThread` records the numbers it receives.  The
+publisher starts only after the subscriber's own side has matched (its
+*matched* event), so the first messages cannot be lost to discovery.  The
+executors alternate round by round.  For each missing message it prints how
+long after its sending the subscriber took its next message, and counts the
+missing messages a newer one was sent after before that: with keep-last-1
+(depth 1), a newer message replaces one the subscriber has not taken yet,
+which is the QoS at work.  A missing message not replaced would be a loss.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+TOPIC = "/Delivery/joint_state"
+
+
+def _qos(depth: int):
+    from tutorial.controllers.joint_state_publisher import joint_state_qos
+
+    qos = joint_state_qos()
+    qos.depth = depth
+    return qos
+
+
+def subscriber(out: Path, depth: int, timeout: float) -> None:
+    """Record (number, arrival ns) of every message until the publisher says it is done."""
+    import rclpy
+    from rclpy.event_handler import SubscriptionEventCallbacks
+    from sensor_msgs.msg import JointState
+
+    from tutorial import ros_env
+
+    ros_env.init()
+    node = rclpy.create_node("delivery_sub")
+    log: list[tuple[int, int]] = []
+
+    def matched(status):
+        if status.current_count:
+            out.with_suffix(".matched").touch()
+
+    node.create_subscription(JointState, TOPIC, lambda m: log.append((int(m.header.frame_id), time.monotonic_ns())),
+                             _qos(depth), event_callbacks=SubscriptionEventCallbacks(matched=matched))
+    spin = ros_env.SpinThread(node).start()
+    end = time.monotonic() + timeout
+    while time.monotonic() < end and not out.with_suffix(".done").exists():
+        time.sleep(0.05)  # polling a file the other process writes; bounded by the timeout
+    time.sleep(0.5)  # messages still in flight when the publisher finished
+    spin.stop()
+    out.write_text(json.dumps({"received": log, "spin_error": repr(spin.error) if spin.error else None}))
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def publisher(out: Path, depth: int, messages: int, gap: float) -> None:
+    """Wait for the subscriber's side to match, then send the numbered messages on a fixed schedule."""
+    import rclpy
+    from rclpy.duration import Duration
+    from sensor_msgs.msg import JointState
+
+    from tutorial import ros_env
+
+    ros_env.init()
+    node = rclpy.create_node("delivery_pub")
+    pub = node.create_publisher(JointState, TOPIC, _qos(depth))
+    deadline = time.monotonic() + 30
+    while not (pub.get_subscription_count() and out.with_suffix(".matched").exists()):
+        if time.monotonic() > deadline:
+            raise SystemExit("the subscriber did not match within 30 s")
+        time.sleep(0.01)
+    msg = JointState(name=["A", "B"], position=[0.0, 0.0], velocity=[0.0, 0.0], effort=[0.0, 0.0])
+    sent_ns = []
+    t0 = time.monotonic()
+    for i in range(messages):
+        left = t0 + i * gap - time.monotonic()
+        if left > 0:
+            time.sleep(left)
+        msg.header.frame_id = str(i)
+        sent_ns.append(time.monotonic_ns())
+        pub.publish(msg)
+    pub.wait_for_all_acked(Duration(seconds=2))
+    out.with_suffix(".sent").write_text(json.dumps(sent_ns))
+    out.with_suffix(".done").touch()
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+def one_round(executor: str, messages: int, gap: float, depth: int) -> dict:
+    """One publisher/subscriber pair on ``executor``; returns what went missing and the arrival gaps around it."""
+    env = {**os.environ, "RTT_EXECUTOR": executor}
+    with tempfile.TemporaryDirectory() as d:
+        out = Path(d) / "log.json"
+        me = [sys.executable, "-m", "benchmarks.delivery"]
+        common = ["--out", str(out), "--depth", str(depth), "--messages", str(messages), "--gap", str(gap)]
+        sub = subprocess.Popen(me + ["--role", "sub"] + common, env=env)
+        pub = subprocess.Popen(me + ["--role", "pub"] + common, env=env)
+        limit = messages * gap + 60
+        if pub.wait(timeout=limit) != 0 or sub.wait(timeout=limit) != 0:
+            raise RuntimeError(f"{executor}: publisher exited {pub.returncode}, subscriber {sub.returncode}")
+        result = json.loads(out.read_text())
+        sent_ns = json.loads(out.with_suffix(".sent").read_text())
+    received = result["received"]
+    got = {n for n, _ in received}
+    missing = [i for i in range(messages) if i not in got]
+    # For each missing message: how long after it was sent did the subscriber take its next
+    # message, and was a newer message sent before that?  If so, keep-last-1 replaced it
+    # (the subscriber was late); if not, it was lost.
+    waited_ms, replaced = [], 0
+    for m in missing:
+        nxt = next((t for n, t in received if n > m), None)
+        if nxt is None:
+            continue
+        waited_ms.append(round((nxt - sent_ns[m]) * 1e-6, 1))
+        replaced += m + 1 < messages and sent_ns[m + 1] < nxt
+    return {"executor": executor, "sent": messages, "received": len(got), "duplicates": len(received) - len(got),
+            "missing": missing, "replaced": replaced, "next_taken_after_ms": waited_ms,
+            "spin_error": result["spin_error"]}
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--messages", type=int, default=2000)
+    p.add_argument("--gap", type=float, default=0.01, help="s between messages (default 0.01)")
+    p.add_argument("--depth", type=int, default=1, help="QoS history depth (default 1, the tutorial's)")
+    p.add_argument("--rounds", type=int, default=2, help="rounds per executor, alternating (default 2)")
+    p.add_argument("--role", choices=["sub", "pub"], help=argparse.SUPPRESS)
+    p.add_argument("--out", type=Path, help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    if args.role == "sub":
+        subscriber(args.out, args.depth, args.messages * args.gap + 40)
+        return 0
+    if args.role == "pub":
+        publisher(args.out, args.depth, args.messages, args.gap)
+        return 0
+    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
+    totals: dict[str, list[int]] = {}
+    for r in range(args.rounds):
+        for executor in ("single", "events") if r % 2 == 0 else ("events", "single"):
+            res = one_round(executor, args.messages, args.gap, args.depth)
+            print(f"round {r} {executor:6s}: received {res['received']} of {res['sent']}, missing "
+                  f"{len(res['missing'])} {res['missing'][:8]} (a newer one sent before the subscriber took "
+                  f"its next: {res['replaced']}), next taken after (ms) {res['next_taken_after_ms'][:8]}, "
+                  f"duplicates {res['duplicates']}, spin error {res['spin_error']}", flush=True)
+            t = totals.setdefault(executor, [0, 0, 0])
+            t[0] += len(res["missing"])
+            t[1] += res["replaced"]
+            t[2] += res["sent"]
+    for executor, (missing, replaced, sent) in totals.items():
+        print(f"{executor}: {missing} missing of {sent}, {replaced} of them replaced by a newer message "
+              f"(depth {args.depth}, {args.gap * 1000:g} ms apart)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
