@@ -67,6 +67,7 @@ class Scene:
         self.moving_bodies: list[int] = []
         # The pose last sent for each moving body, one row each: position (3) and rotation matrix (9).
         self._sent = np.empty((0, 12))
+        self._paths: list = []  # the meshcat handle of each moving body, made once in build()
         self.frames = 0
         self.transforms_sent = 0
         zmq_url = getattr(getattr(vis, "window", None), "zmq_url", None)
@@ -107,7 +108,7 @@ class Scene:
                 self.vis[path].set_object(geometry, material)
                 self.vis[path].set_transform(base @ local)
         self.moving_bodies = sorted(moving)
-        self._paths = [self.vis[self.body_path(b)] for b in self.moving_bodies]  # meshcat handles, made once
+        self._paths = [self.vis[self.body_path(b)] for b in self.moving_bodies]
         self._sent = np.full((len(self.moving_bodies), 12), np.nan)  # NaN: never sent
         self.update(data)
 
