@@ -38,8 +38,8 @@ def _qos(depth: int):
     return qos
 
 
-def subscriber(out: Path, depth: int, timeout: float) -> None:
-    """Record (number, arrival ns) of every message until the publisher says it is done."""
+def subscriber(out: Path, depth: int, messages: int, timeout: float) -> None:
+    """Record (number, arrival ns) of every message until the publisher is done and the last one is in."""
     import rclpy
     from rclpy.event_handler import SubscriptionEventCallbacks
     from sensor_msgs.msg import JointState
@@ -60,7 +60,12 @@ def subscriber(out: Path, depth: int, timeout: float) -> None:
     end = time.monotonic() + timeout
     while time.monotonic() < end and not out.with_suffix(".done").exists():
         time.sleep(0.05)  # polling a file the other process writes; bounded by the timeout
-    time.sleep(0.5)  # messages still in flight when the publisher finished
+    # The publisher is done once the last message is acknowledged; wait (at most 2 s)
+    # until the executor has also handed it to the callback.  Nothing comes after the
+    # last message to replace it, so it must arrive.
+    end = time.monotonic() + 2.0
+    while time.monotonic() < end and not (log and log[-1][0] == messages - 1):
+        time.sleep(0.01)
     spin.stop()
     out.write_text(json.dumps({"received": log, "spin_error": repr(spin.error) if spin.error else None}))
     node.destroy_node()
@@ -101,7 +106,7 @@ def publisher(out: Path, depth: int, messages: int, gap: float) -> None:
 
 
 def one_round(executor: str, messages: int, gap: float, depth: int) -> dict:
-    """One publisher/subscriber pair on ``executor``; returns what went missing and the arrival gaps around it."""
+    """One publisher/subscriber pair on ``executor``; returns what went missing and whether a newer message replaced it."""
     env = {**os.environ, "RTT_EXECUTOR": executor}
     with tempfile.TemporaryDirectory() as d:
         out = Path(d) / "log.json"
@@ -143,7 +148,7 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     if args.role == "sub":
-        subscriber(args.out, args.depth, args.messages * args.gap + 40)
+        subscriber(args.out, args.depth, args.messages, args.messages * args.gap + 40)
         return 0
     if args.role == "pub":
         publisher(args.out, args.depth, args.messages, args.gap)
