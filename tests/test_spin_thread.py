@@ -9,13 +9,13 @@ from conftest import wait_until
 from tutorial.ros_env import SPIN_POLL, SpinThread, make_executor
 
 
-def test_the_executor_is_the_events_executor_unless_switched(node, monkeypatch):
+def test_the_executor_is_the_single_threaded_executor_unless_switched(node, monkeypatch):
     from rclpy.executors import SingleThreadedExecutor
 
     monkeypatch.delenv("RTT_EXECUTOR", raising=False)
-    assert type(make_executor(node.context)).__name__ == "EventsExecutor"
-    monkeypatch.setenv("RTT_EXECUTOR", "single")
     assert isinstance(make_executor(node.context), SingleThreadedExecutor)
+    monkeypatch.setenv("RTT_EXECUTOR", "events")
+    assert type(make_executor(node.context)).__name__ == "EventsExecutor"
     monkeypatch.setenv("RTT_EXECUTOR", "fast")
     with pytest.raises(ValueError, match="RTT_EXECUTOR"):
         make_executor(node.context)

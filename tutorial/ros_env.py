@@ -67,43 +67,33 @@ def init(args: Sequence[str] | None = None):
 
 SPIN_POLL = 0.1  # s: how often the spin thread checks whether it should stop
 
-EXECUTOR_VARIABLE = "RTT_EXECUTOR"  # "events" (the default) or "single"
+EXECUTOR_VARIABLE = "RTT_EXECUTOR"  # "single" (the default) or "events"
 _spun_nodes: "weakref.WeakSet" = weakref.WeakSet()  # nodes given to a SpinThread, see SpinThread
 
 
 def make_executor(context):
-    """The executor a :class:`SpinThread` uses: rclpy's ``EventsExecutor``, chosen on purpose.
+    """The executor a :class:`SpinThread` uses: rclpy's ``SingleThreadedExecutor``, chosen on purpose.
 
-    rclpy's default ``SingleThreadedExecutor`` rebuilds its wait set in
-    Python before every callback.  On the viewer's spin thread that work
-    holds the interpreter lock, and the main thread needs that lock to show
-    the state the callback has just handed over.  The ``EventsExecutor``
-    (experimental in Jazzy) dispatches from C++: at 1 kHz the viewer shows
-    each state sooner and uses less CPU (``book/benchmarks.md``).
-
-    It lost no message in our tests: with a deep history, both executors
-    delivered every one of 6,000.  With the tutorial's keep-last-1 QoS, both
-    let a newer state replace one the subscriber has not taken yet, which is
-    what that QoS is chosen for; the ``EventsExecutor`` did so more often
-    after bursts (``python -m benchmarks.delivery``).  The final state of a
-    simulation has nothing after it to replace it.
-    ``RTT_EXECUTOR=single`` selects rclpy's default executor instead.
-
-    Two limits of this rclpy, which :class:`SpinThread` respects: the
-    executor's ``shutdown()`` and ``create_task()`` hang when called from
-    another thread while it spins, and a node with guard conditions
-    (``Node.create_guard_condition``) stops its spin thread with
-    "Guard conditions not supported".
+    rclpy's experimental ``EventsExecutor`` dispatches from C++ and measured
+    faster here (``book/benchmarks.md``: the viewer at 1 kHz uses less CPU
+    and shows each state sooner), but with it a viewer lost messages the
+    default executor delivered: about one in 1,500 to 2,000 in the middle of
+    a stream, and once one of 10 messages sent 250 ms apart, both sides
+    matched (the cause is not known).  A tutorial that counts
+    every received message, and whose last message is the simulation's
+    final state, must not lose any, so ``RTT_EXECUTOR=events`` is an
+    opt-in, for measuring.  ``SpinThread`` never calls its ``shutdown()`` or
+    ``create_task()`` from another thread while it spins: in this rclpy they hang.
 
     Args:
         context: the ``rclpy.context.Context`` of the node(s) to spin.
 
     Raises:
-        ValueError: ``RTT_EXECUTOR`` is neither ``events`` nor ``single``.
+        ValueError: ``RTT_EXECUTOR`` is neither ``single`` nor ``events``.
     """
-    choice = os.environ.get(EXECUTOR_VARIABLE, "events")
-    if choice not in ("events", "single"):
-        raise ValueError(f"{EXECUTOR_VARIABLE}={choice!r}: use 'events' or 'single'")
+    choice = os.environ.get(EXECUTOR_VARIABLE, "single")
+    if choice not in ("single", "events"):
+        raise ValueError(f"{EXECUTOR_VARIABLE}={choice!r}: use 'single' or 'events'")
     if choice == "events":
         from rclpy.experimental import EventsExecutor
 
