@@ -1,21 +1,27 @@
-"""Which messages arrive? Numbered JointStates through each executor (not part of ``make bench``).
+"""Which messages arrive? One numbered stream, read by both executors at once (not part of ``make bench``).
 
-    python -m benchmarks.delivery --messages 2000 --gap 0.01 --rounds 4            # the tutorial's QoS
-    python -m benchmarks.delivery --messages 3000 --gap 0.005 --rounds 2 --depth 500
+    python -m benchmarks.delivery --messages 15000 --gap 0.02 --busy     # the tutorial's QoS, viewer-like readers
+    python -m benchmarks.delivery --messages 3000 --gap 0.005 --depth 500
 
 A publisher process sends ``--messages`` JointStates ``--gap`` s apart, each
-numbered in ``header.frame_id``, and a subscriber process spun by
-:class:`tutorial.ros_env.SpinThread` records the numbers it receives.  The
-publisher starts only after the subscriber's own side has matched (its
-*matched* event), so the first messages cannot be lost to discovery.  The
-executors alternate round by round.  For each missing message it prints how
-long the publisher waited before sending the next one, and how long after
-the missing one was sent the subscriber took its next.  With keep-last-1
-(depth 1), a newer message replaces one the subscriber has not taken yet:
-a burst from the publisher (the first figure much below ``--gap``) or a
-subscriber stalled for longer than ``--gap`` (the second figure well above
-it) can explain a missing message; one with neither was lost.  The
-figures cannot prove which: a stall may end just as the next message comes.
+numbered in ``header.frame_id``.  Two subscriber processes read the same
+stream at the same time, each spun by :class:`tutorial.ros_env.SpinThread`:
+one on rclpy's ``SingleThreadedExecutor``, one on its ``EventsExecutor``.
+The publisher starts only after both subscribers' own sides have matched
+(their *matched* events), so no message can be lost to discovery.  With
+``--busy`` each subscriber's main thread holds the interpreter lock for
+1.5 ms sixty times a second, as a viewer drawing its frames does.
+
+Reading one stream together, both executors see the same publisher and the
+same stalls of the machine, so a message one of them misses and the other
+receives says something about that executor; a message both miss says
+something about the publisher or the machine.  For each message only one
+executor missed, it prints how long the publisher waited before sending the
+next one, and how long after the missing one was sent that subscriber took
+its next.  With keep-last-1 (depth 1) a newer message replaces one not yet
+taken: a burst from the publisher (the first figure much below ``--gap``)
+or a subscriber stalled for longer than the gap (the second figure above
+it) explains a missing message.  The figures cannot prove which happened.
 """
 
 from __future__ import annotations
@@ -31,6 +37,9 @@ import time
 from pathlib import Path
 
 TOPIC = "/Delivery/joint_state"
+EXECUTORS = ("single", "events")
+BUSY_CHUNK = 0.0015  # s of interpreter-lock-holding work per frame with --busy
+BUSY_RATE = 60.0  # frames/s with --busy
 
 
 def _qos(depth: int):
@@ -41,8 +50,24 @@ def _qos(depth: int):
     return qos
 
 
-def subscriber(out: Path, depth: int, messages: int, timeout: float) -> None:
-    """Record (number, arrival ns) of every message until the publisher is done and the last one is in."""
+def _wait_for(path: Path, timeout: float, busy: bool) -> None:
+    """Wait (at most ``timeout`` s) until ``path`` exists; with ``busy``, hold the interpreter lock in chunks meanwhile."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end and not path.exists():
+        if busy:
+            t = time.perf_counter()
+            while time.perf_counter() - t < BUSY_CHUNK:
+                sum(i * i for i in range(50))
+            time.sleep(1 / BUSY_RATE)
+        else:
+            time.sleep(0.05)  # polling a file the other process writes; bounded by the timeout
+
+
+def subscriber(out: Path, depth: int, messages: int, timeout: float, busy: bool) -> None:
+    """Record (number, arrival ns) of every message until the publisher is done and the last one is in.
+
+    Runs in its own process; the executor is the one ``RTT_EXECUTOR`` names.
+    """
     import rclpy
     from rclpy.event_handler import SubscriptionEventCallbacks
     from sensor_msgs.msg import JointState
@@ -50,7 +75,7 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float) -> None:
     from tutorial import ros_env
 
     ros_env.init()
-    node = rclpy.create_node("delivery_sub")
+    node = rclpy.create_node("delivery_sub_" + os.environ[ros_env.EXECUTOR_VARIABLE])
     log: list[tuple[int, int]] = []
 
     def matched(status):
@@ -60,9 +85,7 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float) -> None:
     node.create_subscription(JointState, TOPIC, lambda m: log.append((int(m.header.frame_id), time.monotonic_ns())),
                              _qos(depth), event_callbacks=SubscriptionEventCallbacks(matched=matched))
     spin = ros_env.SpinThread(node).start()
-    end = time.monotonic() + timeout
-    while time.monotonic() < end and not out.with_suffix(".done").exists():
-        time.sleep(0.05)  # polling a file the other process writes; bounded by the timeout
+    _wait_for(out.parent / "done", timeout, busy)
     # The publisher is done once the last message is acknowledged; wait (at most 2 s)
     # until the executor has also handed it to the callback.  Nothing comes after the
     # last message to replace it, so it must arrive.
@@ -75,8 +98,8 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float) -> None:
     rclpy.try_shutdown()
 
 
-def publisher(out: Path, depth: int, messages: int, gap: float) -> None:
-    """Wait for the subscriber's side to match, then send the numbered messages on a fixed schedule."""
+def publisher(folder: Path, depth: int, messages: int, gap: float) -> None:
+    """Wait until every subscriber's side has matched, then send the numbered messages on a fixed schedule."""
     import rclpy
     from rclpy.duration import Duration
     from sensor_msgs.msg import JointState
@@ -87,9 +110,10 @@ def publisher(out: Path, depth: int, messages: int, gap: float) -> None:
     node = rclpy.create_node("delivery_pub")
     pub = node.create_publisher(JointState, TOPIC, _qos(depth))
     deadline = time.monotonic() + 30
-    while not (pub.get_subscription_count() and out.with_suffix(".matched").exists()):
+    while not (pub.get_subscription_count() >= len(EXECUTORS)
+               and all((folder / f"{e}.matched").exists() for e in EXECUTORS)):
         if time.monotonic() > deadline:
-            raise SystemExit("the subscriber did not match within 30 s")
+            raise SystemExit("the subscribers did not match within 30 s")
         time.sleep(0.01)
     msg = JointState(name=["A", "B"], position=[0.0, 0.0], velocity=[0.0, 0.0], effort=[0.0, 0.0])
     sent_ns = []
@@ -102,73 +126,71 @@ def publisher(out: Path, depth: int, messages: int, gap: float) -> None:
         sent_ns.append(time.monotonic_ns())
         pub.publish(msg)
     pub.wait_for_all_acked(Duration(seconds=2))
-    out.with_suffix(".sent").write_text(json.dumps(sent_ns))
-    out.with_suffix(".done").touch()
+    (folder / "sent.json").write_text(json.dumps(sent_ns))
+    (folder / "done").touch()
     node.destroy_node()
     rclpy.try_shutdown()
 
 
-def one_round(executor: str, messages: int, gap: float, depth: int) -> dict:
-    """One publisher/subscriber pair on ``executor``; returns what went missing, with the timings around it."""
-    env = {**os.environ, "RTT_EXECUTOR": executor}
+def one_run(messages: int, gap: float, depth: int, busy: bool) -> dict:
+    """One publisher and one subscriber per executor, all at once; returns, per executor, what went missing."""
     with tempfile.TemporaryDirectory() as d:
-        out = Path(d) / "log.json"
+        folder = Path(d)
         me = [sys.executable, "-m", "benchmarks.delivery"]
-        common = ["--out", str(out), "--depth", str(depth), "--messages", str(messages), "--gap", str(gap)]
-        sub = subprocess.Popen(me + ["--role", "sub"] + common, env=env)
-        pub = subprocess.Popen(me + ["--role", "pub"] + common, env=env)
+        common = ["--depth", str(depth), "--messages", str(messages), "--gap", str(gap)] + (["--busy"] if busy else [])
+        procs = {e: subprocess.Popen(me + ["--role", "sub", "--out", str(folder / f"{e}.json")] + common,
+                                     env={**os.environ, "RTT_EXECUTOR": e}) for e in EXECUTORS}
+        procs["publisher"] = subprocess.Popen(me + ["--role", "pub", "--out", str(folder / "sent.json")] + common)
         limit = messages * gap + 60
-        if pub.wait(timeout=limit) != 0 or sub.wait(timeout=limit) != 0:
-            raise RuntimeError(f"{executor}: publisher exited {pub.returncode}, subscriber {sub.returncode}")
-        result = json.loads(out.read_text())
-        sent_ns = json.loads(out.with_suffix(".sent").read_text())
-    received = result["received"]
-    got = {n for n, _ in received}
-    missing = [i for i in range(messages) if i not in got]
-    # For each missing message: the publisher's wait before the next send, and how long after
-    # the missing one was sent the subscriber took its next (see the module text).
-    next_sent_ms, next_taken_ms = [], []
-    for m in missing:
-        nxt = next((t for n, t in received if n > m), None)
-        if nxt is None or m + 1 >= messages:
-            continue
-        next_sent_ms.append(round((sent_ns[m + 1] - sent_ns[m]) * 1e-6, 1))
-        next_taken_ms.append(round((nxt - sent_ns[m]) * 1e-6, 1))
-    return {"executor": executor, "sent": messages, "received": len(got), "duplicates": len(received) - len(got),
-            "missing": missing, "next_sent_after_ms": next_sent_ms, "next_taken_after_ms": next_taken_ms,
-            "spin_error": result["spin_error"]}
+        codes = {name: p.wait(timeout=limit) for name, p in procs.items()}
+        if any(codes.values()):
+            raise RuntimeError(f"exit codes {codes}")
+        sent_ns = json.loads((folder / "sent.json").read_text())
+        results = {e: json.loads((folder / f"{e}.json").read_text()) for e in EXECUTORS}
+    missing = {e: sorted(set(range(messages)) - {n for n, _ in r["received"]}) for e, r in results.items()}
+    both = set(missing[EXECUTORS[0]]) & set(missing[EXECUTORS[1]])
+    report = {"sent": messages, "missed_by_both": len(both)}
+    for e, r in results.items():
+        received = r["received"]
+        only = []  # (number, next sent after ms, next taken after ms), see the module text
+        for m in missing[e]:
+            if m in both:
+                continue
+            nxt = next((t for n, t in received if n > m), None)
+            only.append((m, round((sent_ns[m + 1] - sent_ns[m]) * 1e-6, 1) if m + 1 < messages else None,
+                         round((nxt - sent_ns[m]) * 1e-6, 1) if nxt is not None else None))
+        report[e] = {"received": len({n for n, _ in received}), "duplicates": len(received) - len({n for n, _ in received}),
+                     "missing": len(missing[e]), "only_this_executor": only, "spin_error": r["spin_error"]}
+    return report
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--messages", type=int, default=2000)
-    p.add_argument("--gap", type=float, default=0.01, help="s between messages (default 0.01)")
+    p.add_argument("--messages", type=int, default=15000)
+    p.add_argument("--gap", type=float, default=0.02, help="s between messages (default 0.02)")
     p.add_argument("--depth", type=int, default=1, help="QoS history depth (default 1, the tutorial's)")
-    p.add_argument("--rounds", type=int, default=2, help="rounds per executor, alternating (default 2)")
+    p.add_argument("--busy", action="store_true", help="subscribers' main threads busy like a viewer's")
     p.add_argument("--role", choices=["sub", "pub"], help=argparse.SUPPRESS)
     p.add_argument("--out", type=Path, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     if args.role == "sub":
-        subscriber(args.out, args.depth, args.messages, args.messages * args.gap + 40)
+        subscriber(args.out, args.depth, args.messages, args.messages * args.gap + 40, args.busy)
         return 0
     if args.role == "pub":
-        publisher(args.out, args.depth, args.messages, args.gap)
+        publisher(args.out.parent, args.depth, args.messages, args.gap)
         return 0
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
-    totals: dict[str, list[int]] = {}
-    for r in range(args.rounds):
-        for executor in ("single", "events") if r % 2 == 0 else ("events", "single"):
-            res = one_round(executor, args.messages, args.gap, args.depth)
-            print(f"round {r} {executor:6s}: received {res['received']} of {res['sent']}, missing "
-                  f"{len(res['missing'])} {res['missing'][:8]}, next sent after (ms) "
-                  f"{res['next_sent_after_ms'][:8]}, next taken after (ms) {res['next_taken_after_ms'][:8]}, "
-                  f"duplicates {res['duplicates']}, spin error {res['spin_error']}", flush=True)
-            t = totals.setdefault(executor, [0, 0])
-            t[0] += len(res["missing"])
-            t[1] += res["sent"]
-    for executor, (missing, sent) in totals.items():
-        print(f"{executor}: {missing} missing of {sent} (depth {args.depth}, {args.gap * 1000:g} ms apart)")
+    report = one_run(args.messages, args.gap, args.depth, args.busy)
+    print(f"{report['sent']} messages {args.gap * 1000:g} ms apart, depth {args.depth}"
+          f"{', busy readers' if args.busy else ''}: missed by both executors {report['missed_by_both']}")
+    for e in EXECUTORS:
+        r = report[e]
+        only = r["only_this_executor"]
+        print(f"  {e:6s}: received {r['received']}, missing {r['missing']}, of which only here {len(only)}; "
+              f"duplicates {r['duplicates']}, spin error {r['spin_error']}")
+        print(f"          only here (number, next sent after ms, next taken after ms): {only[:12]}"
+              f"{' ...' if len(only) > 12 else ''}")
     return 0
 
 

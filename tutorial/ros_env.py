@@ -74,16 +74,17 @@ _spun_nodes: "weakref.WeakSet" = weakref.WeakSet()  # nodes given to a SpinThrea
 def make_executor(context):
     """The executor a :class:`SpinThread` uses: rclpy's ``SingleThreadedExecutor``, chosen on purpose.
 
-    rclpy's experimental ``EventsExecutor`` dispatches from C++ and measured
-    faster here (``book/benchmarks.md``: the viewer at 1 kHz uses less CPU
-    and shows each state sooner), but with it a viewer lost messages the
-    default executor delivered: about one in 1,500 to 2,000 in the middle of
-    a stream, and once one of 10 messages sent 250 ms apart, both sides
-    matched (the cause is not known).  A tutorial that counts
-    every received message, and whose last message is the simulation's
-    final state, must not lose any, so ``RTT_EXECUTOR=events`` is an
-    opt-in, for measuring.  ``SpinThread`` never calls its ``shutdown()`` or
-    ``create_task()`` from another thread while it spins: in this rclpy they hang.
+    It is the executor ``rclpy.spin()`` uses, so a learner's own nodes run
+    their callbacks the way this tutorial's do.  rclpy's ``EventsExecutor``
+    dispatches from C++ and measured faster here (``book/benchmarks.md``: at
+    1 kHz the viewer shows each state sooner and uses less CPU), but in Jazzy
+    it is experimental: it refuses guard conditions, and its ``shutdown()``
+    and ``create_task()`` hang when called from another thread while it
+    spins (``SpinThread`` never does that).  It is not kept out for losing
+    messages: reading one stream at the same time, the two executors missed
+    about the same messages (``python -m benchmarks.delivery``), although a
+    CI run once lost one of 10 messages sent 250 ms apart with it (cause
+    not found).  ``RTT_EXECUTOR=events`` selects it, for measuring.
 
     Args:
         context: the ``rclpy.context.Context`` of the node(s) to spin.
