@@ -2,7 +2,6 @@
 
 import math
 import signal
-import time
 
 import pytest
 
@@ -16,6 +15,12 @@ def viewer(procs, project="project/step3.yaml", name="rtt_viewer", *extra):
 
 def records(proc, event):
     return [r for r in proc.json_records() if r.get("event") == event]
+
+
+def applied_seen(proc) -> int:
+    """How many messages the viewer's newest status line says it has applied (0 before the first)."""
+    status = records(proc, "status")
+    return status[-1]["applied"] if status else 0
 
 
 def is_stale(line: str) -> bool:
@@ -84,14 +89,17 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
     assert wait_until(lambda: publishers_seen(view) >= 1, timeout=30), view.out
     expected = {}
-    for names, positions, rejections in HOSTILE:
+    for sent, (names, positions, rejections) in enumerate(HOSTILE, start=1):
         msg = JointState()
         msg.name = names
         msg.position = positions
         pub.publish(msg)
         for k, v in rejections.items():
             expected[k] = expected.get(k, 0) + v
-        time.sleep(0.25)  # pacing, not synchronisation: one message per viewer frame, so none coalesce
+        # The next message goes out only once the viewer has applied this one (its status
+        # line, once a second, says so): with a keep-last-1 reader, a message sent while the
+        # viewer is stalled would replace this one, and one applied late would coalesce.
+        assert wait_until(lambda: applied_seen(view) >= sent, timeout=30), view.out
     summary = stop_when_stale(view, 0)  # no stale before the first message
     counts = summary["controllers"]["RttJointStateSubscriber"]
     assert counts["received"] == len(HOSTILE)
