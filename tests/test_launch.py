@@ -30,21 +30,29 @@ def processes_with_marker(marker: str) -> list[int]:
     return found
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
-def test_step3_launch_stops_every_node_within_5_s(procs, sig):
+@pytest.mark.parametrize("sig, group", [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False)],
+                         ids=["ctrl-c", "ctrl-c-in-a-terminal", "sigterm"])
+def test_step3_launch_stops_every_node_within_5_s(procs, sig, group):
+    """``group``: the signal goes to the launcher's whole process group, as a terminal's Ctrl-C
+    does, so every node gets SIGINT twice: from the terminal and from the launcher."""
     marker = uuid.uuid4().hex
     env = dict(os.environ, RTT_TEST_MARKER=marker)
-    launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"], env=env)
+    launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"], env=env,
+                   start_new_session=group)
     launch.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "meshcat: open" in line, timeout=60)
     launch.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "2/2 joints matched" in line
                          and not line.split("] ", 2)[-1].startswith("0.0 msg/s"), timeout=60)
     assert len(processes_with_marker(marker)) >= 6  # launcher, 3 nodes, 2 meshcat servers
     started = time.monotonic()
-    launch.p.send_signal(sig)
+    if group:
+        os.killpg(launch.p.pid, sig)
+    else:
+        launch.p.send_signal(sig)
     code = launch.wait(15)
     elapsed = time.monotonic() - started
     assert code == 0, launch.out
     assert "[launch] all nodes stopped cleanly" in launch.out
+    assert "Traceback" not in launch.out + launch.err, launch.out + launch.err
     assert elapsed < 5.0 + 1.0  # the launcher's own start-up of Python is not in its 5 s budget
     assert wait_until(lambda: processes_with_marker(marker) == [], timeout=2.0), processes_with_marker(marker)
     for name in ("rtt_joy", "rtt", "rtt_viewer"):

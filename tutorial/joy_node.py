@@ -127,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
         except (KeyboardInterrupt, ExternalShutdownException):
             pass
         finally:
+            ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
             node.destroy_node()
             rclpy.try_shutdown()
         print(f"[{NODE_NAME}] published {pub.published} messages", flush=True)

@@ -121,6 +121,7 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
+        ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
         spin.stop()
         series = recorder.series()
         if not live:

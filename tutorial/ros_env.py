@@ -15,6 +15,7 @@ so :func:`use_localhost_by_default` must run before that; importing
 from __future__ import annotations
 
 import os
+import signal
 import threading
 import weakref
 from typing import MutableMapping, Sequence
@@ -63,6 +64,19 @@ def init(args: Sequence[str] | None = None):
 
     rclpy.init(args=list(args) if args is not None else None)
     return remove_ros_args(list(args) if args is not None else None)
+
+
+def ignore_stop_signals() -> None:
+    """Ignore further Ctrl-C and SIGTERM while the program cleans up (main thread, at the start of clean-up).
+
+    Ctrl-C in a terminal sends SIGINT to every process of the foreground
+    group, and a launcher then sends each of its nodes another one.  Without
+    this, that second signal raises ``KeyboardInterrupt`` in the middle of
+    ``destroy_node()`` and prints a traceback.  A clean-up that hangs is still
+    ended: a launcher escalates to SIGKILL.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 SPIN_POLL = 0.1  # s: how often the spin thread checks whether it should stop

@@ -132,8 +132,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"rtt-run: {exc}", file=sys.stderr)
         status = 1
     finally:
-        signal.signal(signal.SIGINT, signal.SIG_IGN)  # a second Ctrl-C must not break the clean-up
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
         try:
             app.close()
             if hasattr(app, "bodies"):
