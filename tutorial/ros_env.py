@@ -74,6 +74,9 @@ def ignore_stop_signals() -> None:
     this, that second signal raises ``KeyboardInterrupt`` in the middle of
     ``destroy_node()`` and prints a traceback.  A clean-up that hangs is still
     ended: a launcher escalates to SIGKILL.
+
+    Raises:
+        ValueError: called from a thread other than the main thread.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
