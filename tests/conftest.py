@@ -57,8 +57,24 @@ def publishers_seen(proc) -> int:
     publisher: discovery is not symmetric, and a publisher that already
     counts the viewer may still send into the void.
     """
-    seen = [r for r in proc.json_records() if r.get("event") == "publishers"]
+    seen = proc.records("publishers")
     return seen[-1]["count"] if seen else 0
+
+
+def publish_and_wait_applied(pub, view, names, positions, applied: int, timeout: float = 30) -> None:
+    """Publish one ``JointState`` and wait until the viewer's status line counts ``applied`` messages applied.
+
+    The status line comes once a second.  Sending the next message only after
+    this makes a keep-last-1 reader unable to have one replaced (a stalled
+    viewer) or coalesced (one applied late); a lost message fails the wait.
+    """
+    from sensor_msgs.msg import JointState
+
+    msg = JointState()
+    msg.name, msg.position = names, positions
+    pub.publish(msg)
+    view.wait_for_line(lambda line: line.startswith("{") and json.loads(line).get("event") == "status"
+                       and json.loads(line)["applied"] >= applied, timeout=timeout)
 
 
 def module_command(module: str, *args: str) -> list[str]:
@@ -143,8 +159,12 @@ class Proc:
     def json_records(self) -> list[dict]:
         return [json.loads(line) for line in self.out.splitlines() if line.startswith("{")]
 
+    def records(self, event: str) -> list[dict]:
+        """The JSON output records of one ``event`` kind so far, oldest first."""
+        return [r for r in self.json_records() if r.get("event") == event]
+
     def summary(self) -> dict:
-        records = [r for r in self.json_records() if r.get("event") == "summary"]
+        records = self.records("summary")
         assert records, f"no summary from {self.cmd}:\n{self.out}\n{self.err}"
         return records[-1]
 

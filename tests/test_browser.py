@@ -6,19 +6,9 @@ import numpy as np
 import pytest
 
 from browser import chromium, greenish_pixels, screenshot
-from conftest import module_command, publishers_seen, wait_until
+from conftest import module_command, publish_and_wait_applied, publishers_seen, wait_until
 
 pytestmark = pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
-
-
-def publish_and_wait_applied(pub, view, names, positions, expect_applied):
-    from sensor_msgs.msg import JointState
-
-    msg = JointState()
-    msg.name, msg.position = names, positions
-    pub.publish(msg)
-    view.wait_for_line(lambda line: line.startswith("{") and json.loads(line).get("event") == "status"
-                       and json.loads(line)["applied"] >= expect_applied, timeout=30)
 
 
 def test_viewer_page_draws_the_tank_and_follows_the_turret(procs, node, tmp_path):

@@ -5,22 +5,12 @@ import signal
 
 import pytest
 
-from conftest import module_command, publishers_seen, wait_until
+from conftest import module_command, publish_and_wait_applied, publishers_seen, wait_until
 
 
 def viewer(procs, project="project/step3.yaml", name="rtt_viewer", *extra):
     return procs(module_command("tutorial.runner", project, "--headless", "--json", *extra,
                                 "--ros-args", "-r", f"__node:={name}"))
-
-
-def records(proc, event):
-    return [r for r in proc.json_records() if r.get("event") == event]
-
-
-def applied_seen(proc) -> int:
-    """How many messages the viewer's newest status line says it has applied (0 before the first)."""
-    status = records(proc, "status")
-    return status[-1]["applied"] if status else 0
 
 
 def is_stale(line: str) -> bool:
@@ -90,16 +80,11 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
     assert wait_until(lambda: publishers_seen(view) >= 1, timeout=30), view.out
     expected = {}
     for sent, (names, positions, rejections) in enumerate(HOSTILE, start=1):
-        msg = JointState()
-        msg.name = names
-        msg.position = positions
-        pub.publish(msg)
+        # The next message goes out only once the viewer has applied this one: a stalled
+        # keep-last-1 reader cannot have it replaced, nor can it coalesce.
+        publish_and_wait_applied(pub, view, names, positions, sent)
         for k, v in rejections.items():
             expected[k] = expected.get(k, 0) + v
-        # The next message goes out only once the viewer has applied this one (its status
-        # line, once a second, says so): with a keep-last-1 reader, a message sent while the
-        # viewer is stalled would replace this one, and one applied late would coalesce.
-        assert wait_until(lambda n=sent: applied_seen(view) >= n, timeout=30), view.out
     summary = stop_when_stale(view, 0)  # every message is applied (waited for above): any stale event will do
     counts = summary["controllers"]["RttJointStateSubscriber"]
     assert counts["received"] == len(HOSTILE)
@@ -107,7 +92,7 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
     assert counts["rejected"] == dict(sorted(expected.items()))
     assert counts["last_positions"] == {"TURRET_Y": 0.5, "TURRET_P": 0.25}
     assert summary["bodies"]["Tank"]["joint_positions"] == {"TURRET_Y": 0.5, "TURRET_P": 0.25}
-    status = records(view, "status")[-1]
+    status = view.records("status")[-1]
     assert status["rejected"] == counts["rejected"]
 
 
@@ -123,7 +108,7 @@ def test_viewer_reports_publishers_that_come_and_go(procs, node):
     assert wait_until(lambda: publishers_seen(view) == 0, timeout=30), view.out
     view.p.send_signal(signal.SIGINT)
     assert view.wait(30) == 0, view.err
-    assert [r["topic"] for r in records(view, "publishers")] == ["/Tank/joint_state"] * 2
+    assert [r["topic"] for r in view.records("publishers")] == ["/Tank/joint_state"] * 2
 
 
 def test_a_second_node_with_the_same_name_is_warned_about(procs):
@@ -131,7 +116,7 @@ def test_a_second_node_with_the_same_name_is_warned_about(procs):
     b = viewer(procs, "project/step3.yaml", "rtt", "--duration", "9")
     assert a.wait(60) == 0 and b.wait(60) == 0
     for p in (a, b):
-        warnings = records(p, "warning")
+        warnings = p.records("warning")
         assert warnings and "2 nodes are named /rtt" in warnings[0]["message"], p.out
 
 
@@ -139,7 +124,7 @@ def test_distinct_names_give_no_warning(procs):
     a = viewer(procs, "project/step3.yaml", "rtt_a", "--duration", "5")
     b = viewer(procs, "project/step3.yaml", "rtt_b", "--duration", "5")
     assert a.wait(60) == 0 and b.wait(60) == 0
-    assert records(a, "warning") == [] and records(b, "warning") == []
+    assert a.records("warning") == [] and b.records("warning") == []
 
 
 def test_any_model_publishes_and_shows_its_own_joints(procs):
