@@ -147,7 +147,8 @@ def one_run(messages: int, gap: float, depth: int, busy: bool) -> dict:
             raise RuntimeError(f"exit codes {codes}")
         sent_ns = json.loads((folder / "sent.json").read_text())
         results = {e: json.loads((folder / f"{e}.json").read_text()) for e in EXECUTORS}
-    missing = {e: sorted(set(range(messages)) - {n for n, _ in r["received"]}) for e, r in results.items()}
+    got = {e: {n for n, _ in r["received"]} for e, r in results.items()}  # the numbers each executor received
+    missing = {e: sorted(set(range(messages)) - got[e]) for e in EXECUTORS}
     both = set(missing[EXECUTORS[0]]) & set(missing[EXECUTORS[1]])
     report = {"sent": messages, "missed_by_both": len(both)}
     for e, r in results.items():
@@ -159,7 +160,7 @@ def one_run(messages: int, gap: float, depth: int, busy: bool) -> dict:
             nxt = next((t for n, t in received if n > m), None)
             only.append((m, round((sent_ns[m + 1] - sent_ns[m]) * 1e-6, 1) if m + 1 < messages else None,
                          round((nxt - sent_ns[m]) * 1e-6, 1) if nxt is not None else None))
-        report[e] = {"received": len({n for n, _ in received}), "duplicates": len(received) - len({n for n, _ in received}),
+        report[e] = {"received": len(got[e]), "duplicates": len(received) - len(got[e]),
                      "missing": len(missing[e]), "only_this_executor": only, "spin_error": r["spin_error"]}
     return report
 
