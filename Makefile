@@ -3,13 +3,15 @@
 #   make test   - the whole test suite: library, cross-process, launch, browser, and the notebooks (nbval)
 # Both create the virtual environment .venv on first use and reuse it after.
 # More: make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
-#       make bench (the benchmark suite; not part of make test).
+#       make bench (the benchmark suite; not part of make test),
+#       make export (write the controllers from the notebooks that build them),
+#       make run-notebooks (run every notebook and save its outputs, the ones nbval checks).
 
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test notebooks book bench venv clean
+.PHONY: demo test notebooks book bench export run-notebooks venv clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -25,15 +27,23 @@ test: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
 
+# The notebooks carry recorded 3D views (scripts in their outputs): trusting the project's own
+# notebooks lets JupyterLab show them; an untrusted notebook shows those outputs empty.
 notebooks: $(VENV)/.installed
-	$(VENV)/bin/jupyter lab notebooks/
+	$(VENV)/bin/jupyter trust notebooks/[0-9][0-9]_*.ipynb
+	$(VENV)/bin/jupyter lab --ip=127.0.0.1 notebooks/
+
+export: $(VENV)/.installed
+	$(PY) scripts/export_notebooks.py
+
+run-notebooks: $(VENV)/.installed
+	$(PY) scripts/run_notebooks.py
 
 book: $(VENV)/.installed
-	ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST $(PY) book/make_snapshots.py
 	$(VENV)/bin/jupyter-book build book --warningiserror --keep-going
 
 bench: $(VENV)/.installed
 	$(PY) -m benchmarks.run
 
 clean:
-	rm -rf $(VENV) .pytest_cache book/_build book/_static/snapshots
+	rm -rf $(VENV) .pytest_cache book/_build

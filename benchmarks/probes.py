@@ -13,7 +13,7 @@ import os
 import time
 
 from tutorial.controller import SimpleController
-from tutorial.controllers.joint_state_subscriber import RttJointStateSubscriber
+from tutorial.controllers.joint_state_subscriber import RttJointStateMonitor
 
 
 def _write(record: dict) -> None:
@@ -45,7 +45,7 @@ class StepClock(SimpleController):
         _write({"sim_ns": self.sim_ns, "wall_ns": self.wall_ns})
 
 
-class ProbedJointStateSubscriber(RttJointStateSubscriber):
+class ProbedJointStateSubscriber(RttJointStateMonitor):
     """Viewer side: when each state was applied on the main thread, and what each frame showed."""
 
     def configure(self, config) -> bool:

@@ -25,7 +25,7 @@ os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYTHONFAULTHANDLER", "1")  # a hung child prints its threads' stacks on SIGABRT
 os.environ.setdefault("RTT_TEST_MODE", "1")  # notebooks run under nbval: shorter interactive runs
 
-from tutorial.notebook import wait_until  # noqa: E402,F401 - after the environment; one polling helper for all
+from tutorial.notebook.session import wait_until  # noqa: E402,F401 - after the environment; one polling helper for all
 
 ROOT = Path(__file__).resolve().parent.parent
 PROJECT = ROOT / "project"

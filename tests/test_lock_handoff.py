@@ -25,7 +25,7 @@ def test_control_always_sees_one_whole_message_under_concurrent_callbacks():
     def control_loop() -> None:
         try:
             for _ in range(20000):
-                axes, buttons = controller.take_input()
+                _count, axes, buttons = controller.take_input()
                 if axes and (set(axes) != {float(buttons[0])} or set(buttons) != {buttons[0]}):
                     torn.append((axes, buttons))
         except BaseException as exc:  # noqa: BLE001

@@ -67,3 +67,93 @@ def test_a_move_within_the_tolerance_is_not_sent_and_a_nan_pose_is():
     assert scene.update(data) == 1
     data.xpos[b, 1] = np.nan  # never equal to what was sent: sent, as the view must show something is wrong
     assert scene.update(data) == 1
+
+
+# ---- overlays: arrows a controller draws over the view ----------------------------------
+
+class CommandVisualizer(RecordingVisualizer):
+    """A RecordingVisualizer that also keeps every command, in order: (kind, path, value)."""
+
+    def __init__(self, sent=None, path="meshcat", log=None):
+        super().__init__(sent, path)
+        self.log = [] if log is None else log
+
+    def __getitem__(self, path):
+        return CommandVisualizer(self.sent, f"{self.path}/{path}", self.log)
+
+    def set_transform(self, matrix):
+        super().set_transform(matrix)
+        self.log.append(("transform", self.path, np.array(matrix)))
+
+    def set_object(self, geometry, material=None):
+        self.log.append(("object", self.path, geometry))
+
+    def set_property(self, key, value):
+        self.log.append((key, self.path, value))
+
+    def delete(self):
+        self.log.append(("delete", self.path, None))
+
+
+def tip_of(shaft, head):
+    """Where an arrow drawn with these transforms ends: the cone's apex, and where its shaft starts."""
+    from tutorial.overlays import HEAD_LENGTH
+
+    apex = head @ np.array([0.0, HEAD_LENGTH / 2, 0.0, 1.0])
+    tail = shaft @ np.array([0.0, -0.5, 0.0, 1.0])  # the shaft is a unit cylinder along meshcat's Y
+    return tail[:3], apex[:3]
+
+
+def test_an_arrow_is_drawn_from_its_origin_to_origin_plus_vector():
+    from tutorial.overlays import arrow_transforms
+
+    for origin, vector in [((0, 0, 0.1), (0.3, 0.4, 0.0)), ((1, 2, 3), (0, 0, -0.5)), ((0, 0, 0), (0.01, 0, 0.02)),
+                           ((0.5, 0, 0), (1e-3, 0, 0))]:
+        shaft, head = arrow_transforms(origin, vector)
+        tail, tip = tip_of(shaft, head)
+        np.testing.assert_allclose(tail, origin, atol=1e-6)
+        np.testing.assert_allclose(tip, np.add(origin, vector), atol=1e-12)
+        np.testing.assert_allclose(np.linalg.norm(head[:3, 0]), 1.0)  # the head's radius is never scaled
+
+
+def test_overlays_send_only_changed_arrows_and_hide_without_moving():
+    from tutorial.overlays import MeshcatOverlays, Overlays
+
+    overlays = Overlays()
+    red = overlays.arrow("Tank/acceleration", (1.0, 0.2, 0.2))
+    blue = overlays.arrow("Tank/angular_velocity", (0.2, 0.2, 1.0))
+    vis = CommandVisualizer()
+    drawer = MeshcatOverlays(vis, overlays)
+    assert vis.log == [("delete", "meshcat/rtt_overlays", None)]  # a previous run's arrows go
+    vis.log.clear()
+    assert drawer.update() == 2  # both created, both hidden: no transforms yet
+    assert [c[0] for c in vis.log] == ["object", "object", "visible", "object", "object", "visible"]
+    assert {c[2] for c in vis.log if c[0] == "visible"} == {False}
+    vis.log.clear()
+    assert drawer.update() == 0 and vis.log == []
+    red.set((0, 0, 0.1), (0.5, 0, 0))
+    assert drawer.update() == 1
+    assert [(c[0], c[1].rsplit("/", 2)[-2:]) for c in vis.log] == [
+        ("transform", ["acceleration", "shaft"]), ("transform", ["acceleration", "head"]),
+        ("visible", ["Tank", "acceleration"])]
+    vis.log.clear()
+    red.set((0, 0, 0.1), (0.5, 0, 0))  # the same: nothing to send
+    blue.set((0, 0, 0.1), (0, 0, 0.001), visible=False)  # hidden was hidden: no command either
+    assert drawer.update() == 1 and vis.log == []
+    red.set((0, 0, 0.1), (0.4, 0, 0), visible=False)
+    drawer.update()
+    assert [c[0] for c in vis.log] == ["visible"]
+    assert red.record() == {"length": 0.4, "visible": False}
+
+
+def test_an_arrow_refuses_non_finite_numbers_and_a_second_arrow_of_the_same_name():
+    import pytest
+
+    from tutorial.overlays import Overlays
+
+    overlays = Overlays()
+    arrow = overlays.arrow("a", (1, 0, 0))
+    with pytest.raises(ValueError, match="finite"):
+        arrow.set((0, 0, 0), (np.nan, 0, 0))
+    with pytest.raises(ValueError, match="exists already"):
+        overlays.arrow("a", (0, 0, 1))

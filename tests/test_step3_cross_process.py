@@ -40,13 +40,13 @@ def test_viewer_ends_on_the_simulations_final_state(procs):
     sim_summary = sim.summary()
     view_summary = stop_when_stale(view, stale_before)
     final = sim_summary["bodies"]["Tank"]["joint_positions"]
-    shown = view_summary["controllers"]["RttJointStateSubscriber"]["last_positions"]
+    shown = view_summary["controllers"]["RttJointStateMonitor"]["last_positions"]
     assert set(shown) == {"TURRET_Y", "TURRET_P"}
     for name in final:
         assert abs(shown[name] - final[name]) <= 1e-6, (name, shown, final)
     assert view_summary["bodies"]["Tank"]["joint_positions"] == pytest.approx(final, abs=1e-6)
     assert abs(final["TURRET_Y"]) > 0.1  # the demo really moved it
-    counts = view_summary["controllers"]["RttJointStateSubscriber"]
+    counts = view_summary["controllers"]["RttJointStateMonitor"]
     assert counts["rejected"] == {}
     assert counts["received"] > 100  # 50 Hz for most of 6 s
     assert sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 300 + 1  # 50 Hz over 6 s (steps 0, 20, ..., 5980), and the final state
@@ -86,7 +86,7 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
         for k, v in rejections.items():
             expected[k] = expected.get(k, 0) + v
     summary = stop_when_stale(view, 0)  # every message is applied (waited for above): any stale event will do
-    counts = summary["controllers"]["RttJointStateSubscriber"]
+    counts = summary["controllers"]["RttJointStateMonitor"]
     assert counts["received"] == len(HOSTILE)
     assert counts["applied"] == len(HOSTILE), "messages coalesced: the pacing was too fast for this machine"
     assert counts["rejected"] == dict(sorted(expected.items()))
@@ -137,7 +137,7 @@ def test_any_model_publishes_and_shows_its_own_joints(procs):
     assert sim.wait(60) == 0, sim.err
     final = sim.summary()["bodies"]["Crane"]["joint_positions"]
     assert list(final) == ["SLEW", "LUFF", "TROLLEY"]  # hinge, hinge, slide; the ball joint is not numbered
-    shown = stop_when_stale(view, stale_before)["controllers"]["RttJointStateSubscriber"]
+    shown = stop_when_stale(view, stale_before)["controllers"]["RttJointStateMonitor"]
     assert shown["topic"] == "/Crane/joint_state"
     assert shown["rejected"] == {}
     for name, q in final.items():

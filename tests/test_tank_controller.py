@@ -52,11 +52,13 @@ def test_bad_axes_never_raise_and_never_give_non_finite_commands(bad):
     assert all(math.isfinite(v) and abs(v) <= tc.TURRET_RATE for v in (yaw, pitch))
 
 
-def make_controller():
+def make_controller(joy_timeout: float = 0.0):
+    """The Step 1 controller on the tank in its room, unconfigured (no ROS), initialized; the safe stop off by default."""
     model = build_world([ModelEntry("Room", MODEL / "room.xml"), ModelEntry("Tank", MODEL / "tank.xml")])
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     controller = tc.RttTankController()
+    controller.joy_timeout = joy_timeout
     io = ControllerIO(body=Body(model, data, "Tank"), time_step=model.opt.timestep, node=None, data=data)
     assert controller.initialize(io)
     return controller, model, data
@@ -73,7 +75,7 @@ def test_malformed_joy_is_counted_and_simulation_stays_finite():
         for _ in range(50):
             assert controller.control()
             mujoco.mj_step(model, data)
-    assert controller.summary() == {"joy_received": 4, "joy_malformed": 4}
+    assert controller.summary() == {"joy_received": 4, "joy_malformed": 4, "joy_timeouts": 0}
     assert all(math.isfinite(v) for v in data.qpos)
 
 
@@ -98,3 +100,43 @@ def test_turret_reference_stays_inside_the_joint_range():
     pitch = Body(model, data, "Tank").joint("TURRET_P")
     assert controller.q_ref[1] == pytest.approx(pitch.info.upper)
     assert pitch.q == pytest.approx(pitch.info.upper, abs=0.02)
+
+
+def run(controller, model, data, steps: int, feed=None) -> None:
+    for k in range(steps):
+        if feed is not None:
+            feed(k)
+        controller.control()
+        mujoco.mj_step(model, data)
+
+
+def test_the_tank_stops_when_the_joystick_goes_silent():
+    controller, model, data = make_controller(joy_timeout=0.5)
+    # a joystick repeating "forward" at 20 Hz for 1 s, then silent (its node died)
+    run(controller, model, data, 1000, lambda k: k % 50 == 0 and controller.on_joy(joy(axes(lv=0.5))))
+    assert controller.timeouts == 0 and controller.tracks[0].dq_target == pytest.approx(1.0)
+    x_silent = data.qpos[0]
+    run(controller, model, data, 440)  # 0.489 s without a Joy (the last came at step 950): not yet
+    assert controller.timeouts == 0 and not controller.stopped
+    run(controller, model, data, 100)
+    assert controller.timeouts == 1 and controller.stopped
+    assert controller.tracks[0].dq_target == 0.0 and controller.tracks[1].dq_target == 0.0
+    assert controller.rates == (0.0, 0.0)
+    x_stopped = data.qpos[0]
+    run(controller, model, data, 1500)  # 1.5 s more of silence: one timeout, the tank stands
+    assert controller.timeouts == 1
+    assert abs(data.qpos[0] - x_stopped) < 0.1 and data.qpos[0] > x_silent
+    assert abs(data.qvel[0]) < 0.01
+    controller.on_joy(joy(axes(lv=0.5)))  # the joystick is back
+    run(controller, model, data, 10)
+    assert not controller.stopped and controller.tracks[0].dq_target == pytest.approx(1.0)
+
+
+def test_no_timeout_before_the_first_joy_and_none_when_disabled():
+    controller, model, data = make_controller(joy_timeout=0.5)
+    run(controller, model, data, 2000)  # no joystick at all: the tank was never told to move
+    assert controller.timeouts == 0
+    controller, model, data = make_controller(joy_timeout=0.0)
+    controller.on_joy(joy(axes(lv=0.5)))
+    run(controller, model, data, 2000)
+    assert controller.timeouts == 0 and controller.tracks[0].dq_target == pytest.approx(1.0)

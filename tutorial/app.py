@@ -25,6 +25,7 @@ import mujoco
 from tutorial.body import Body
 from tutorial.call_later import MainLoop
 from tutorial.controller import ControllerConfig
+from tutorial.overlays import MeshcatOverlays, Overlays
 from tutorial.project import Project, check_parameter
 from tutorial.simulator import Attachment, Simulator
 from tutorial.world import build_world
@@ -79,6 +80,9 @@ class App:
         self.log = logging.getLogger("rtt")
         self.server = None
         self.scene = None
+        self.camera = None  # (position, target) of the view's camera, m, once the view is open
+        self.overlays = Overlays()  # what controllers draw over the view (main thread)
+        self.overlay_view = None
         self.sim: Simulator | None = None
         self.spin = None
         self._own_node = node is None
@@ -148,7 +152,7 @@ class App:
         config = ControllerConfig(
             name=name, body=self.bodies[body_name], node=self.node, parameters=params,
             call_later=self.loop.call_later, call_every=self.loop.call_every, output=self.output,
-            log=logging.getLogger(f"rtt.{name}"),
+            log=logging.getLogger(f"rtt.{name}"), overlays=self.overlays,
         )
         try:
             ok = controller.configure(config)
@@ -190,11 +194,13 @@ class App:
             self.vis = self.server.visualizer()
         self.scene = Scene(self.vis, self.model)
         self.scene.build(self.data)
+        self.overlay_view = MeshcatOverlays(self.vis, self.overlays)
         root = self.bodies[self.project.models[-1].name].root_pose()[0]
         if self.project.simulator is not None:
-            self.scene.set_camera(root + [-3.2, -3.4, 3.0], root + [0.8, 0.6, 0.0])  # the room, from above a corner
+            self.camera = (root + [-1.4, -2.2, 1.6], root + [1.0, 0.2, 0.0])  # the robot in its room
         else:
-            self.scene.set_camera(root + [-1.1, -1.2, 0.8], root)  # the robot, close up
+            self.camera = (root + [-1.1, -1.2, 0.8], root)  # the robot, close up
+        self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it
         self.output({"event": "meshcat", "node": self.node_fqn,
                      "url": self.vis.url() if self.server is None else self.server.web_url})
 
@@ -225,6 +231,7 @@ class App:
         self._sync_from_simulation()
         if self.scene is not None:
             self.scene.update(self.data)
+            self.overlay_view.update()
 
     def request_stop(self) -> None:
         """Ask the app to finish its current step and end (any thread, or a signal handler)."""

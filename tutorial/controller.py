@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from tutorial.body import Body
+from tutorial.overlays import Overlays
 
 
 @dataclass
@@ -50,6 +51,9 @@ class ControllerConfig:
         output: ``output(record: dict)`` prints a status line (text or JSON,
             as the program was asked); main thread only.
         log: a ``logging.Logger`` for the controller.
+        overlays: arrows to draw over the App's 3D view (see
+            :mod:`tutorial.overlays`); main thread only.  Headless, they
+            are numbers only.
     """
 
     name: str
@@ -60,6 +64,7 @@ class ControllerConfig:
     call_every: Callable[[float, Callable[[], Any]], None] = lambda period, func: None
     output: Callable[[dict], None] = print
     log: logging.Logger = logging.getLogger("tutorial.controller")
+    overlays: Overlays = field(default_factory=Overlays)
 
     @property
     def body_name(self) -> str:

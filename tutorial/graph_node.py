@@ -61,12 +61,15 @@ def read_graph(node, show_all: bool = False) -> Graph:
 
 
 def draw_graph(graph: Graph, path: str) -> None:
-    """Save a picture of the graph: nodes as ellipses, topics as boxes (any thread; uses matplotlib Agg)."""
-    import matplotlib
+    """Save a picture of the graph, left to right as rqt_graph draws it (any thread; matplotlib Agg).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Nodes are rounded green boxes, topics square yellow boxes, each sized to
+    its name; arrows run publisher -> topic -> subscriber.  The figure is
+    sized from the layout (columns of the graph, rows in the fullest column),
+    so a small graph gives a small picture with no empty half.
+    """
     import networkx as nx
+    from matplotlib.figure import Figure
 
     g = nx.DiGraph()
     for n in graph.nodes:
@@ -78,25 +81,32 @@ def draw_graph(graph: Graph, path: str) -> None:
         for s in t["subscribers"]:
             g.add_edge(topic, s)
     if len(g) and nx.is_directed_acyclic_graph(g):
-        # left to right, as rqt_graph draws it: publishers, their topics, subscribers, ...
-        for layer, names in enumerate(nx.topological_generations(g)):
-            for n in names:
-                g.nodes[n]["layer"] = layer
-        pos = nx.multipartite_layout(g, subset_key="layer")
-    else:
-        pos = nx.spring_layout(g, seed=1)
-    fig, ax = plt.subplots(figsize=(9, 5.5))
-    nodes = [n for n, d in g.nodes(data=True) if d["kind"] == "node"]
-    topics = [n for n, d in g.nodes(data=True) if d["kind"] == "topic"]
-    nx.draw_networkx_edges(g, pos, ax=ax, arrows=True, arrowsize=16, node_size=2600, edge_color="#555")
-    nx.draw_networkx_nodes(g, pos, nodelist=nodes, ax=ax, node_shape="o", node_color="#9fd3a8", node_size=2600)
-    nx.draw_networkx_nodes(g, pos, nodelist=topics, ax=ax, node_shape="s", node_color="#f2d49b", node_size=2200)
-    nx.draw_networkx_labels(g, pos, ax=ax, font_size=9)
-    ax.set_title("ROS 2 graph: nodes (circles) and topics (squares)")
+        columns = [sorted(names) for names in nx.topological_generations(g)]
+    else:  # a cycle (a node that subscribes to what it publishes): one column per kind
+        columns = [sorted(n for n, d in g.nodes(data=True) if d["kind"] == k) for k in ("node", "topic")]
+    columns = [c for c in columns if c] or [[]]
+    rows = max(len(c) for c in columns) or 1
+    longest = max((len(n) for n in g), default=4)
+    column_width = 0.3 + 0.085 * longest  # inches: wide enough for the longest name at 10 pt
+    fig = Figure(figsize=(max(3.0, column_width * len(columns)), 0.3 + 0.75 * rows))
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_xlim(-0.5, len(columns) - 0.5)
+    ax.set_ylim(-0.5, rows - 0.5)
     ax.axis("off")
-    fig.tight_layout()
+    boxes = {}
+    for x, names in enumerate(columns):
+        top = (rows - 1 + len(names) - 1) / 2  # centre each column vertically
+        for i, name in enumerate(names):
+            topic = g.nodes[name]["kind"] == "topic"
+            style = dict(boxstyle="square,pad=0.35" if topic else "round,pad=0.45",
+                         fc="#f2d49b" if topic else "#9fd3a8", ec="#666")
+            boxes[name] = ax.text(x, top - i, name, ha="center", va="center", fontsize=10, bbox=style)
+    fig.canvas.draw()  # the boxes get their sizes, so the arrows can end at their edges
+    for a, b in g.edges:
+        ax.annotate("", xy=boxes[b].get_position(), xytext=boxes[a].get_position(),
+                    arrowprops=dict(arrowstyle="-|>", color="#555", shrinkA=2, shrinkB=2,
+                                    patchA=boxes[a].get_bbox_patch(), patchB=boxes[b].get_bbox_patch()))
     fig.savefig(path, dpi=100)
-    plt.close(fig)
 
 
 def main(argv: list[str] | None = None) -> int:

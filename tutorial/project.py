@@ -25,6 +25,7 @@ e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import math
 import re
@@ -78,6 +79,40 @@ class Project:
     name: str
     models: list[ModelEntry]
     simulator: SimulatorSettings | None
+
+    def with_controller(self, model: str, name: str, cls: type, parameters: dict | None = None) -> "Project":
+        """A copy of this project with one more controller attached to ``model``.
+
+        This is what adding a controller item under a body item does in
+        Choreonoid; a notebook attaches the class it has just built this way.
+
+        Args:
+            model: the model (body) name, e.g. ``Tank``.
+            name: the controller's name (also the prefix of its ROS parameters).
+            cls: the controller class, a :class:`SimpleController` subclass.
+            parameters: values for the class's ``PARAMETERS`` (defaults for the rest).
+
+        Raises:
+            ProjectError: no such model, a bad or repeated name, a class that is
+                not a controller, an unknown parameter or a value of the wrong type.
+
+        Any thread may call this; the project itself is not changed.
+        """
+        r = _Reader(self.path)
+        index = next((i for i, m in enumerate(self.models) if m.name == model), None)
+        if index is None:
+            raise r.fail("models", f"no model named {model!r}; the project has {[m.name for m in self.models]}")
+        key = f"models[{index}].controllers[{len(self.models[index].controllers)}]"
+        r.name(name, f"{key}.name")
+        if any(c.name == name for c in self.models[index].controllers):
+            raise r.fail(f"{key}.name", f"{name!r} is used twice on {model}")
+        if not (isinstance(cls, type) and issubclass(cls, SimpleController)):
+            raise r.fail(f"{key}.class", f"expected a SimpleController subclass, got {cls!r}")
+        params = _parameters(r, cls, parameters or {}, f"{key}.parameters")
+        entry = ControllerEntry(name, cls, f"{cls.__module__}:{cls.__qualname__}", params)
+        models = list(self.models)
+        models[index] = dataclasses.replace(models[index], controllers=[*models[index].controllers, entry])
+        return dataclasses.replace(self, models=models)
 
 
 class _Reader:

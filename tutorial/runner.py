@@ -27,11 +27,31 @@ from tutorial.project import ProjectError, load_project
 from tutorial.viewer_status import format_status
 
 
+def _brief(value) -> str:
+    """A value of a summary's dict as text; a dict in it (an arrow's length and visibility) in parentheses."""
+    if isinstance(value, dict):
+        return "(" + ", ".join(f"{k}={v}" for k, v in value.items()) + ")"
+    return str(value)
+
+
 def format_record(record: dict) -> str:
     """One status record as a human-readable line (or a few, for the summary)."""
     event = record.get("event")
     if event in ("status", "stale", "recovered", "first_state", "publishers"):
         return format_status(record, record.get("node", ""))
+    if event == "imu_status":
+        age = "no reading yet" if record["age_ms"] is None else f"newest {record['age_ms']:.0f} ms old"
+        arrows = ", ".join(f"{k.replace('_', ' ')} {a['length']:.3f} m{'' if a['visible'] else ' (hidden)'}"
+                           for k, a in record["arrows"].items())
+        rejected = ", ".join(f"{k} {v}" for k, v in record["rejected"].items()) or "none"
+        shaking = " [SHAKING]" if record["shaking"] else ""
+        return (f"[{record['node']}] {record['topic']}: {record['rate_hz']:.1f} msg/s, {age}, arrows: {arrows}, "
+                f"shakes {record['shakes']}, rejected: {rejected}{shaking}")
+    if event == "shake":
+        return (f"[{record['node']}] {record['body']}: collision, {record['horizontal_acceleration']:.1f} m/s^2 "
+                "horizontal: shaking the view")
+    if event == "shake_end":
+        return f"[{record['node']}] {record['body']}: shake over, back at its position"
     if event == "meshcat":
         return f"[{record['node']}] meshcat: open {record['url']} in a browser"
     if event == "warning":
@@ -50,7 +70,7 @@ def format_record(record: dict) -> str:
             lines.append(f"{name}: " + ", ".join(f"{k}={v}" for k, v in s.items() if not isinstance(v, dict)))
             for k, v in s.items():
                 if isinstance(v, dict):
-                    lines.append(f"{name}: {k}: " + (", ".join(f"{a}={b}" for a, b in v.items()) or "none"))
+                    lines.append(f"{name}: {k}: " + (", ".join(f"{a}={_brief(b)}" for a, b in v.items()) or "none"))
         if record.get("error"):
             lines.append("ERROR:\n" + record["error"])
         return "\n".join(lines)

@@ -1,8 +1,10 @@
 """Deterministic joystick input for notebooks, tests and snapshots.
 
 :class:`ScriptedJoy` is a controller that plays :data:`tutorial.joy_input.DEMO_SCRIPT`
-by *simulated* time and hands each new stick state to the tank controller's
-``on_joy``, the same callback the ``/joy`` subscription calls.  No network is
+by *simulated* time and hands the stick state to the tank controller's
+``on_joy``, the same callback the ``/joy`` subscription calls: when it
+changes, and again every 50 ms of simulated time, as ``rtt-joy`` repeats
+at 20 Hz (so the controller's Joy timeout sees a live operator).  No network is
 involved, so the same script gives the same trajectory on every run: that is
 what lets a notebook show exact numbers.  (Over ROS, messages arrive at
 slightly different steps each run.)
@@ -14,6 +16,8 @@ from types import SimpleNamespace
 
 from tutorial.controller import SimpleController
 from tutorial.joy_input import DemoInput
+
+AUTOREPEAT = 0.05  # s of simulated time between repeats of an unchanged state (20 Hz)
 
 
 class ScriptedJoy(SimpleController):
@@ -32,6 +36,7 @@ class ScriptedJoy(SimpleController):
         self.target = target
         self.source = DemoInput(start=0.0, cycles=cycles)
         self.last = None
+        self.last_sent = float("-inf")
         self.sent = 0
 
     def initialize(self, io) -> bool:
@@ -41,9 +46,10 @@ class ScriptedJoy(SimpleController):
         return True
 
     def control(self) -> bool:
-        axes, buttons = self.source.read(self.io.current_time)
-        if (axes, buttons) != self.last:
-            self.last = (axes, buttons)
+        now = self.io.current_time
+        axes, buttons = self.source.read(now)
+        if (axes, buttons) != self.last or now - self.last_sent >= AUTOREPEAT - 1e-9:
+            self.last, self.last_sent = (axes, buttons), now
             self.target.on_joy(SimpleNamespace(axes=list(axes), buttons=list(buttons)))
             self.sent += 1
         return True

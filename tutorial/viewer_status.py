@@ -2,9 +2,11 @@
 
 Once a second the viewer reports how many messages arrived, how old the
 newest displayed state is, how many joints matched and what was rejected.
-When no state has arrived for longer than :data:`STALE_AFTER` it says so
-(``stale``) once, and once more when data resumes (``recovered``): a frozen
-view that looks alive is the most dangerous thing a monitor can show.
+Four times a second it checks for silence: when no state has arrived for
+longer than :data:`STALE_AFTER` it says so (``stale``, at most
+``STALE_AFTER + STALE_CHECK_PERIOD`` s after the last state) once, and
+once more when data resumes (``recovered``): a frozen view that looks
+alive is the most dangerous thing a monitor can show.
 
 Threads: :meth:`ViewerStatus.received` is called by the spin thread; the
 rest by the main thread.  The counters the spin thread writes are guarded by
@@ -18,7 +20,8 @@ import time
 from collections import Counter
 from typing import Callable
 
-STALE_AFTER = 1.0  # s
+STALE_AFTER = 1.0  # s without a state before the view is called stale
+STALE_CHECK_PERIOD = 0.25  # s between checks for silence
 
 
 class ViewerStatus:
@@ -41,6 +44,7 @@ class ViewerStatus:
         self.rejections: Counter = Counter()
         self.last_positions: dict[str, float] = {}
         self.stale = False
+        self.stamps_back = 0  # times a state's stamp was older than the one before (a restarted publisher)
         self._received_at_last_report = 0
         self._last_report = clock()
 
@@ -60,22 +64,31 @@ class ViewerStatus:
         self.rejections.update(rejected)
         self.last_positions.update(positions)
 
+    def check_stale(self) -> list[dict]:
+        """A ``stale`` or ``recovered`` record when the view changed between live and stale, else none (main thread)."""
+        with self._lock:
+            last_arrival = self._last_arrival
+        if last_arrival is None:
+            return []  # nothing ever came: the status line says "no state yet"
+        silent_for = self.clock() - last_arrival
+        is_stale = silent_for > STALE_AFTER
+        records = []
+        if is_stale and not self.stale:
+            records.append({"event": "stale", "silent_s": round(silent_for, 3)})
+        elif not is_stale and self.stale:
+            records.append({"event": "recovered"})
+        self.stale = is_stale
+        return records
+
     def report(self) -> list[dict]:
-        """Records for this second: a ``status`` record, preceded by ``stale`` or ``recovered`` on a change (main thread)."""
+        """Records for this second: any ``stale``/``recovered`` change, then a ``status`` record (main thread)."""
+        records = self.check_stale()
         now = self.clock()
         with self._lock:
             received, last_arrival = self._received, self._last_arrival
         period = now - self._last_report
         rate = (received - self._received_at_last_report) / period if period > 0 else 0.0
         self._last_report, self._received_at_last_report = now, received
-        silent_for = None if last_arrival is None else now - last_arrival
-        records = []
-        is_stale = silent_for is None or silent_for > STALE_AFTER
-        if is_stale and not self.stale and last_arrival is not None:
-            records.append({"event": "stale", "silent_s": round(silent_for, 3)})
-        elif not is_stale and self.stale:
-            records.append({"event": "recovered"})
-        self.stale = is_stale
         records.append({
             "event": "status",
             "rate_hz": round(rate, 1),
@@ -85,7 +98,8 @@ class ViewerStatus:
             "matched": self.matched,
             "joints": self.joint_count,
             "rejected": dict(sorted(self.rejections.items())),
-            "stale": is_stale,
+            "stale": last_arrival is None or self.stale,
+            "stamps_back": self.stamps_back,
         })
         return records
 
@@ -110,5 +124,7 @@ def format_status(record: dict, node: str = "") -> str:
     age = "no state yet" if record["age_ms"] is None else f"newest state {record['age_ms']:.0f} ms old"
     rejected = ", ".join(f"{k} {v}" for k, v in record["rejected"].items()) or "none"
     stale = " [STALE]" if record["stale"] and record["received"] else ""
+    back = record.get("stamps_back", 0)
+    went_back = f", stamps went back {back}x (a publisher restarted)" if back else ""
     return (f"{tag}{record['rate_hz']:.1f} msg/s, {age}, {record['matched']}/{record['joints']} joints matched, "
-            f"rejected: {rejected}{stale}")
+            f"rejected: {rejected}{went_back}{stale}")

@@ -1,0 +1,50 @@
+"""One source: the controller modules are exactly what their notebooks export, and notebooks read well."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+
+NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+
+
+def test_controller_modules_are_what_the_notebooks_export():
+    result = subprocess.run([sys.executable, "scripts/export_notebooks.py", "--check"], cwd=ROOT,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert "are in step" in result.stdout
+
+
+def test_the_check_fails_when_a_module_is_edited_by_hand(tmp_path):
+    import shutil
+
+    library = tmp_path / "tutorial"
+    shutil.copytree(ROOT / "tutorial" / "controllers", library / "controllers")
+    module = library / "controllers" / "tank_controller.py"
+    module.write_text(module.read_text().replace("TRACK_DEAD_ZONE = 0.2", "TRACK_DEAD_ZONE = 0.3"))
+    result = subprocess.run([sys.executable, "scripts/export_notebooks.py", "--check", "--library", str(library)],
+                            cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1
+    assert "tutorial/controllers/tank_controller.py: differs from what its notebook exports" in result.stderr
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_code_lines_fit_the_book(path):
+    """Code cells stay within 88 characters, so the book never scrolls them sideways."""
+    long = [(i, line) for i, cell in enumerate(json.loads(path.read_text())["cells"]) if cell["cell_type"] == "code"
+            for line in "".join(cell["source"]).splitlines() if len(line) > 88]
+    assert long == [], f"{path.name}: cells with lines over 88 characters: {long}"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_ignored_outputs_say_why(path):
+    """An output nbval ignores has its reason on the next line, and the marker is one nbval knows."""
+    for cell in json.loads(path.read_text())["cells"]:
+        lines = "".join(cell["source"]).splitlines()
+        for i, line in enumerate(lines):
+            if "NBVAL_IGNORE_OUTPUT" in line:
+                assert line.strip() == "# NBVAL_IGNORE_OUTPUT", f"nbval only knows the bare marker: {line!r}"
+                assert i + 1 < len(lines) and lines[i + 1].startswith("# (why:"), lines[:3]

@@ -1,0 +1,61 @@
+"""What a controller publishes, captured in-process, for the exercises' checks.
+
+:class:`CapturingNode` stands in for the ``rclpy`` node a controller gets in
+``configure``: everything goes to the real node, except that each publisher
+it creates also keeps a copy of every message published through it (a
+serialized copy: a controller may refill and reuse its message object).
+Nothing depends on the network or on timing, so a check sees exactly what
+was published, in order.  Used by one thread at a time, as a node is.
+"""
+
+from __future__ import annotations
+
+
+class CapturingPublisher:
+    """A publisher that forwards to a real one and keeps ``(topic, type, bytes)`` of each message."""
+
+    def __init__(self, real, msg_type, topic: str):
+        self.real, self.msg_type, self.topic = real, msg_type, topic
+        self.sent: list[bytes] = []
+
+    def publish(self, msg) -> None:
+        from rclpy.serialization import serialize_message
+
+        self.sent.append(serialize_message(msg))
+        self.real.publish(msg)
+
+    def messages(self) -> list:
+        """Every message published so far, deserialized, oldest first."""
+        from rclpy.serialization import deserialize_message
+
+        return [deserialize_message(b, self.msg_type) for b in self.sent]
+
+    def __getattr__(self, name):
+        return getattr(self.real, name)
+
+
+class CapturingNode:
+    """A node wrapper whose publishers capture what they publish; see the module text.
+
+    Args:
+        node: the real ``rclpy.node.Node``.
+    """
+
+    def __init__(self, node):
+        self.node = node
+        self.publishers: list[CapturingPublisher] = []
+
+    def create_publisher(self, msg_type, topic, qos_profile, **kwargs):
+        pub = CapturingPublisher(self.node.create_publisher(msg_type, topic, qos_profile, **kwargs), msg_type, topic)
+        self.publishers.append(pub)
+        return pub
+
+    def destroy_publisher(self, publisher) -> bool:
+        return self.node.destroy_publisher(getattr(publisher, "real", publisher))
+
+    def published(self, topic: str | None = None) -> list[CapturingPublisher]:
+        """The capturing publishers made so far (of one topic, or all)."""
+        return [p for p in self.publishers if topic is None or p.topic == topic]
+
+    def __getattr__(self, name):
+        return getattr(self.node, name)

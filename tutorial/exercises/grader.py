@@ -1,0 +1,141 @@
+"""Checks for the notebooks' exercises: run the learner's code on cases, say one clear line.
+
+Each exercise has a check function (in :mod:`tutorial.exercises.step1`,
+``step2``, ...) that takes what the learner wrote (a function or a class),
+runs it on cases and returns a :class:`Result`.  A notebook's check cell
+ends with that call, so the cell shows one line:
+
+    ✓ Exercise 1.1, steer with the D-pad: passed (9 cases).
+    ✗ Exercise 1.1, steer with the D-pad: dpad_track_velocities(axes=[0, 0, 0, 0, 0, 1.0, 0, 0])
+      returned (0.0, 0.0), expected (1.0, 1.0). Hint: ...
+
+A case is a function that raises :class:`CaseFailed` (what failed, with the
+input, and a hint) or returns.  Anything else it raises is reported with
+the case's input too: a ``NotImplementedError`` means the learner has not
+written the code yet, any other exception is a bug in their code.
+
+The checks are deterministic (no wall-clock timing, seeded where random),
+so the same code always gets the same line.  Any thread may run them;
+a check that simulates runs the simulation on the calling thread.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Iterable, Sequence
+
+PASS, FAIL = "\u2713", "\u2717"
+
+
+class CaseFailed(AssertionError):
+    """One case of a check failed.
+
+    Args:
+        what: what was called with which input, what came back, what was expected.
+        hint: what to look at, for the learner.
+    """
+
+    def __init__(self, what: str, hint: str = ""):
+        super().__init__(what)
+        self.what = what
+        self.hint = hint
+
+
+@dataclass
+class Case:
+    """One case: ``run()`` raises :class:`CaseFailed` on a wrong answer; ``call`` names the input."""
+
+    call: str
+    run: Callable[[], None]
+    hint: str = ""
+
+
+@dataclass
+class Result:
+    """The outcome of one exercise's check; shown as its one line.
+
+    Attributes:
+        exercise: e.g. ``"Exercise 1.1, steer with the D-pad"``.
+        passed: whether every case passed.
+        message: the line shown (without the mark).
+        case: the ``call`` of the first failing case, or None.
+    """
+
+    exercise: str
+    passed: bool
+    message: str
+    case: str | None = None
+
+    def __bool__(self) -> bool:
+        return self.passed
+
+    def __str__(self) -> str:
+        return f"{PASS if self.passed else FAIL} {self.exercise}: {self.message}"
+
+    __repr__ = __str__
+
+
+def grade(exercise: str, cases: Iterable[Case]) -> Result:
+    """Run the cases in order; stop at the first failure.
+
+    Returns:
+        a passing :class:`Result` naming how many cases ran, or a failing one
+        saying which input failed, how, and the hint.
+    """
+    count = 0
+    for case in cases:
+        count += 1
+        try:
+            case.run()
+        except CaseFailed as failure:
+            hint = failure.hint or case.hint
+            what = failure.what if case.call in failure.what else f"{case.call}: {failure.what}"
+            return Result(exercise, False, what + (f" Hint: {hint}" if hint else ""), case.call)
+        except Exception as exc:  # noqa: BLE001 - the learner's bug, reported with its input
+            if not_done(exc):
+                return Result(exercise, False, f"not done yet: {case.call} raised NotImplementedError. "
+                                               "Write your code in place of the `raise NotImplementedError` line.",
+                              case.call)
+            hint = f" Hint: {case.hint}" if case.hint else ""
+            return Result(exercise, False, f"{case.call} raised {type(exc).__name__}: {exc}.{hint}", case.call)
+    if count == 0:
+        raise ValueError(f"{exercise}: a check with no cases cannot pass")
+    return Result(exercise, True, f"passed ({count} case{'s' if count != 1 else ''}).")
+
+
+def not_done(exc: BaseException | None) -> bool:
+    """Whether ``exc`` is, or was caused by, a ``NotImplementedError`` (a stub not yet written)."""
+    while exc is not None:
+        if isinstance(exc, NotImplementedError):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+def same_numbers(got, expected, tol: float = 1e-9) -> bool:
+    """True when ``got`` is a number or a sequence of numbers equal to ``expected`` within ``tol``."""
+    if isinstance(expected, (int, float)):
+        return isinstance(got, (int, float)) and not isinstance(got, bool) and math.isfinite(got) \
+            and abs(got - expected) <= tol
+    try:
+        got = list(got)
+    except TypeError:
+        return False
+    return len(got) == len(expected) and all(same_numbers(g, e, tol) for g, e in zip(got, expected))
+
+
+def show(value) -> str:
+    """A short, stable text for a value in a message (floats rounded to 4 decimals)."""
+    if isinstance(value, float):
+        return repr(round(value, 4)) if math.isfinite(value) else repr(value)
+    if isinstance(value, (list, tuple)):
+        inner = ", ".join(show(v) for v in value)
+        return f"[{inner}]" if isinstance(value, list) else f"({inner}{',' if len(value) == 1 else ''})"
+    return repr(value)
+
+
+def expect_numbers(call: str, got, expected: Sequence[float] | float, tol: float = 1e-9, hint: str = "") -> None:
+    """Raise :class:`CaseFailed` unless ``got`` equals ``expected`` within ``tol``."""
+    if not same_numbers(got, expected, tol):
+        raise CaseFailed(f"{call} returned {show(got)}, expected {show(expected)}.", hint)

@@ -1,0 +1,119 @@
+"""Checks for the exercises of notebook 01 (Step 1, the tank controller).
+
+Exercise 1.1, steer with the D-pad: ``dpad_track_velocities(axes) -> (left, right)``.
+Exercise 1.2, count the shots: a ``RttTankController`` subclass whose
+``on_joy`` counts presses of button A and whose ``summary()`` reports ``shots``.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from tutorial import joy
+from tutorial.exercises.grader import Case, CaseFailed, Result, expect_numbers, grade, show
+
+DPAD_SPEED = 1.0  # m/s of both tracks for D-pad up
+DPAD_TURN = 0.5  # m/s of each track, opposite ways, for D-pad left or right
+
+
+def _axes(dh: float = 0.0, dv: float = 0.0, lv: float = 0.0) -> list[float]:
+    a = [0.0] * joy.NUM_AXES
+    a[joy.DPAD_H], a[joy.DPAD_V], a[joy.LEFT_STICK_V] = dh, dv, lv
+    return a
+
+
+def check_dpad_steering(func) -> Result:
+    """Check ``func(axes) -> (left, right)`` track velocities in m/s from the D-pad.
+
+    D-pad up drives both tracks forward at 1.0 m/s, down backward; left turns
+    left on the spot (left track -0.5 m/s, right +0.5 m/s), right the other
+    way; diagonals add up; a missing or non-finite axis counts as 0; the
+    sticks do not move the tracks here.
+    """
+    table = [
+        ("released", _axes(), (0.0, 0.0), "nothing pressed: both tracks stand still."),
+        ("up", _axes(dv=1.0), (DPAD_SPEED, DPAD_SPEED), "axis 5 (D-pad vertical) is +1 for up: both forward."),
+        ("down", _axes(dv=-1.0), (-DPAD_SPEED, -DPAD_SPEED), "down is axis 5 = -1: both backward."),
+        ("left", _axes(dh=1.0), (-DPAD_TURN, DPAD_TURN),
+         "axis 4 (D-pad horizontal) is +1 for left, as the sticks: turning left, the left track runs backward."),
+        ("right", _axes(dh=-1.0), (DPAD_TURN, -DPAD_TURN), "right is axis 4 = -1: the right track runs backward."),
+        ("up and left", _axes(dh=1.0, dv=1.0), (DPAD_SPEED - DPAD_TURN, DPAD_SPEED + DPAD_TURN),
+         "a diagonal is the sum of its two directions."),
+        ("a Joy with only 4 axes", [0.0, 0.0, 0.0, 0.0], (0.0, 0.0),
+         "a message without axes 4 and 5 must not raise: read axes with joy.axis(axes, index)."),
+        ("NaN on the vertical axis", _axes(dv=float("nan")), (0.0, 0.0),
+         "a non-finite value counts as 0: joy.axis() does that for you."),
+        ("left stick up, D-pad released", _axes(lv=1.0), (0.0, 0.0), "only axes 4 and 5 count here."),
+    ]
+
+    def case(label, axes, expected, hint):
+        call = f"dpad_track_velocities({show(axes)}) ({label})"
+        return Case(call, lambda: expect_numbers(call, func(list(axes)), expected, hint=hint), hint)
+
+    return grade("Exercise 1.1, steer with the D-pad", [case(*row) for row in table])
+
+
+def _joy(buttons, axes=None) -> SimpleNamespace:
+    return SimpleNamespace(axes=list(axes if axes is not None else [0.0] * joy.NUM_AXES), buttons=list(buttons))
+
+
+def _runs(presses) -> str:
+    """``[A, A, A, NONE]`` as ``"A x3, none"``: a short text for a sequence of button states."""
+    names = [{tuple(A): "A", tuple(B): "B", tuple(NONE): "none"}.get(tuple(p), show(list(p))) for p in presses]
+    out: list[list] = []
+    for name in names:
+        if out and out[-1][0] == name:
+            out[-1][1] += 1
+        else:
+            out.append([name, 1])
+    return ", ".join(f"{n} x{k}" if k > 1 else n for n, k in out)
+
+
+A = [1, 0, 0, 0, 0, 0, 0, 0]  # button A pressed
+B = [0, 1, 0, 0, 0, 0, 0, 0]  # button B pressed
+NONE = [0] * joy.NUM_BUTTONS
+
+
+def check_shot_counter(cls) -> Result:
+    """Check a tank controller class that counts presses of button A as ``summary()["shots"]``.
+
+    A press is a change from released to pressed; a button held while the
+    joy node repeats the same Joy at 20 Hz is one press; a Joy with too few
+    buttons reads A as released; the class still drives (its ``on_joy``
+    stores the sticks, as ``RttTankController``'s does).
+    """
+    sequences = [
+        ("A held for 10 repeats, then released", [A] * 10 + [NONE] * 3, 1,
+         "a press is a change from released to pressed: remember whether A was down in the last Joy."),
+        ("press, release, press", [A, NONE, A], 2, "each 0 -> 1 change of A is a shot."),
+        ("the first Joy already has A pressed", [A], 1, "before any Joy, A counts as released."),
+        ("a Joy with no buttons between two presses", [A, [], A], 2,
+         "a Joy with too few buttons reads A as released (and must not raise)."),
+        ("only B pressed", [B, B, NONE, B], 0, "A is button 0 (joy.BUTTON_A); B is button 1."),
+    ]
+
+    def count(label, presses, expected, hint):
+        call = f"{cls.__name__}().on_joy() with buttons {_runs(presses)} ({label})"
+
+        def run():
+            controller = cls()
+            for buttons in presses:
+                controller.on_joy(_joy(buttons))
+            shots = controller.summary().get("shots")
+            if shots != expected:
+                raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.", hint)
+        return Case(call, run, hint)
+
+    def still_drives():
+        controller = cls()
+        stick = [0.0, 1.0] + [0.0] * (joy.NUM_AXES - 2)
+        controller.on_joy(_joy(A, stick))
+        count_, axes, _ = controller.take_input()
+        if list(axes) != stick or count_ != 1 or controller.summary().get("joy_received") != 1:
+            raise CaseFailed(f"after on_joy(axes={show(stick)}), take_input() gave ({count_}, {show(list(axes))}, ...) "
+                             f"and summary() {controller.summary()}: the sticks are no longer stored.",
+                             "call super().on_joy(msg) first, so the controller still drives.")
+
+    cases = [count(*row) for row in sequences]
+    cases.append(Case(f"{cls.__name__}: on_joy(a Joy with the left stick up)", still_drives))
+    return grade("Exercise 1.2, count the shots", cases)

@@ -1,0 +1,189 @@
+"""Checks for the exercises of notebook 03 (Step 3, the viewer).
+
+Exercise 3.1, refuse another model's message: a ``RttJointStateSubscriber``
+subclass that refuses, whole, a JointState naming a joint this body does not
+have (or none of its joints), counting it as ``wrong_model``.
+Exercise 3.2, your own joint matcher: ``my_match(joints, names, positions)``
+returning what to apply, checked against the hostile messages.
+"""
+
+from __future__ import annotations
+
+import math
+
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+
+TANK = ["TURRET_Y", "TURRET_P"]
+
+# (label, names, positions): the hostile messages of notebook 03, and a few more
+HOSTILE = [
+    ("in order", ["TURRET_Y", "TURRET_P"], [0.3, 0.2]),
+    ("reordered", ["TURRET_P", "TURRET_Y"], [0.2, 0.3]),
+    ("unknown name", ["TURRET_Y", "GUN", "TURRET_P"], [0.3, 9.0, 0.2]),
+    ("duplicate name", ["TURRET_Y", "TURRET_Y", "TURRET_P"], [0.3, 0.4, 0.2]),
+    ("short positions", ["TURRET_Y", "TURRET_P"], [0.3]),
+    ("short names", ["TURRET_Y"], [0.3, 0.2]),
+    ("NaN", ["TURRET_Y", "TURRET_P"], [math.nan, 0.2]),
+    ("minus infinity", ["TURRET_Y", "TURRET_P"], [0.1, -math.inf]),
+    ("huge", ["TURRET_Y", "TURRET_P"], [1e300, 0.2]),
+    ("past the limit a little", ["TURRET_P"], [0.80]),
+    ("past the limit a lot", ["TURRET_P"], [0.90]),
+    ("empty", [], []),
+]
+
+
+def _tank():
+    """A Body of the tank alone, over its own MjData (the caller's thread owns it)."""
+    import mujoco
+
+    from tutorial.body import Body
+    from tutorial.notebook.runs import load
+    from tutorial.world import build_world
+
+    model = build_world(load("tank_view.yaml").models)
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    return Body(model, data, "Tank")
+
+
+def _crane():
+    import mujoco
+
+    from tutorial.body import Body
+    from tutorial.notebook.session import MODEL
+    from tutorial.world import ModelEntry, build_world
+
+    model = build_world([ModelEntry("Crane", MODEL / "crane.xml")])
+    return Body(model, mujoco.MjData(model), "Crane")
+
+
+def check_own_matcher(func) -> Result:
+    """Check ``func(joints, names, positions) -> {name: position}`` against the library's matcher.
+
+    ``joints`` is ``Body.joint_infos``; the result must be exactly what
+    :func:`tutorial.joint_matching.match_joint_state` applies: matched by
+    name in any order; unknown names, every entry of a duplicated name,
+    entries without a position, non-finite values and values outside the
+    joint's range by more than 0.05 rad (0.01 m for a slide) are skipped.
+    """
+    from tutorial.joint_matching import match_joint_state
+
+    tank, crane = _tank().joint_infos, _crane().joint_infos
+    rows = [(label, tank, names, positions) for label, names, positions in HOSTILE]
+    rows += [
+        ("a slide a little past its limit", crane, ["TROLLEY"], [crane[2].upper + 0.005]),
+        ("a slide 0.05 m past its limit", crane, ["TROLLEY"], [crane[2].upper + 0.05]),
+        ("an unlimited hinge far round", crane, ["SLEW", "LUFF"], [100.0, 0.1]),
+    ]
+    hints = {
+        "reordered": "match by name, not by index: the message may list joints in any order.",
+        "unknown name": "skip a name the body does not have, and keep going.",
+        "duplicate name": "a name given twice: which value is right cannot be known, so skip every copy.",
+        "short positions": "an entry without a position is skipped (never read past the array).",
+        "short names": "a position without a name is skipped.",
+        "NaN": "math.isfinite(q) is False for NaN and infinities: skip those.",
+        "minus infinity": "math.isfinite(q) is False for NaN and infinities: skip those.",
+        "huge": "a value far outside the joint's range (info.lower, info.upper) is skipped, not clamped.",
+        "past the limit a little": "within 0.05 rad of a limit is what a joint pressing on its stop reports: apply it.",
+        "past the limit a lot": "more than 0.05 rad past a limit: skip it.",
+        "a slide a little past its limit": "a slide's tolerance is 0.01 m (info.kind == 'slide').",
+        "a slide 0.05 m past its limit": "a slide's tolerance is 0.01 m (info.kind == 'slide').",
+        "an unlimited hinge far round": "an unlimited joint (info.limited False) has no range to check.",
+    }
+
+    def case(label, joints, names, positions):
+        call = f"my_match({'crane' if joints is crane else 'tank'} joints, {show(names)}, {show(positions)}) ({label})"
+
+        def run():
+            expected = match_joint_state(joints, names, positions).applied
+            got = func(joints, list(names), list(positions))
+            if not isinstance(got, dict) or set(got) != set(expected) or any(
+                    not _same(got[k], expected[k]) for k in expected):
+                raise CaseFailed(f"{call} returned {_show_dict(got)}, expected {_show_dict(expected)}.",
+                                 hints.get(label, ""))
+        return Case(call, run, hints.get(label, ""))
+
+    return grade("Exercise 3.2, your own joint matcher", [case(*row) for row in rows])
+
+
+def _same(a, b) -> bool:
+    return isinstance(a, (int, float)) and not isinstance(a, bool) and math.isfinite(a) and abs(a - b) <= 1e-12
+
+
+def _show_dict(d) -> str:
+    if not isinstance(d, dict):
+        return repr(d)
+    return "{" + ", ".join(f"{k!r}: {show(v)}" for k, v in d.items()) + "}"
+
+
+def check_wrong_model(cls) -> Result:
+    """Check a ``RttJointStateSubscriber`` subclass that refuses another model's messages whole.
+
+    A JointState that names a joint the body does not have, or none of its
+    joints, is refused: nothing is applied, ``summary()["rejected"]`` counts
+    it once as ``wrong_model`` and ``applied`` does not count it.  Any other
+    message is handled as before (the matcher still rejects bad entries).
+    """
+    import rclpy
+    from sensor_msgs.msg import JointState
+
+    from tutorial.controller import ControllerConfig
+
+    def message(names, positions):
+        msg = JointState()
+        msg.name, msg.position = list(names), [float(p) for p in positions]
+        return msg
+
+    def run_messages(messages):
+        """Configure a fresh controller on a fresh tank, apply each message on this thread."""
+        body = _tank()
+        node = rclpy.create_node("exercise_check_wrong_model")
+        try:
+            controller = cls()
+            config = ControllerConfig(name="Strict", body=body, node=node)
+            if not controller.configure(config):
+                raise CaseFailed(f"{cls.__name__}.configure() returned False.",
+                                 "keep RttJointStateSubscriber.configure: call super().configure(config).")
+            for msg in messages:
+                controller.update_joint_state(msg)
+            summary = controller.summary()
+            controller.unconfigure()
+        finally:
+            node.destroy_node()
+        return body, summary
+
+    def expect(label, messages, applied, rejected, positions, hint=""):
+        sent = "; ".join(f"{show(list(m.name))} {show(list(m.position))}" for m in messages)
+        call = f"{cls.__name__}.update_joint_state() for {sent} ({label})"
+
+        def run():
+            body, summary = run_messages(messages)
+            got = {k: round(v, 9) for k, v in body.joint_positions().items()}
+            if summary.get("applied") != applied or summary.get("rejected") != rejected:
+                raise CaseFailed(f"{call} gave applied={summary.get('applied')!r}, rejected={summary.get('rejected')!r}"
+                                 f"; expected applied={applied}, rejected={rejected}.", hint)
+            if got != positions:
+                raise CaseFailed(f"{call} left the tank at {got}, expected {positions}.", hint)
+        return Case(call, run, hint)
+
+    zero = {"TURRET_Y": 0.0, "TURRET_P": 0.0}
+    return grade("Exercise 3.1, refuse another model's message", [
+        expect("the tank's own message", [message(TANK, [0.3, 0.2])], 1, {},
+               {"TURRET_Y": 0.3, "TURRET_P": 0.2}, "a message of this body's joints is applied as before."),
+        expect("the tank's joints, reordered", [message(["TURRET_P", "TURRET_Y"], [0.2, 0.3])], 1, {},
+               {"TURRET_Y": 0.3, "TURRET_P": 0.2}, "order does not matter: the names are all the tank's."),
+        expect("the crane's message", [message(["SLEW", "LUFF", "TROLLEY"], [0.5, 0.2, 1.0])], 0,
+               {"wrong_model": 1}, zero,
+               "none of these names is a joint of the body (self.body.joint_names): refuse it whole, "
+               "count self.rejected['wrong_model'] += 1, and do not call super().update_joint_state()."),
+        expect("one of the tank's joints and one unknown", [message(["TURRET_Y", "GUN"], [0.3, 0.1])], 0,
+               {"wrong_model": 1}, zero, "one unknown name is enough: the message is from another model."),
+        expect("an empty message", [message([], [])], 0, {"wrong_model": 1}, zero,
+               "a message that names none of the body's joints is not this body's."),
+        expect("the tank's, with a NaN", [message(TANK, [math.nan, 0.2])], 1, {"not_finite": 1},
+               {"TURRET_Y": 0.0, "TURRET_P": 0.2},
+               "a message of this body stays with the matcher, which rejects the NaN entry alone."),
+        expect("the crane's, then the tank's", [message(["SLEW"], [0.5]), message(TANK, [0.4, 0.1])], 1,
+               {"wrong_model": 1}, {"TURRET_Y": 0.4, "TURRET_P": 0.1},
+               "after refusing one message, the next good one is applied."),
+    ])

@@ -1,0 +1,17 @@
+"""Helpers for the notebooks, one module per job; a notebook imports each from its home.
+
+================  ==============================================================
+module            what it gives a notebook
+================  ==============================================================
+``session``       ``init_ros``, ``reset``, ``TEST_MODE``, ``wait_until``, paths
+``runs``          ``run_project`` (deterministic), ``BackgroundApp`` (live, over ROS 2), ``load``
+``views``         ``LiveView`` (a run's 3D view: live, then its recording), ``show``, ``MeshcatPage``
+``replay``        self-contained meshcat pages of recorded runs (no server)
+``panels``        widget panels that say what they are doing, and a stand-in where widgets cannot run
+``teleop``        ``TeleopPanel``: sliders and a gamepad publishing ``/joy``
+``plots``         ``LivePlot``: joint positions from ``/<body>/joint_state``
+``graph``         ``graph_picture``: the ROS 2 graph as a picture
+================  ==============================================================
+
+The exercises' checks live in :mod:`tutorial.exercises`.
+"""

@@ -1,0 +1,99 @@
+"""Widget panels that tell the truth: live in JupyterLab, a plain stand-in anywhere else.
+
+An ipywidgets panel needs a running kernel.  Opened without one (a
+notebook just cloned, the book), a panel shows what its output bundle
+offers instead, so :class:`Panel` gives it a text stand-in (and an HTML one
+for the book) that says what the panel is and how to get it back, rather
+than ``VBox(children=(HBox(...``.
+
+A closed panel (``reset()``) keeps its place: its controls are disabled
+and its status line says why.
+
+Threads: widget callbacks and :meth:`Panel.close` run on the kernel
+thread; :meth:`RunControls.refresh` may be called from a run's owner
+thread (an ipywidgets trait change sends a comm message, which ipykernel
+accepts from any thread).
+"""
+
+from __future__ import annotations
+
+import html
+
+
+class Panel:
+    """A widget panel with a status line, a stand-in, and a ``close()`` that disables it.
+
+    Subclasses build ``self.widget`` (an ipywidgets container whose
+    controls are in ``self.controls``) and ``self.line`` (an ``HTML`` widget).
+
+    Args:
+        title: what the panel is, e.g. ``"Teleop panel (publishes /joy)"``.
+        description: one sentence for where the panel cannot be live.
+    """
+
+    def __init__(self, title: str, description: str):
+        import ipywidgets as w
+
+        self.title = title
+        self.description = description
+        self.line = w.HTML()
+        self.controls: list = []
+        self.closed = False
+
+    def say(self, text: str, warning: bool = False) -> None:
+        """Set the status line (kernel thread, or any thread that owns no widget lock)."""
+        color = "#b00" if warning else "#444"
+        self.line.value = f'<span style="color: {color}">{html.escape(text)}</span>'
+
+    def _repr_mimebundle_(self, **kwargs):
+        bundle = self.widget._repr_mimebundle_(**kwargs)
+        text = f"{self.title}: {self.description} (a live panel: run this cell in JupyterLab to use it)"
+        bundle["text/plain"] = text
+        bundle["text/html"] = (f'<div style="border: 1px solid #bbb; border-radius: 4px; padding: 6px 10px; '
+                               f'color: #444"><b>{html.escape(self.title)}</b>: {html.escape(self.description)}'
+                               "<br><i>A live panel: in JupyterLab this cell shows its controls.</i></div>")
+        return bundle
+
+    def close(self, why: str = "closed by reset(): run this cell again to use it") -> None:
+        """Disable the controls and say why (kernel thread)."""
+        if self.closed:
+            return
+        self.closed = True
+        for c in self.controls:
+            c.disabled = True
+        self.say(why)
+
+
+class RunControls(Panel):
+    """Start and Stop buttons for a :class:`tutorial.notebook.runs.BackgroundApp`, with its status."""
+
+    def __init__(self, run):
+        import ipywidgets as w
+
+        super().__init__(f"Start/Stop for /{run.node_name}",
+                         "buttons that start and stop the run, and a line saying what it is doing")
+        self.run = run
+        self.start = w.Button(description="Start", button_style="success")
+        self.stop = w.Button(description="Stop")
+        self.start.on_click(lambda _: self._start())
+        self.stop.on_click(lambda _: run.stop())
+        self.controls = [self.start, self.stop]
+        self.widget = w.HBox([self.start, self.stop, self.line])
+        self.refresh()
+
+    def _start(self) -> None:
+        try:
+            self.run.start()
+        except RuntimeError as exc:
+            self.say(str(exc), warning=True)
+
+    def refresh(self) -> None:
+        """Show the run's status; Start is enabled only when it is not running."""
+        if self.closed:
+            return
+        status = self.run.status
+        # From the status, not from the thread: the owner thread reports "finished" while it is still alive.
+        active = status in ("starting", "running")
+        self.start.disabled = active
+        self.stop.disabled = not active
+        self.say(f"/{self.run.node_name}: {status}", warning=status.startswith("failed"))

@@ -1,0 +1,83 @@
+"""The notebook session: ROS once per kernel, and a reset that stops what cells started.
+
+Every notebook starts with::
+
+    from tutorial.notebook.session import init_ros, reset, TEST_MODE
+
+Threads in a notebook: the kernel's main thread runs the cells and the
+widget callbacks.  Things that run on after a cell has finished (a
+simulation, a live plot, a teleop panel's node) register here when they
+start; :func:`reset` closes them all, newest first, so a section can be
+re-run from its first cell.  Each closed thing leaves its output saying
+so: a recording in place of a live 3D view, a disabled panel with a line
+saying why.
+
+``RTT_TEST_MODE=1`` (set by the test suite) shortens the interactive runs;
+it never changes what a checked output says.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import Callable
+
+from tutorial import ros_env
+
+TEST_MODE = os.environ.get("RTT_TEST_MODE") == "1"
+ROOT = Path(__file__).resolve().parent.parent.parent
+PROJECT = ROOT / "project"
+MODEL = ROOT / "model"
+
+_active: list = []  # things with a .close() started from cells, oldest first
+
+
+def init_ros() -> None:
+    """Initialise rclpy once per kernel, without its signal handlers (kernel thread).
+
+    rclpy would otherwise take over SIGINT and shut ROS down when you press
+    the notebook's "interrupt" button.  Calling it again does nothing.
+    """
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    ros_env.use_localhost_by_default()
+    if not rclpy.ok():
+        rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+
+
+def register(thing):
+    """Remember ``thing`` (anything with ``close()``) for :func:`reset`; returns it."""
+    _active.append(thing)
+    return thing
+
+
+def forget(thing) -> None:
+    """Drop ``thing`` from the registry (it closed itself)."""
+    if thing in _active:
+        _active.remove(thing)
+
+
+def reset() -> None:
+    """Close every run, view, panel and plot started by earlier cells (kernel thread).
+
+    Run it at the top of a section so the section can be re-run safely.
+    One thing failing to close does not stop the others from closing.
+    """
+    while _active:
+        thing = _active.pop()
+        try:
+            thing.close()
+        except Exception as exc:  # noqa: BLE001 - keep closing the rest, but say so
+            print(f"reset: {type(thing).__name__} did not close cleanly: {exc!r}")
+
+
+def wait_until(predicate: Callable[[], bool], timeout: float, poll: float = 0.05) -> bool:
+    """Poll ``predicate`` until it is true or ``timeout`` s pass; its last value (any thread)."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() >= deadline:
+            return bool(predicate())
+        time.sleep(poll)
+    return True

@@ -1,0 +1,258 @@
+"""3D views in a notebook: live while their run lives, a recording once it has ended.
+
+A :class:`LiveView` belongs to one run (:class:`tutorial.notebook.runs.BackgroundApp`)
+and outlives its Start/Stop cycles: its meshcat server stays up, so the
+page in the notebook stays connected and shows every restarted run.  A
+caption under the page says what the view shows right now: starting,
+live, stopped, finished, failed.  When the view closes (``reset()``), the
+live page is replaced, in the same output, by a recording of the run's
+last seconds, marked as a recording: a view never points at a server that
+is gone, and a saved notebook (and the book) shows what happened.
+
+:func:`show` puts one or more views side by side in one output.
+
+Threads: :func:`show` and :meth:`LiveView.close` run on the kernel
+thread; :meth:`LiveView.visualizer`, :meth:`LiveView.begin` and
+:meth:`LiveView.record` on the run's owner thread; :meth:`LiveView.set_status`
+on either (it only sends an output update, which ipykernel accepts from
+any thread).  The recorded frames are the one thing both threads touch:
+a lock guards them.
+"""
+
+from __future__ import annotations
+
+import html
+import threading
+import time
+from collections import deque
+
+from tutorial.notebook import replay, session
+
+
+class LiveView:
+    """The inline 3D view of one run, with a meshcat server of its own.
+
+    Args:
+        label: what the view shows, e.g. ``"simulation (node /rtt)"``.
+        height: height of the page in the notebook, px.
+
+    Raises:
+        RuntimeError: the meshcat server did not start.
+    """
+
+    FPS = 15.0  # recorded frames per second of wall time
+    SECONDS = 60.0  # the recording keeps the last this many seconds of the run
+
+    def __init__(self, label: str, height: int = 380):
+        from tutorial.meshcat_server import start_server
+
+        self.label = label
+        self.height = height
+        self.server = start_server()
+        self.url = self.server.web_url
+        self.status = "not started yet"
+        self.closed = False
+        self._displays: list[_Display] = []
+        self._lock = threading.Lock()  # guards the three below: the owner thread writes, close() reads
+        self._model = None
+        self._camera = None
+        self._frames: deque = deque(maxlen=int(self.FPS * self.SECONDS))
+        self._next_frame = 0.0
+
+    # ---- the run's owner thread ---------------------------------------------------
+    def visualizer(self):
+        """A ``meshcat.Visualizer`` on this view's server, owned by the calling thread (one per run)."""
+        return self.server.visualizer()
+
+    def begin(self, model, camera=None) -> None:
+        """A run starts drawing ``model``: its recording starts afresh (owner thread).
+
+        Args:
+            model: the run's ``MjModel``.
+            camera: ``(position, target)`` the run placed its camera at, m, for the recording.
+        """
+        with self._lock:
+            self._model, self._camera = model, camera
+            self._frames.clear()
+            self._next_frame = 0.0
+
+    def record(self, data) -> None:
+        """Keep ``data.qpos`` as a frame of the recording, at most ``FPS`` times a second (owner thread)."""
+        now = time.monotonic()
+        if now < self._next_frame:
+            return
+        self._next_frame = now + 1.0 / self.FPS
+        with self._lock:
+            self._frames.append(data.qpos.copy())
+
+    # ---- any thread -------------------------------------------------------------------
+    def set_status(self, status: str) -> None:
+        """Say what the view shows now (the caption under the page)."""
+        self.status = status
+        for d in list(self._displays):
+            d.refresh_caption()
+
+    # ---- kernel thread ---------------------------------------------------------------------
+    def recording(self):
+        """A :class:`tutorial.notebook.replay.SceneRecorder` of the last run, or None if nothing was drawn."""
+        with self._lock:
+            model, camera, frames = self._model, self._camera, list(self._frames)
+        if model is None or not frames:
+            return None
+        return replay.record_replay(model, frames, self.FPS, camera=camera)
+
+    def recorded_seconds(self) -> float:
+        with self._lock:
+            return len(self._frames) / self.FPS
+
+    def close(self) -> None:
+        """Replace the live page by the recording and stop the server (kernel thread, once)."""
+        if self.closed:
+            return
+        self.closed = True
+        for d in list(self._displays):
+            d.view_closed()
+        self.server.close()
+
+
+class _Display:
+    """One output showing one or more views side by side, with a caption under them."""
+
+    def __init__(self, views: list[LiveView], height: int):
+        from IPython.display import HTML, display
+
+        self.views = views
+        self.height = height
+        frames = "".join(f'<iframe src="{v.url}" style="flex: 1; min-width: 0; height: {height}px; border: none">'
+                         "</iframe>" for v in views)
+        self.page = display(HTML(f'<div style="display: flex; gap: 4px">{frames}</div>'), display_id=True)
+        self.caption = display(HTML(self._caption()), display_id=True)
+        for v in views:
+            v._displays.append(self)
+
+    def _caption(self) -> str:
+        parts = []
+        for v in self.views:
+            state = "recording" if v.closed else "live"
+            parts.append(f"<b>{html.escape(v.label)}</b> ({state}): {html.escape(v.status)}")
+        return '<div style="font-size: 90%">' + " &nbsp;|&nbsp; ".join(parts) + "</div>"
+
+    def refresh_caption(self) -> None:
+        from IPython.display import HTML
+
+        self.caption.update(HTML(self._caption()))
+
+    def view_closed(self) -> None:
+        """Once every view of this output has closed, show their recordings side by side."""
+        from IPython.display import HTML
+
+        if not all(v.closed for v in self.views):
+            self.refresh_caption()
+            return
+        scenes = [v.recording() for v in self.views]
+        if any(s is None for s in scenes):
+            self.page.update(HTML("<p><i>This view closed before its run drew anything: "
+                                  "there is nothing to replay. Run the section again to see it live.</i></p>"))
+        else:
+            labels = [f"{v.label}: recorded, {v.recorded_seconds():.1f} s" for v in self.views]
+            page = replay.page_html(scenes, labels, title="recording")
+            self.page.update(HTML(replay.iframe_html(page, self.height)))
+        seconds = ", ".join(f"{v.label} {v.recorded_seconds():.1f} s" for v in self.views)
+        self.caption.update(HTML(
+            '<div style="font-size: 90%"><b>Recorded</b> (' + html.escape(seconds) + f", {LiveView.FPS:.0f} frames/s): "
+            "the run has ended and its live page is gone, so this is a recording of what it showed. "
+            "Drag to turn, scroll to zoom; <i>Open Controls, Animations</i> pauses it. "
+            "Run the section again for a live view.</div>"))
+
+
+def show(*views: LiveView, height: int | None = None) -> None:
+    """Display ``views`` side by side in this cell's output (kernel thread).
+
+    The output stays true: a caption says what each view shows, and when
+    the views close their pages become their recordings.
+    """
+    if not views:
+        raise ValueError("show: no views given")
+    _Display(list(views), height or max(v.height for v in views))
+
+
+class MeshcatPage:
+    """A meshcat page to draw in by hand, shown inline; a still picture of it stays after it closes.
+
+    ``vis`` is a ``meshcat.Visualizer`` that draws both into the live page
+    and into a recorder, so :meth:`close` can leave the scene as it was.
+    Owned by the kernel thread (meshcat's socket is not thread-safe).
+    """
+
+    def __init__(self, label: str = "meshcat page", height: int = 350):
+        import meshcat
+
+        from tutorial.meshcat_server import start_server
+
+        self.label = label
+        self.height = height
+        self.server = start_server()
+        self.url = self.server.web_url
+        self.recorder = replay.SceneRecorder()
+        self.vis = meshcat.Visualizer(window=_Tee(self.server.visualizer().window, self.recorder))
+        self.closed = False
+        self._handle = None
+        session.register(self)
+
+    def show(self) -> None:
+        """Display the live page, with a caption, in this cell's output."""
+        from IPython.display import HTML, display
+
+        self._handle = display(HTML(f'<div><iframe src="{self.url}" style="width: 100%; height: {self.height}px; '
+                                    'border: none"></iframe></div>'), display_id=True)
+        self._caption = display(HTML(f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> (live)</div>'),
+                                display_id=True)
+
+    def close(self) -> None:
+        """Leave a still copy of the scene in the output, then stop the server (kernel thread)."""
+        from IPython.display import HTML
+
+        if self.closed:
+            return
+        self.closed = True
+        if self._handle is not None:
+            page = replay.page_html([self.recorder], [self.label], title=self.label)
+            self._handle.update(HTML(replay.iframe_html(page, self.height)))
+            self._caption.update(HTML(f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> '
+                                      "(a saved copy: the live page has closed; drag to turn, scroll to zoom)</div>"))
+        self.server.close()
+
+
+class _Tee:
+    """A meshcat window that sends each command to a live window and to a recorder."""
+
+    zmq_url = None  # one path for every command, so the recorder sees them all
+
+    def __init__(self, live, recorder: replay.SceneRecorder):
+        self.live = live
+        self.recorder = recorder
+        self.web_url = live.web_url
+
+    def send(self, command) -> None:
+        self.live.send(command)
+        self.recorder.send(command)
+
+
+def show_recording(model, frames, fps: float, label: str, camera=None, height: int = 380) -> None:
+    """Display a recording of ``frames`` (a finished run, e.g. :func:`tutorial.notebook.runs.run_project`'s).
+
+    Args:
+        model: the ``MjModel`` of the frames.
+        frames: (nq,) ``qpos`` arrays, ``1/fps`` s apart.
+        fps: frames per second of the recording.
+        label: what it shows, written in its corner.
+        camera: optional ``(position, target)``, m.
+        height: px.
+
+    The page is self-contained and the same bytes for the same frames, so a
+    deterministic run's recording is checked like any other output.
+    """
+    from IPython.display import HTML, display
+
+    page = replay.page_html([replay.record_replay(model, frames, fps, camera=camera)], [label], title=label)
+    display(HTML(replay.iframe_html(page, height)))
