@@ -30,18 +30,34 @@ DEMO_SCRIPT: tuple[tuple[float, tuple[float, float, float, float]], ...] = (
     (1.0, (0.0, 0.0, 0.0, 0.0)),   # still
 )
 
+# Step 5's demo: ram the wall ahead at full speed, back off, swing the barrel and turn on
+# the spot (and back), again.  Started from the room's centre facing +x, every cycle hits
+# the east wall at about 2 m/s: a horizontal acceleration of 35-56 m/s^2 in the IMU's 50 ms
+# mean, well over the viewer's 20 m/s^2 collision threshold.
+WALL_SCRIPT: tuple[tuple[float, tuple[float, float, float, float]], ...] = (
+    (0.5, (0.0, 0.0, 0.0, 0.0)),    # still
+    (2.0, (0.0, 1.0, -0.3, 0.0)),   # full speed ahead, into the wall; turret turning right
+    (1.6, (0.0, -0.5, 0.3, 0.0)),   # back off at 1 m/s, turret turning back
+    (0.8, (0.6, 0.0, 0.0, -0.4)),   # turn left on the spot, barrel rising
+    (0.8, (-0.6, 0.0, 0.0, 0.4)),   # and back, barrel lowering
+    (0.5, (0.0, 0.0, 0.0, 0.0)),    # still
+)
+SCRIPTS = {"drive": DEMO_SCRIPT, "wall": WALL_SCRIPT}
+
 
 @dataclass
 class DemoInput:
-    """The scripted :data:`DEMO_SCRIPT`, from ``start`` (s, monotonic), looped.
+    """A scripted drive, :data:`DEMO_SCRIPT` unless told otherwise, from ``start`` (s), looped.
 
     Args:
         start: time the script starts; None waits (sticks at rest) until :meth:`begin`.
         cycles: how many times to play it (None: forever); afterwards the sticks rest at 0.
+        script: ``(seconds, (left H, left V, right H, right V))`` steps, e.g. a value of :data:`SCRIPTS`.
     """
 
     start: float | None = None
     cycles: int | None = None
+    script: tuple = DEMO_SCRIPT
 
     @property
     def waiting(self) -> bool:
@@ -53,7 +69,7 @@ class DemoInput:
 
     @property
     def period(self) -> float:
-        return sum(d for d, _ in DEMO_SCRIPT)
+        return sum(d for d, _ in self.script)
 
     def finished(self, now: float) -> bool:
         return self.start is not None and self.cycles is not None and now - self.start >= self.cycles * self.period
@@ -62,7 +78,7 @@ class DemoInput:
         if self.start is None or self.finished(now):
             return ZERO_AXES, ZERO_BUTTONS
         t = (now - self.start) % self.period
-        for duration, (lh, lv, rh, rv) in DEMO_SCRIPT:
+        for duration, (lh, lv, rh, rv) in self.script:
             if t < duration:
                 return (lh, lv, rh, rv, 0.0, 0.0, 0.0, 0.0), ZERO_BUTTONS
             t -= duration

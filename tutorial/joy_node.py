@@ -4,6 +4,7 @@
     rtt-joy --demo       # scripted input: drive, turn, swing the turret (loops; starts
                          # when /joy has a subscriber)
     rtt-joy --demo --duration 10
+    rtt-joy --demo --script wall   # Step 5's: ram the wall ahead, back off, again
 
 Like ROS 2's ``joy_node`` it publishes when the input changes (at most
 ``--rate`` Hz, 60 by default) and repeats the current state at
@@ -81,10 +82,11 @@ class JoyPublisher:
 
 def choose_source(args, stack: contextlib.ExitStack):
     """The input source the command line asks for, and a line saying which it is."""
-    from tutorial.joy_input import KEYBOARD_HELP, DemoInput, GamepadInput, KeyboardInput
+    from tutorial.joy_input import SCRIPTS, KEYBOARD_HELP, DemoInput, GamepadInput, KeyboardInput
 
     if args.demo:
-        return DemoInput(), "demo script (it starts when /joy has a subscriber)"
+        return (DemoInput(script=SCRIPTS[args.script]),
+                f"demo script {args.script!r} (it starts when /joy has a subscriber)")
     try:
         pad = GamepadInput()
         return pad, f"gamepad {pad.name}"
@@ -106,6 +108,8 @@ def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv if argv is None else argv)
     parser = argparse.ArgumentParser(prog="rtt-joy", description="Publish sensor_msgs/Joy on /joy.")
     parser.add_argument("--demo", action="store_true", help="scripted input (drive, turn, turret), looped")
+    parser.add_argument("--script", choices=["drive", "wall"], default="drive",
+                        help="with --demo: 'drive' (around the room) or 'wall' (ram the wall ahead, Step 5)")
     parser.add_argument("--duration", type=float, default=None, metavar="SECONDS",
                         help="stop after this long (with --demo: this long after the demo starts)")
     parser.add_argument("--rate", type=float, default=60.0, help="input polling rate, Hz (default 60)")

@@ -28,13 +28,15 @@ class ScriptedJoy(SimpleController):
             function returning it (called in ``initialize``, when every
             controller of the project has been configured).
         cycles: how many times to play the script (None: forever).
+        script: the script, :data:`tutorial.joy_input.DEMO_SCRIPT` unless given
+            (e.g. ``SCRIPTS["wall"]``, Step 5's).
 
     Attach it before the target, so both see the same step.  Runs on the simulation thread.
     """
 
-    def __init__(self, target, cycles: int | None = None):
+    def __init__(self, target, cycles: int | None = None, script=None):
         self.target = target
-        self.source = DemoInput(start=0.0, cycles=cycles)
+        self.source = DemoInput(start=0.0, cycles=cycles, **({"script": script} if script else {}))
         self.last = None
         self.last_sent = float("-inf")
         self.sent = 0

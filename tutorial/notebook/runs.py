@@ -95,7 +95,7 @@ def run_headless(project, duration: float, attach=(), output=None, node_name: st
 
 
 def run_project(project, duration: float, node_name: str = "rtt_scripted", scripted: bool = True,
-                fps: float = 30.0, realtime: bool = False):
+                fps: float = 30.0, realtime: bool = False, script: str = "drive"):
     """Run a project to its end on this thread with the demo script: the same numbers every run.
 
     Args:
@@ -106,6 +106,8 @@ def run_project(project, duration: float, node_name: str = "rtt_scripted", scrip
             project's ``RttTankController`` by simulated time, repeated at 20 Hz.
         fps: frame rate of the recorded states.
         realtime: keep simulated time with wall time (False: as fast as possible).
+        script: which demo script, a key of :data:`tutorial.joy_input.SCRIPTS`
+            (``"drive"``, or ``"wall"``: Step 5's wall ramming).
 
     Returns:
         ``(summary, app, recorder)``: the exit summary, the closed app (its
@@ -113,6 +115,7 @@ def run_project(project, duration: float, node_name: str = "rtt_scripted", scrip
 
     Deaf to the network, as :func:`run_headless`; what it publishes still goes out.
     """
+    from tutorial.joy_input import SCRIPTS
     from tutorial.recorder import StateRecorder
     from tutorial.scripted_input import ScriptedJoy
 
@@ -122,7 +125,8 @@ def run_project(project, duration: float, node_name: str = "rtt_scripted", scrip
     attach = [(body, "Recorder", recorder)]
     if scripted:
         # The tank controller exists once the app has configured it: look it up then.
-        attach.insert(0, (body, "ScriptedJoy", ScriptedJoy(lambda: app.controller("RttTankController"))))
+        joystick = ScriptedJoy(lambda: app.controller("RttTankController"), script=SCRIPTS[script])
+        attach.insert(0, (body, "ScriptedJoy", joystick))
     app, node = _headless_app(proj, duration, node_name, realtime, None, attach)
     return _run_to_end(app, node), app, recorder
 
