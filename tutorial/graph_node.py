@@ -87,8 +87,8 @@ def draw_graph(graph: Graph, path: str) -> None:
     columns = [c for c in columns if c] or [[]]
     rows = max(len(c) for c in columns) or 1
     longest = max((len(n) for n in g), default=4)
-    column_width = 0.3 + 0.085 * longest  # inches: wide enough for the longest name at 10 pt
-    fig = Figure(figsize=(max(3.0, column_width * len(columns)), 0.3 + 0.75 * rows))
+    column_width = 0.4 + 0.1 * longest  # inches: wide enough for the longest name at 12 pt
+    fig = Figure(figsize=(max(3.0, column_width * len(columns)), 0.4 + 0.8 * rows))
     ax = fig.add_axes((0, 0, 1, 1))
     ax.set_xlim(-0.5, len(columns) - 0.5)
     ax.set_ylim(-0.5, rows - 0.5)
@@ -100,7 +100,7 @@ def draw_graph(graph: Graph, path: str) -> None:
             topic = g.nodes[name]["kind"] == "topic"
             style = dict(boxstyle="square,pad=0.35" if topic else "round,pad=0.45",
                          fc="#f2d49b" if topic else "#9fd3a8", ec="#666")
-            boxes[name] = ax.text(x, top - i, name, ha="center", va="center", fontsize=10, bbox=style)
+            boxes[name] = ax.text(x, top - i, name, ha="center", va="center", fontsize=12, bbox=style)
     fig.canvas.draw()  # the boxes get their sizes, so the arrows can end at their edges
     for a, b in g.edges:
         ax.annotate("", xy=boxes[b].get_position(), xytext=boxes[a].get_position(),
