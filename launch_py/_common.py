@@ -1,4 +1,4 @@
-"""Shared by the launch files: where the project files are, and the Step 2 pair of nodes."""
+"""Shared by the launch files: where the project files are, the Step 2 pair of nodes, the recorder."""
 
 import sys
 from pathlib import Path
@@ -10,12 +10,27 @@ sys.path.insert(0, str(ROOT))  # run from a clone without installing, too
 from tutorial.launch import Node  # noqa: E402
 
 
-def joy_node(args) -> Node:
-    """The joystick: scripted with --demo, else a gamepad or this terminal's keyboard."""
-    return Node("rtt_joy", "tutorial.joy_node", ["--demo"] if args.demo else [])
+def joy_node(args, script: str = "drive") -> Node:
+    """The joystick: with --demo the demo ``script`` (``drive`` or ``wall``), else a gamepad or the keyboard."""
+    return Node("rtt_joy", "tutorial.joy_node", ["--demo", "--script", script] if args.demo else [])
 
 
 def simulation_node(args, project: str) -> Node:
     """The simulation (``rtt``), required: when it ends, the launch ends."""
     extra = (["--headless"] if args.headless else []) + (["--duration", str(args.duration)] if args.duration else [])
     return Node("rtt", "tutorial.runner", [str(PROJECT / project), *extra], required=True)
+
+
+def record_nodes(args, topics: list[str]) -> list[Node]:
+    """With ``--record FILE.mcap``: ``rtt-bag record`` of the step's ``topics`` as node ``rtt_bag``; else none.
+
+    Put it first in the launch description: started before the publishers,
+    it has joined the ROS graph when they appear, and records from their
+    first message (a recorder that joins later can take up to one of Fast
+    DDS's 3 s discovery periods to see them).  Not required: when the
+    simulation ends, the launch stops the recorder with SIGINT and it
+    closes the file whole.
+    """
+    if not args.record:
+        return []
+    return [Node("rtt_bag", "tutorial.bag", ["record", *topics, "-o", args.record])]

@@ -2,11 +2,12 @@
 separately named viewer process (``rtt_viewer``) showing the joint state.
 
     python launch_py/step3_launch.py --demo
+    python launch_py/step3_launch.py --demo --record drive.mcap   # also record /joy, /Tank/joint_state
 """
 
 import sys
 
-from _common import PROJECT, joy_node, simulation_node
+from _common import PROJECT, joy_node, record_nodes, simulation_node
 
 from tutorial.launch import LaunchDescription, Node, launch_parser, run
 
@@ -14,6 +15,7 @@ from tutorial.launch import LaunchDescription, Node, launch_parser, run
 def generate_launch_description(args) -> LaunchDescription:
     viewer_args = [str(PROJECT / "step3.yaml")] + (["--headless"] if args.headless else [])
     return LaunchDescription([
+        *record_nodes(args, ["/joy", "/Tank/joint_state"]),  # first: up before the publishers start
         joy_node(args),
         simulation_node(args, "step2.yaml"),
         Node("rtt_viewer", "tutorial.runner", viewer_args),

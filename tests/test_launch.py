@@ -76,3 +76,20 @@ def test_a_failing_node_fails_the_launch_and_stops_the_others():
     assert "[launch] failed: broken (exit 2)" in text
     assert all(p.poll() is not None for p in launch.procs.values())
     assert "cannot read the project file" in text
+
+
+def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
+    """``--record FILE.mcap`` adds ``rtt-bag record`` (node ``rtt_bag``); the launch's stop closes the file whole."""
+    from tutorial.bag.info import bag_info
+
+    bag = tmp_path / "launch.mcap"
+    launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo", "--headless",
+                    "--duration", "5", "--record", str(bag)])
+    assert launch.wait(60) == 0, launch.out
+    assert "[launch] all nodes stopped cleanly" in launch.out
+    assert "Traceback" not in launch.out + launch.err
+    assert "[rtt_bag] [/rtt_bag] recording /joy /Tank/joint_state to" in launch.out
+    info = bag_info(bag)  # raises unless the file is a whole MCAP file
+    assert [(t.topic, t.type) for t in info.topics] == [("/Tank/joint_state", "sensor_msgs/msg/JointState"),
+                                                         ("/joy", "sensor_msgs/msg/Joy")]
+    assert all(t.count > 0 for t in info.topics), launch.out

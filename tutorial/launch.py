@@ -178,6 +178,8 @@ def launch_parser(description: str) -> argparse.ArgumentParser:
     p.add_argument("--headless", action="store_true", help="no meshcat pages")
     p.add_argument("--duration", type=float, default=None, metavar="SECONDS",
                    help="stop after this many seconds of simulated time")
+    p.add_argument("--record", default=None, metavar="FILE.mcap",
+                   help="also record the step's topics to FILE.mcap (rtt-bag record, node rtt_bag)")
     return p
 
 

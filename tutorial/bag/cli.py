@@ -1,0 +1,197 @@
+"""``rtt-bag``: record, list and replay MCAP bags (``ros2 bag``'s stand-in; no rosbag2 wheel exists).
+
+    rtt-bag record /joy /Tank/joint_state -o drive.mcap    # until Ctrl-C or SIGTERM
+    rtt-bag record --all -o all.mcap --duration 10
+    rtt-bag info drive.mcap
+    rtt-bag play drive.mcap --rate 2 --topics /Tank/joint_state --start-offset 1.5
+    rtt-bag play drive.mcap --loop
+
+The files are what ``ros2 bag record -s mcap`` writes, so ``ros2 bag
+info``/``play`` (with the mcap storage plugin) and Foxglove open them.
+``record`` runs as node ``rtt_bag``, ``play`` as ``rtt_bag_play``; rename
+with ``--ros-args -r __node:=NAME``.  Ctrl-C or SIGTERM ends a recording
+cleanly: the file is closed with its indexes and summary.
+
+Exit status: 0 done (also when stopped by Ctrl-C/SIGTERM); 1 a failure
+while running (a write failed); 2 a bad command line, an output file that
+exists, or a bag that cannot be read or played (not MCAP, truncated,
+corrupt, a message type not installed): one line on stderr says which.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import functools
+import json
+import signal
+import sys
+import time
+
+from tutorial import ros_env
+
+PROG = "rtt-bag"
+_say = functools.partial(print, flush=True)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line of ``rtt-bag`` (ROS arguments are removed before it parses)."""
+    p = argparse.ArgumentParser(prog=PROG, description="Record, list and replay ROS 2 bags in MCAP files.",
+                                epilog="ROS arguments go after --ros-args, e.g. --ros-args -r __node:=my_bag")
+    sub = p.add_subparsers(dest="command", required=True, metavar="{record,info,play}")
+
+    r = sub.add_parser("record", help="record topics to an MCAP file until Ctrl-C, SIGTERM or --duration")
+    r.add_argument("topics", nargs="*", metavar="TOPIC", help="topics to record, e.g. /joy /Tank/joint_state")
+    r.add_argument("-a", "--all", action="store_true", help="record every topic with a publisher (hidden ones aside)")
+    r.add_argument("-o", "--output", metavar="FILE.mcap",
+                   help="the file to write (default rtt_bag_<date>-<time>.mcap); it must not exist")
+    r.add_argument("--duration", type=float, default=None, metavar="SECONDS",
+                   help="stop after this long (wall time from the start)")
+    r.add_argument("--compression", choices=["zstd", "lz4", "none"], default="zstd",
+                   help="chunk compression (default zstd)")
+    r.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
+
+    i = sub.add_parser("info", help="per topic: type, message count, time span, rate, QoS")
+    i.add_argument("file", metavar="FILE.mcap")
+    i.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+
+    y = sub.add_parser("play", help="republish a bag's messages with the recorded timing")
+    y.add_argument("file", metavar="FILE.mcap")
+    y.add_argument("-r", "--rate", type=float, default=1.0, help="speed factor (default 1.0)")
+    y.add_argument("-l", "--loop", action="store_true", help="play again from the start offset, until stopped")
+    y.add_argument("--topics", nargs="+", metavar="TOPIC", help="play only these topics")
+    y.add_argument("--start-offset", type=float, default=0.0, metavar="SECONDS",
+                   help="skip this many seconds from the bag's start")
+    y.add_argument("--delay", type=float, default=0.0, metavar="SECONDS",
+                   help="wait this long before playing (each loop), e.g. for discovery")
+    return p
+
+
+class _StopRequest:
+    """Set by the SIGINT/SIGTERM handler, read by the main loop.
+
+    A plain attribute, not a ``threading.Event``: a signal handler runs on
+    the main thread between two bytecodes, possibly inside ``Event.wait``
+    holding the event's lock, and ``Event.set`` would take it again.
+    """
+
+    def __init__(self, on_stop=None):
+        self.requested = False
+        self._on_stop = on_stop
+
+    def __call__(self, signum, frame) -> None:
+        self.requested = True
+        if self._on_stop is not None:
+            self._on_stop()
+
+    def install(self) -> "_StopRequest":
+        signal.signal(signal.SIGINT, self)
+        signal.signal(signal.SIGTERM, self)
+        return self
+
+
+def _fail(text: str, status: int = 2) -> int:
+    print(f"{PROG}: {text}", file=sys.stderr, flush=True)
+    return status
+
+
+def _init_ros(argv: list[str]) -> None:
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    ros_env.use_localhost_by_default()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+
+
+def record(args, argv: list[str]) -> int:
+    """``rtt-bag record``: main thread; the recorder's callbacks run on its spin thread."""
+    import rclpy
+
+    from tutorial.bag.record import BagRecorder
+    from tutorial.bag.writer import BagWriteError
+
+    if not args.topics and not args.all:
+        return _fail("record: name the topics to record, or pass --all")
+    if args.duration is not None and not args.duration > 0:
+        return _fail("record: --duration must be > 0")
+    path = args.output or datetime.datetime.now().strftime("rtt_bag_%Y_%m_%d-%H_%M_%S.mcap")
+    try:  # the file first: a name that exists fails before ROS starts
+        recorder = BagRecorder(path, args.topics, all_topics=args.all, compression=args.compression,
+                               overwrite=args.overwrite, output=_say)
+    except (BagWriteError, ValueError) as exc:
+        return _fail(f"record: {exc}")
+    stop = _StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
+    status = 0
+    deadline = None if args.duration is None else time.monotonic() + args.duration
+    try:
+        _init_ros(argv)
+        recorder.start()
+        while not stop.requested and (deadline is None or time.monotonic() < deadline):
+            if recorder.error is not None:
+                status = _fail(f"record: stopped: {recorder.error!r}", 1)
+                break
+            time.sleep(0.05)  # the stop flag and the deadline are seen within 50 ms
+    finally:
+        ros_env.ignore_stop_signals()  # a second Ctrl-C must not cut the file's closing short
+        try:
+            recorder.close()
+        finally:
+            rclpy.try_shutdown()
+    return status
+
+
+def info(args) -> int:
+    """``rtt-bag info``: no ROS needed."""
+    from tutorial.bag.info import bag_info, format_info
+    from tutorial.bag.reader import BagError
+
+    try:
+        summary = bag_info(args.file)
+    except BagError as exc:
+        return _fail(f"info: {exc}")
+    _say(json.dumps(summary.as_dict()) if args.json else format_info(summary))
+    return 0
+
+
+def play(args, argv: list[str]) -> int:
+    """``rtt-bag play``: publishes from the main thread."""
+    import rclpy
+
+    from tutorial.bag.play import BagPlayer
+    from tutorial.bag.reader import BagError
+
+    try:
+        player = BagPlayer(args.file, rate=args.rate, loop=args.loop, topics=args.topics,
+                           start_offset=args.start_offset, delay=args.delay, output=_say)
+    except (BagError, ValueError) as exc:
+        return _fail(f"play: {exc}")
+    _StopRequest(player.request_stop).install()
+    _init_ros(argv)
+    try:
+        player.play()
+    except BagError as exc:  # the file changed or broke while playing
+        return _fail(f"play: {exc}")
+    finally:
+        ros_env.ignore_stop_signals()
+        try:
+            player.close()
+        finally:
+            rclpy.try_shutdown()
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``rtt-bag``: parse the command line and run the subcommand; the exit status (main thread)."""
+    from rclpy.utilities import remove_ros_args
+
+    argv = list(sys.argv if argv is None else argv)
+    args = build_parser().parse_args(remove_ros_args(argv)[1:])
+    if args.command == "record":
+        return record(args, argv)
+    if args.command == "play":
+        return play(args, argv)
+    return info(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
