@@ -1,4 +1,7 @@
-"""Reading a received sensor_msgs/Image: every field is checked; a bad message is counted, never drawn."""
+"""Reading a received sensor_msgs/Image: every field is checked; a bad message is counted, never drawn.
+
+Also the notebooks' live picture (:class:`tutorial.notebook.images.LiveImage`).
+"""
 
 from array import array
 
@@ -6,6 +9,7 @@ import numpy as np
 import pytest
 from sensor_msgs.msg import Image
 
+from conftest import wait_until
 from tutorial.image_node import ImageReceiver, PngWriter, format_status
 from tutorial.images import ImageError, image_to_array, png_bytes
 
@@ -165,3 +169,55 @@ def test_the_window_shows_the_newest_picture_and_its_stamp():
         assert viewer.shown == 7
     finally:
         plt.close("all")
+
+
+def test_the_notebook_live_image_redraws_in_place_and_keeps_the_last_picture_when_closed(node, monkeypatch):
+    """LiveImage (notebook 06): subscribes best effort, redraws when a picture arrives, says stopped on reset()."""
+    import IPython.display
+
+    from tutorial.controllers.camera_image_publisher import camera_image_qos
+    from tutorial.notebook import session
+    from tutorial.notebook.images import LiveImage
+
+    class Handle:  # what display(..., display_id=True) returns in a kernel
+        def __init__(self):
+            self.updates = 0
+
+        def update(self, obj):
+            self.updates += 1
+
+    handle = Handle()
+    monkeypatch.setattr(IPython.display, "display", lambda obj, display_id=False: handle)
+    topic = "/test_live_image/image"
+    live = LiveImage(topic, node_name="test_live_image")
+    drawn: list[str] = []  # the state of each picture drawn into the output
+    render = live.render
+    monkeypatch.setattr(live, "render", lambda state="live": (drawn.append(state), render(state))[1])
+    try:
+        assert live in session._active  # reset() will close it
+        live.show()
+        assert live.newest() is None
+        assert live.figure().axes[0].get_title() == f"{topic} (live)"
+        publisher = node.create_publisher(Image, topic, camera_image_qos())
+        msg = make_image(picture(24, 32))
+        msg.header.stamp.sec, msg.header.stamp.nanosec = 2, 500_000_000
+        msg.header.frame_id = "Kinect"
+
+        def arrived():
+            publisher.publish(msg)  # best effort: sent again until one arrives
+            return live.received() >= 1
+
+        assert wait_until(arrived, timeout=20, poll=0.1)
+        np.testing.assert_array_equal(live.newest().pixels, picture(24, 32))
+        assert live.figure().axes[0].get_title() == f"{topic}  t = 2.50 s\n(live)"
+        assert wait_until(lambda: handle.updates >= 1, timeout=5)  # the refresh thread redrew it
+        node.destroy_publisher(publisher)
+    finally:
+        session.reset()
+    assert live.closed and live not in session._active
+    assert not live._thread.is_alive()
+    updates = handle.updates
+    assert updates >= 2 and drawn[-1] == "stopped: the last picture received", drawn
+    assert drawn.count("live") == updates  # shown once, then redrawn only for a new picture
+    live.close()  # a second close does nothing
+    assert handle.updates == updates

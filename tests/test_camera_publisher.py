@@ -22,7 +22,7 @@ from conftest import PROJECT, ROOT, module_command, wait_until
 from tutorial.body import Body
 from tutorial.controller import ControllerConfig, ControllerIO
 from tutorial.controllers.camera_image_publisher import (RttCameraImagePublisher, body_cameras,
-                                                          camera_image_topic)
+                                                          camera_image_topic, fill_image)
 from tutorial.controllers.joint_state_publisher import PeriodAccumulator
 from tutorial.images import image_to_array
 from tutorial.project import load_project
@@ -213,6 +213,19 @@ def test_control_never_waits_for_the_renderer_and_the_newest_snapshot_wins(node,
     assert stamps == [0.0, pytest.approx(due[-1]), pytest.approx(1.0)]
     summary = controller.summary()
     assert (summary["handed_over"], summary["skipped"], summary["rendered"], summary["published"]) == (31, 28, 3, 3)
+
+
+def test_fill_image_stamps_whole_nanoseconds_and_describes_the_rows():
+    from sensor_msgs.msg import Image
+
+    msg = Image()
+    msg.header.frame_id = "Kinect"
+    pixels = np.arange(2 * 3 * 3, dtype=np.uint8).reshape(2, 3, 3)
+    fill_image(msg, pixels, 7.9999999999)  # Step 2's stamp_parts: never 1_000_000_000 ns
+    assert (msg.header.stamp.sec, msg.header.stamp.nanosec) == (8, 0)
+    assert (msg.height, msg.width, msg.encoding, msg.step, msg.is_bigendian) == (2, 3, "rgb8", 9, 0)
+    assert msg.header.frame_id == "Kinect"  # left as it was
+    np.testing.assert_array_equal(image_to_array(msg), pixels)
 
 
 def test_configure_refuses_a_bad_rate_and_a_body_without_camera(node):
