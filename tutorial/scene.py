@@ -177,9 +177,16 @@ class Scene:
             self._pipe.close()
 
     def set_camera(self, position, target=(0.0, 0.0, 0.0)) -> None:
-        """Place meshcat's default camera at ``position`` (m, world frame, Z up) looking at ``target``."""
+        """Place meshcat's default camera at ``position`` (m, world frame, Z up) looking at ``target``.
+
+        meshcat's camera always looks at the origin of the page's world, and
+        turns about it when dragged.  So the drawing is shifted instead: the
+        visualizer's root (everything drawn through it, the scene and any
+        overlays) moves by ``-target``, which puts ``target`` at the origin.
+        """
         x, y, z = (float(p) - float(t) for p, t in zip(position, target))
-        self.vis["/Cameras/default"].set_transform(_pose(target, np.eye(3)))
+        self.vis.set_transform(_pose(-np.asarray(target, dtype=float), np.eye(3)))
+        self.vis["/Cameras/default"].set_transform(np.eye(4))
         # meshcat's camera frame is Y-up: world (x, y, z) -> (x, z, -y)
         self.vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
 

@@ -135,7 +135,7 @@ def record_scene(model, qpos, camera=None, root: str = "rtt") -> SceneRecorder:
 
 
 def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, root: str = "rtt",
-                  animate: bool = True) -> SceneRecorder:
+                  animate: bool = True, overlays=None, overlay_frames=None) -> SceneRecorder:
     """A recorder holding ``model`` and a looping animation of ``frames``.
 
     Args:
@@ -145,9 +145,12 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
         camera: optional ``(position, target)`` for the initial view, m.
         root: the meshcat path everything is drawn under.
         animate: False draws the first frame only.
+        overlays: optional :class:`tutorial.overlays.Overlays` whose arrows to draw too,
+            as ``overlay_frames`` says: one :meth:`~tutorial.overlays.Overlays.snapshot`
+            per frame (the arrows of a run are not in ``qpos``).
 
     Raises:
-        ValueError: no frames.
+        ValueError: no frames, or not one overlay snapshot per frame.
     """
     import mujoco
     from meshcat.animation import Animation, AnimationClip
@@ -156,6 +159,8 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
 
     if len(frames) == 0:
         raise ValueError("record_replay: no frames to record")
+    if overlays is not None and len(overlay_frames or ()) != len(frames):
+        raise ValueError(f"record_replay: {len(overlay_frames or ())} overlay snapshots for {len(frames)} frames")
     recorder = SceneRecorder()
     vis = recorder.visualizer()
     data = mujoco.MjData(model)
@@ -165,6 +170,10 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
     scene.build(data)
     if camera is not None:
         scene.set_camera(*camera)
+    if overlays is not None:
+        from tutorial.overlays import draw_arrow_snapshot
+
+        draw_arrow_snapshot(vis, overlays, overlay_frames[0])
     if not animate or len(frames) < 2:
         return recorder
     bodies = scene.moving_bodies
@@ -184,6 +193,10 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
             clip.set_property(int(frame), "position", "vector3", poses[frame, k, :3].tolist())
             clip.set_property(int(frame), "quaternion", "quaternion", poses[frame, k, 3:].tolist())
         animation.clips[vis[scene.body_path(body)].path] = clip
+    if overlays is not None:
+        from tutorial.overlays import add_arrow_clips
+
+        add_arrow_clips(vis, overlays, overlay_frames, animation, fps, decimals=DECIMALS)
     vis.set_animation(animation, play=True, repetitions=np.inf)
     return recorder
 

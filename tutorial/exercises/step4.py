@@ -1,0 +1,278 @@
+"""Checks for the exercises of notebook 04 (Step 4, the IMU publisher).
+
+Exercise 4.1, the peak of each period: a ``RttImuStatePublisher`` subclass
+that also publishes, after each Imu message, the largest horizontal
+acceleration any single step of its period read, as ``std_msgs/Float64`` on
+``/<body>/peak_acceleration``.
+Exercise 4.2, report collisions: a ``RttImuStatePublisher`` subclass that
+also publishes ``geometry_msgs/Vector3Stamped`` on ``/<body>/collision``
+when a period's mean horizontal acceleration is above ``threshold``, at most
+once per ``holdoff`` seconds of simulated time.
+
+Each check runs the tank in its room driven by the demo script "wall" (by
+simulated time, deaf to the network, so always the same run), with a probe
+that keeps every step's accelerometer reading, captures what the learner's
+controller publishes in-process (:mod:`tutorial.exercises.capture`) and
+compares it with what the readings say it should be.  The checks run on
+the calling thread.
+"""
+
+from __future__ import annotations
+
+import math
+
+from tutorial.exercises.capture import CapturingNode
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+
+DURATION = 3.0  # s of simulated time per checked run: the tank hits the wall at about 2.05 s
+TIME_STEP_NS = 1_000_000  # the tank world's 1 ms step
+
+
+class _Probe:
+    """A controller keeping every step's accelerometer reading, by step number (simulation thread)."""
+
+    def __init__(self):
+        from tutorial.controller import SimpleController
+        from tutorial.controllers.imu_state_publisher import find_imu
+
+        class ImuProbe(SimpleController):
+            def initialize(probe, io):
+                probe.io = io
+                probe.accel = find_imu(io.body.model, io.body.body_ids)[0]
+                probe.readings = []  # (3,) m/s^2 per step, what control() reads in that step
+                return True
+
+            def control(probe):
+                probe.readings.append(probe.io.data.sensordata[probe.accel].copy())
+                return True
+
+        self.controller = ImuProbe()
+
+    @property
+    def readings(self) -> list:
+        return self.controller.readings
+
+
+def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: float = DURATION):
+    """Run the tank world with ``cls`` attached as ``name``, driven by ``script``.
+
+    Returns:
+        ``(capturing node, probe)``.
+
+    Raises:
+        NotImplementedError: the learner's code is not written yet.
+        CaseFailed: the simulation failed.
+        tutorial.app.ControllerError: the controller refused to configure (or raised there).
+    """
+    import rclpy
+
+    from tutorial.controllers.tank_controller import RttTankController
+    from tutorial.joy_input import SCRIPTS
+    from tutorial.notebook.runs import load, run_headless
+    from tutorial.scripted_input import ScriptedJoy
+
+    project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
+    node = CapturingNode(rclpy.create_node("exercise_check_imu"))
+    probe = _Probe()
+    tank = RttTankController()
+    summary, _ = run_headless(project, duration, node=node, attach=[
+        ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=SCRIPTS[script])),
+        ("Tank", "RttTankController", tank), ("Tank", "ImuProbe", probe.controller)])
+    if summary.get("error"):
+        if "NotImplementedError" in summary["error"]:
+            raise NotImplementedError
+        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1])
+    return node, probe
+
+
+def _stamp_ns(msg) -> int:
+    return msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+
+
+def _one_publisher(node, topic: str, msg_type, call: str, hint: str):
+    """The one capturing publisher of ``topic``; CaseFailed when there is none, several, or of another type."""
+    pubs = node.published(topic)
+    if len(pubs) != 1:
+        topics = sorted({p.topic for p in node.published()})
+        raise CaseFailed(f"{call} made {len(pubs)} publishers of {topic} (its topics: {topics}), "
+                         "expected 1.", hint)
+    if pubs[0].msg_type is not msg_type:
+        raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__} on {topic}, expected "
+                         f"{msg_type.__module__.split('.')[0]}/{msg_type.__name__}.", hint)
+    return pubs[0]
+
+
+def _imu_messages(node, call: str):
+    from sensor_msgs.msg import Imu
+
+    from tutorial.controllers.imu_state_publisher import imu_topic
+
+    return _one_publisher(node, imu_topic("Tank"), Imu, call,
+                          "keep publishing the Imu: call super().configure(config) and "
+                          "super().publish() (or super().control()).").messages()
+
+
+def _windows(imu_messages) -> list[tuple[int, int]]:
+    """The steps each Imu message averages: ``[first, last]`` step numbers, from the stamps."""
+    windows, previous = [], -1
+    for msg in imu_messages:
+        due = _stamp_ns(msg) // TIME_STEP_NS
+        windows.append((previous + 1, due))
+        previous = due
+    return windows
+
+
+def _horizontal(v) -> float:
+    return math.hypot(float(v[0]), float(v[1]))
+
+
+def check_peak_publisher(cls) -> Result:
+    """Check a ``RttImuStatePublisher`` subclass publishing each period's peak horizontal acceleration.
+
+    Topic ``/<body>/peak_acceleration``, ``std_msgs/Float64``, m/s^2: after
+    each Imu message, the largest ``hypot(x, y)`` of the accelerometer's
+    reading in any single step of the steps that message averages.
+    """
+    from std_msgs.msg import Float64
+
+    runs: dict = {}  # rate -> (Imu messages, peaks, probe): one run serves several cases
+
+    def run(rate: float):
+        if rate not in runs:
+            call = f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s"
+            node, probe = _drive("PeakImuPublisher", cls, {"rate": rate})
+            imu = _imu_messages(node, call)
+            peaks = _one_publisher(node, "/Tank/peak_acceleration", Float64, call,
+                                   "create it in configure: config.node.create_publisher(Float64, "
+                                   "f\"/{config.body_name}/peak_acceleration\", imu_qos()).").messages()
+            if len(peaks) != len(imu):
+                raise CaseFailed(f"{call} published {len(peaks)} peaks and {len(imu)} Imu messages, "
+                                 "expected one peak after each Imu message.",
+                                 "publish the peak in publish(), right after super().publish().")
+            runs[rate] = (imu, [p.data for p in peaks], probe)
+        return runs[rate]
+
+    def compare(label: str, rate: float, chosen, hint: str):
+        call = f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s ({label})"
+
+        def check():
+            imu, peaks, probe = run(rate)
+            readings = probe.readings
+            for k, ((first, last), got) in enumerate(zip(_windows(imu), peaks)):
+                t = _stamp_ns(imu[k]) * 1e-9
+                if not chosen(t):
+                    continue
+                expected = max(_horizontal(readings[s]) for s in range(first, last + 1))
+                if not _same(got, expected):
+                    mean = _horizontal([imu[k].linear_acceleration.x, imu[k].linear_acceleration.y])
+                    raise CaseFailed(
+                        f"{call}: the peak published with the Imu message of t = {t:.2f} s was "
+                        f"{_num(got)} m/s^2, expected {_num(expected)} (the largest of its "
+                        f"{last - first + 1} steps; their mean was {_num(mean)}).",
+                        _diagnose(got, mean, readings, first, last) or hint)
+        return Case(call, check, hint)
+
+    return grade("Exercise 4.1, the peak of each period", [
+        compare("at rest, t <= 0.5 s", 20.0, lambda t: t <= 0.5,
+                "the peak of a period is the largest math.hypot(a[0], a[1]) of its steps' readings."),
+        compare("hitting the wall, t = 2.1 s", 20.0, lambda t: abs(t - 2.1) < 1e-6,
+                "the peak of a period is the largest math.hypot(a[0], a[1]) of its steps' readings."),
+        compare("every period", 20.0, lambda t: True,
+                "each peak covers exactly the steps its Imu message averages."),
+        compare("every period", 10.0, lambda t: True, "the rate parameter still sets the period."),
+    ])
+
+
+def _num(value) -> str:
+    """A number for a message: 6 significant digits (a peak at rest is a few 1e-4 m/s^2)."""
+    return f"{value:.6g}" if isinstance(value, float) else repr(value)
+
+
+def _same(got, expected: float) -> bool:
+    return isinstance(got, float) and math.isfinite(got) and abs(got - expected) <= 1e-9
+
+
+def _diagnose(got, mean: float, readings, first: int, last: int) -> str:
+    """A hint naming the likely mistake, when ``got`` is what a known mistake gives ("" if none)."""
+    def largest(steps, norm=_horizontal):
+        return max((norm(readings[s]) for s in steps), default=0.0)
+
+    if _same(got, mean):
+        return ("that is the horizontal part of the period's mean, what the Imu message carries; "
+                "the peak is the largest single step's reading: look at "
+                "self.data.sensordata[self.accel] in every control().")
+    if _same(got, largest(range(first, last + 1), lambda a: float(sum(v * v for v in a)) ** 0.5)):
+        return "horizontal means x and y only: math.hypot(a[0], a[1]); z carries gravity."
+    if _same(got, largest(range(0, last + 1))) and first > 0:
+        return "start over after publishing each peak: set it back to 0."
+    if _same(got, largest(range(max(first - 1, 0), last))):
+        return ("the step that publishes belongs to the period it ends: add its reading before "
+                "super().control() publishes.")
+    return ""
+
+
+def _reports(n: int) -> str:
+    return f"{n} report{'' if n == 1 else 's'}"
+
+
+def check_collision_reporter(cls) -> Result:
+    """Check a ``RttImuStatePublisher`` subclass reporting collisions on ``/<body>/collision``.
+
+    ``geometry_msgs/Vector3Stamped``: published when an Imu message's mean
+    horizontal acceleration ``hypot(x, y)`` is above ``threshold`` (m/s^2,
+    default 20) and no collision was reported in the ``holdoff`` s (default
+    0.5) of simulated time before; the stamp and frame are the Imu
+    message's, the vector its acceleration's horizontal part ``(x, y, 0)``.
+    """
+    from geometry_msgs.msg import Vector3Stamped
+
+    def reports(parameters: dict):
+        where = ", ".join(f"{k}={v}" for k, v in parameters.items()) or "default parameters"
+        call = f"{cls.__name__} with {where}, the wall script for {DURATION} s"
+
+        def check():
+            node, _ = _drive("CollisionReporter", cls, parameters)
+            imu = _imu_messages(node, call)
+            got = _one_publisher(node, "/Tank/collision", Vector3Stamped, call,
+                                 "create it in configure: config.node.create_publisher("
+                                 "Vector3Stamped, f\"/{config.body_name}/collision\", imu_qos()).").messages()
+            threshold, holdoff = parameters.get("threshold", 20.0), parameters.get("holdoff", 0.5)
+            expected, last = [], None
+            for msg in imu:
+                a, t = msg.linear_acceleration, _stamp_ns(msg)
+                if math.hypot(a.x, a.y) > threshold and (last is None or t - last >= holdoff * 1e9):
+                    expected.append(msg)
+                    last = t
+            if not expected:
+                raise CaseFailed(f"{call}: the Imu messages show no collision at all; the tank "
+                                 "should have hit the wall at about 2.05 s.",
+                                 "keep RttImuStatePublisher's behaviour: call super().publish().")
+            at = [round(_stamp_ns(m) * 1e-9, 3) for m in got]
+            want = [round(_stamp_ns(m) * 1e-9, 3) for m in expected]
+            if len(got) != len(expected):
+                raise CaseFailed(f"{call} made {_reports(len(got))}, stamped t = {at} s; expected "
+                                 f"{_reports(len(expected))}, at t = {want} s.",
+                                 "report when hypot(x, y) of the mean is above threshold, and then not "
+                                 "again until holdoff s of simulated time have passed.")
+            for report, msg, t in zip(got, expected, want):
+                a = msg.linear_acceleration
+                vector = [report.vector.x, report.vector.y, report.vector.z]
+                if _stamp_ns(report) != _stamp_ns(msg):
+                    raise CaseFailed(f"{call}: the report of the Imu message of t = {t} s is stamped "
+                                     f"{_stamp_ns(report) * 1e-9:.3f} s.",
+                                     "copy the Imu message's header (stamp and frame_id).")
+                if report.header.frame_id != msg.header.frame_id:
+                    raise CaseFailed(f"{call}: the report at t = {t} s has frame_id "
+                                     f"{report.header.frame_id!r}, expected {msg.header.frame_id!r}.",
+                                     "the vector is in the IMU's frame: use the Imu message's frame_id.")
+                if max(abs(g - e) for g, e in zip(vector, [a.x, a.y, 0.0])) > 1e-9:
+                    raise CaseFailed(f"{call}: the report at t = {t} s carries {show(vector)}, "
+                                     f"expected {show([a.x, a.y, 0.0])}.",
+                                     "the vector is the mean acceleration's horizontal part: (x, y, 0).")
+        return Case(call, check)
+
+    return grade("Exercise 4.2, report collisions", [
+        reports({}),
+        reports({"threshold": 10.0}),
+        reports({"threshold": 10.0, "holdoff": 0.1}),
+    ])
