@@ -10,6 +10,8 @@ module            what it gives a notebook
 ``panels``        widget panels that say what they are doing, and a stand-in where widgets cannot run
 ``teleop``        ``TeleopPanel``: sliders and a gamepad publishing ``/joy``
 ``plots``         ``LivePlot``: joint positions from ``/<body>/joint_state``
+``images``        ``LiveImage``: the newest picture of a camera topic
+``live``          ``LiveOutput``: what the two share, an image output redrawn in place
 ``graph``         ``graph_picture``: the ROS 2 graph as a picture
 ================  ==============================================================
 

@@ -17,14 +17,11 @@ and ``close`` run on the kernel thread.
 from __future__ import annotations
 
 import io
-import threading
 
-from tutorial.notebook import session
-
-REFRESH = 0.5  # s between redraws
+from tutorial.notebook.live import LiveOutput
 
 
-class LiveImage:
+class LiveImage(LiveOutput):
     """The newest picture of an image topic, live in a notebook output.
 
     Args:
@@ -37,23 +34,23 @@ class LiveImage:
     """
 
     def __init__(self, topic: str = "/Tank/camera/image", node_name: str = "rtt_live_image"):
-        import rclpy
-
-        from tutorial.image_node import ImageReceiver
-        from tutorial.ros_env import SpinThread
-
-        session.init_ros()
         self.topic = topic
-        self.node = rclpy.create_node(node_name)
-        self.receiver = ImageReceiver(self.node, topic)
-        self.spin = SpinThread(self.node).start()
-        self.closed = False
-        self._handle = None
         self._drawn = None  # number of the picture last drawn (refresh thread)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._refresh, name="live-image", daemon=True)
-        self._thread.start()
-        session.register(self)
+        super().__init__(node_name)
+
+    def subscribe(self, node) -> None:
+        from tutorial.image_node import ImageReceiver
+
+        self.receiver = ImageReceiver(node, self.topic)
+
+    def changed(self) -> bool:
+        """A picture arrived since the last redraw (refresh thread): redraw only then."""
+        newest = self.receiver.newest()
+        number = newest.number if newest is not None else None
+        if number == self._drawn:
+            return False
+        self._drawn = number
+        return True
 
     def received(self) -> int:
         """How many pictures have been accepted so far (any thread)."""
@@ -99,33 +96,5 @@ class LiveImage:
         self.figure(state).savefig(buf, format="png", dpi=80)
         return buf.getvalue()
 
-    def show(self) -> None:
-        """Display the picture in this cell's output; it redraws in place (kernel thread)."""
-        from IPython.display import Image, display
-
-        self._handle = display(Image(self.render()), display_id=True)
-
-    def _refresh(self) -> None:
-        from IPython.display import Image
-
-        while not self._stop.wait(REFRESH):
-            newest = self.receiver.newest()
-            number = newest.number if newest is not None else None
-            if self._handle is not None and number != self._drawn:
-                self._drawn = number
-                self._handle.update(Image(self.render()))
-
-    def close(self) -> None:
-        """Stop receiving; the output keeps the last picture, titled as stopped (kernel thread)."""
-        from IPython.display import Image
-
-        if self.closed:
-            return
-        self.closed = True
-        self._stop.set()
-        self._thread.join(2.0)
-        self.spin.stop()
-        self.node.destroy_node()
-        if self._handle is not None:
-            self._handle.update(Image(self.render("stopped: the last picture received")))
-        session.forget(self)
+    def close(self, stopped: str = "stopped: the last picture received") -> None:
+        super().close(stopped)

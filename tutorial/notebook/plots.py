@@ -14,14 +14,11 @@ kernel thread.
 from __future__ import annotations
 
 import io
-import threading
 
-from tutorial.notebook import session
-
-REFRESH = 0.5  # s between redraws
+from tutorial.notebook.live import LiveOutput
 
 
-class LivePlot:
+class LivePlot(LiveOutput):
     """Joint positions from ``/<body>/joint_state`` over simulation time.
 
     Args:
@@ -31,23 +28,14 @@ class LivePlot:
     """
 
     def __init__(self, body: str = "Tank", window: float = 10.0, node_name: str = "rtt_live_plot"):
-        import rclpy
-
-        from tutorial.plot_node import JointStateRecorder
-        from tutorial.ros_env import SpinThread
-
-        session.init_ros()
-        self.node = rclpy.create_node(node_name)
         self.topic = f"/{body}/joint_state"
-        self.recorder = JointStateRecorder(self.node, self.topic)
-        self.spin = SpinThread(self.node).start()
         self.window = window
-        self.closed = False
-        self._handle = None
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._refresh, name="live-plot", daemon=True)
-        self._thread.start()
-        session.register(self)
+        super().__init__(node_name)
+
+    def subscribe(self, node) -> None:
+        from tutorial.plot_node import JointStateRecorder
+
+        self.recorder = JointStateRecorder(node, self.topic)
 
     def received(self) -> int:
         """How many samples of the first joint have arrived (any thread)."""
@@ -73,30 +61,5 @@ class LivePlot:
         fig.savefig(buf, format="png", dpi=80)
         return buf.getvalue()
 
-    def show(self) -> None:
-        """Display the plot in this cell's output; it redraws in place (kernel thread)."""
-        from IPython.display import Image, display
-
-        self._handle = display(Image(self.render()), display_id=True)
-
-    def _refresh(self) -> None:
-        from IPython.display import Image
-
-        while not self._stop.wait(REFRESH):
-            if self._handle is not None:
-                self._handle.update(Image(self.render()))
-
-    def close(self) -> None:
-        """Stop receiving; the output keeps the last plot, titled as stopped (kernel thread)."""
-        from IPython.display import Image
-
-        if self.closed:
-            return
-        self.closed = True
-        self._stop.set()
-        self._thread.join(2.0)
-        self.spin.stop()
-        self.node.destroy_node()
-        if self._handle is not None:
-            self._handle.update(Image(self.render("stopped: the last plot it drew")))
-        session.forget(self)
+    def close(self, stopped: str = "stopped: the last plot it drew") -> None:
+        super().close(stopped)
