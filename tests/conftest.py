@@ -169,9 +169,15 @@ class Proc:
         return records[-1]
 
     def kill(self) -> None:
+        """Stop it at the end of a test: Ctrl-C first, so its node removes its Fast DDS
+        shared-memory files (a SIGKILLed node leaves them in /dev/shm), then SIGKILL after 5 s."""
         if self.p.poll() is None:
-            self.p.kill()
-            self.p.wait()
+            self.p.send_signal(signal.SIGINT)
+            try:
+                self.p.wait(5)
+            except subprocess.TimeoutExpired:
+                self.p.kill()
+                self.p.wait()
 
 
 @pytest.fixture

@@ -7,7 +7,9 @@ on Ctrl-C or SIGTERM every node gets SIGINT, then SIGTERM, then SIGKILL,
 and the whole shutdown ends within :data:`SHUTDOWN_TIMEOUT` s.  A node marked
 ``required`` (ROS 1 launch's ``required="true"``) shuts everything down when
 it exits.  Children also get SIGTERM if the launcher itself dies (Linux's
-parent-death signal), so none is left behind.
+parent-death signal), so none is left behind.  Once every child is gone,
+the files Fast DDS kept in ``/dev/shm`` for them and nobody uses any more
+are removed (:func:`tutorial.shm.remove_unused_fast_dds_shm`): a killed node leaves them.
 
 Exit status: 0 when every node ended cleanly, 1 when any failed (its name
 is printed), 130 is never used: an interrupted launch whose nodes all
@@ -26,12 +28,14 @@ import threading
 import time
 from dataclasses import dataclass, field
 
+from tutorial.shm import SHM_DIR, fast_dds_shm_files, is_segment, remove_unused_fast_dds_shm
+
 SHUTDOWN_TIMEOUT = 5.0  # s, from the stop request to the last child gone
 _SIGINT_GRACE = 3.0  # s before SIGINT escalates to SIGTERM
 _SIGTERM_GRACE = 1.5  # s before SIGTERM escalates to SIGKILL
 PR_SET_PDEATHSIG = 1
 _LIBRARY_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
+_SHM_SAMPLE_PERIOD = 1.0  # s between looks at every /dev/shm file the children map
 
 @dataclass
 class Node:
@@ -87,6 +91,8 @@ class Launch:
         self.stop_requested = False
         self.stopping = False
         self.failed: list[str] = []
+        self.shm_files: set[str] = set()  # Fast DDS files in /dev/shm the children used (main thread)
+        self._next_shm_sample = 0.0
 
     def _pump(self, name: str, stream) -> None:
         for raw in iter(stream.readline, b""):
@@ -130,12 +136,14 @@ class Launch:
                         self.failed.append(name)
             if self.failed or required & finished.keys() or len(finished) == len(self.procs):
                 break
+            self.note_shared_memory(mapped=time.monotonic() >= self._next_shm_sample)
             time.sleep(poll)  # polling the children and the flag: a stop is seen within `poll` s
         return self.shutdown()
 
     def shutdown(self) -> int:
         """SIGINT, then SIGTERM, then SIGKILL; every child is gone within SHUTDOWN_TIMEOUT s."""
         self.stopping = True
+        self.note_shared_memory()
         start = time.monotonic()
         for sig, grace in ((signal.SIGINT, _SIGINT_GRACE), (signal.SIGTERM, _SIGTERM_GRACE), (signal.SIGKILL, None)):
             alive = [p for p in self.procs.values() if p.poll() is None]
@@ -152,6 +160,7 @@ class Launch:
             start = time.monotonic() if grace is not None else start
         for t in self._threads:
             t.join(1.0)
+        self.remove_shared_memory()
         for name, p in self.procs.items():
             code = p.returncode
             if code not in (0, None) and name not in self.failed and code != -signal.SIGINT:
@@ -162,6 +171,30 @@ class Launch:
             return 1
         self._say("all nodes stopped cleanly")
         return 0
+
+    def note_shared_memory(self, mapped: bool = True) -> None:
+        """Add the Fast DDS files in /dev/shm the children use now to :attr:`shm_files` (main thread).
+
+        The wait loop looks at the files they hold open (their own) at every
+        poll, and at all they map once every :data:`_SHM_SAMPLE_PERIOD` s.
+        """
+        if mapped:
+            self._next_shm_sample = time.monotonic() + _SHM_SAMPLE_PERIOD
+        for p in self.procs.values():
+            if p.poll() is None:  # a reaped child's pid may be another process's by now
+                self.shm_files |= fast_dds_shm_files(p.pid, mapped)
+
+    def remove_shared_memory(self) -> None:
+        """Once every child is gone: remove the files they used that nobody uses any more (main thread).
+
+        A node killed by a signal left its participant's files; the line says so.
+        """
+        removed = remove_unused_fast_dds_shm(self.shm_files)
+        killed = sorted(name for name, p in self.procs.items()
+                        if p.returncode is not None and p.returncode < 0 and p.returncode != -signal.SIGINT)
+        if killed and any(is_segment(name) for name in removed):
+            self._say(f"removed {len(removed)} Fast DDS shared-memory files the nodes left in {SHM_DIR} "
+                      f"({', '.join(killed)} killed)")
 
 
 def _exit_status(code: int | None) -> str:
