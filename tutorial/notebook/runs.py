@@ -202,7 +202,7 @@ class BackgroundApp:
             app.open()
             self._opened.set()
             if self.view is not None:
-                self.view.begin(app.model, getattr(app, "camera", None))
+                self.view.begin(app.model, app.camera, app.overlays)
             self._set_status("running")
             while not self._stop.is_set() and app.step():
                 if self.view is not None:

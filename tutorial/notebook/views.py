@@ -9,6 +9,13 @@ live page is replaced, in the same output, by a recording of the run's
 last seconds, marked as a recording: a view never points at a server that
 is gone, and a saved notebook (and the book) shows what happened.
 
+A kernel that is restarted or shut down cannot replace its outputs any
+more, and its meshcat servers stop with it.  So a live output watches its
+servers from the browser (:func:`live_html`): once one stops answering, a
+notice over the page says it is not live any more (the page keeps its last
+frame; one that never loaded is hidden, never the browser's error page),
+and the caption says so too.
+
 :func:`show` puts one or more views side by side in one output.
 
 Threads: :func:`show` and :meth:`LiveView.close` run on the kernel
@@ -22,8 +29,10 @@ a lock guards them.
 from __future__ import annotations
 
 import html
+import json
 import threading
 import time
+import uuid
 from collections import deque
 
 from tutorial.notebook import replay, session
@@ -53,10 +62,11 @@ class LiveView:
         self.status = "not started yet"
         self.closed = False
         self._displays: list[_Display] = []
-        self._lock = threading.Lock()  # guards the three below: the owner thread writes, close() reads
+        self._lock = threading.Lock()  # guards the four below: the owner thread writes, close() reads
         self._model = None
         self._camera = None
-        self._frames: deque = deque(maxlen=int(self.FPS * self.SECONDS))
+        self._overlays = None
+        self._frames: deque = deque(maxlen=int(self.FPS * self.SECONDS))  # (qpos, arrows or None)
         self._next_frame = 0.0
 
     # ---- the run's owner thread ---------------------------------------------------
@@ -64,26 +74,29 @@ class LiveView:
         """A ``meshcat.Visualizer`` on this view's server, owned by the calling thread (one per run)."""
         return self.server.visualizer()
 
-    def begin(self, model, camera=None) -> None:
+    def begin(self, model, camera=None, overlays=None) -> None:
         """A run starts drawing ``model``: its recording starts afresh (owner thread).
 
         Args:
             model: the run's ``MjModel``.
             camera: ``(position, target)`` the run placed its camera at, m, for the recording.
+            overlays: the run's :class:`tutorial.overlays.Overlays` (arrows its controllers
+                draw), recorded with each frame; None when it has none.
         """
         with self._lock:
-            self._model, self._camera = model, camera
+            self._model, self._camera, self._overlays = model, camera, overlays
             self._frames.clear()
             self._next_frame = 0.0
 
     def record(self, data) -> None:
-        """Keep ``data.qpos`` as a frame of the recording, at most ``FPS`` times a second (owner thread)."""
+        """Keep ``data.qpos`` (and the arrows) as a frame, at most ``FPS`` times a second (owner thread)."""
         now = time.monotonic()
         if now < self._next_frame:
             return
         self._next_frame = now + 1.0 / self.FPS
+        arrows = self._overlays.snapshot() if self._overlays is not None and self._overlays.arrows else None
         with self._lock:
-            self._frames.append(data.qpos.copy())
+            self._frames.append((data.qpos.copy(), arrows))
 
     # ---- any thread -------------------------------------------------------------------
     def set_status(self, status: str) -> None:
@@ -96,10 +109,14 @@ class LiveView:
     def recording(self):
         """A :class:`tutorial.notebook.replay.SceneRecorder` of the last run, or None if nothing was drawn."""
         with self._lock:
-            model, camera, frames = self._model, self._camera, list(self._frames)
+            model, camera, overlays, frames = self._model, self._camera, self._overlays, list(self._frames)
         if model is None or not frames:
             return None
-        return replay.record_replay(model, frames, self.FPS, camera=camera)
+        qpos = [q for q, _ in frames]
+        arrows = [a for _, a in frames]
+        if any(a is None for a in arrows):  # no arrows, or some frames before the first was drawn
+            return replay.record_replay(model, qpos, self.FPS, camera=camera)
+        return replay.record_replay(model, qpos, self.FPS, camera=camera, overlays=overlays, overlay_frames=arrows)
 
     def recorded_seconds(self) -> float:
         with self._lock:
@@ -115,6 +132,58 @@ class LiveView:
         self.server.close()
 
 
+# Runs in the browser, in a live output: every 2 s it asks each page's server for its page (HEAD);
+# when one does not answer, its kernel has gone (restarted or shut down: nothing in the kernel can
+# say so any more), and the output says it.  It stops once its output is replaced (by a recording).
+_WATCH = """<script>
+(() => {
+  const urls = %(urls)s, notice = %(notice)s, caption = %(caption)s;
+  let box = null, tries = 0, answered = false;
+  const gone = () => {
+    const note = document.createElement("div");
+    note.textContent = notice + (answered ? " What you see is its last frame." : "");
+    note.style.cssText = "position: absolute; left: 0; right: 0; top: 0; padding: 4px 8px; "
+      + "background: rgba(255, 236, 179, 0.95); color: #5d4037; font: 13px sans-serif";
+    if (!answered) box.querySelectorAll("iframe").forEach((f) => { f.style.visibility = "hidden"; });
+    box.appendChild(note);
+    const under = document.getElementById(%(caption_id)s);
+    if (under) under.innerHTML = caption;
+  };
+  const check = () => {
+    box = box || document.getElementById(%(box_id)s);
+    if (!box) { if (++tries < 100) setTimeout(check, 200); return; }  // not on the page yet
+    if (!box.isConnected) return;  // replaced by its recording: nothing left to watch
+    Promise.all(urls.map((u) => fetch(u, {method: "HEAD", mode: "no-cors", cache: "no-store"})))
+      .then(() => { answered = true; setTimeout(check, 2000); }, gone);
+  };
+  check();
+})();
+</script>"""
+
+
+def live_html(urls: list[str], frames: str, caption_id: str, what: str) -> str:
+    """``frames`` (the live pages of ``urls``) in a box that says so when their servers have gone.
+
+    Args:
+        urls: the meshcat pages the frames show.
+        frames: their ``<iframe>`` elements.
+        caption_id: the ``id`` of the caption under them, rewritten then.
+        what: what the frames show, for the notice (e.g. ``"simulation /rtt"``).
+    """
+    box_id = f"rtt-live-{uuid.uuid4().hex}"
+    notice = (f"Not live any more: the kernel that ran {what} was restarted or shut down, so nothing runs "
+              "here now. Run the section again for a live view.")
+    caption = (f'<div style="font-size: 90%"><b>{html.escape(what)}</b> (not live): its kernel has gone, '
+               "so nothing runs; run the section again for a live view.</div>")
+
+    def js(value) -> str:  # a JavaScript literal that cannot end the script early
+        return json.dumps(value).replace("</", "<\\/")
+
+    script = _WATCH % {"urls": js(urls), "notice": js(notice), "caption": js(caption),
+                       "box_id": js(box_id), "caption_id": js(caption_id)}
+    return f'<div id="{box_id}" style="position: relative">{frames}</div>{script}'
+
+
 class _Display:
     """One output showing one or more views side by side, with a caption under them."""
 
@@ -123,9 +192,12 @@ class _Display:
 
         self.views = views
         self.height = height
+        self.caption_id = f"rtt-caption-{uuid.uuid4().hex}"
         frames = "".join(f'<iframe src="{v.url}" style="flex: 1; min-width: 0; height: {height}px; border: none">'
                          "</iframe>" for v in views)
-        self.page = display(HTML(f'<div style="display: flex; gap: 4px">{frames}</div>'), display_id=True)
+        page = live_html([v.url for v in views], f'<div style="display: flex; gap: 4px">{frames}</div>',
+                         self.caption_id, " and ".join(v.label for v in views))
+        self.page = display(HTML(page), display_id=True)
         self.caption = display(HTML(self._caption()), display_id=True)
         for v in views:
             v._displays.append(self)
@@ -135,7 +207,7 @@ class _Display:
         for v in self.views:
             state = "recording" if v.closed else "live"
             parts.append(f"<b>{html.escape(v.label)}</b> ({state}): {html.escape(v.status)}")
-        return '<div style="font-size: 90%">' + " &nbsp;|&nbsp; ".join(parts) + "</div>"
+        return f'<div id="{self.caption_id}" style="font-size: 90%">' + " &nbsp;|&nbsp; ".join(parts) + "</div>"
 
     def refresh_caption(self) -> None:
         from IPython.display import HTML
@@ -203,10 +275,11 @@ class MeshcatPage:
         """Display the live page, with a caption, in this cell's output."""
         from IPython.display import HTML, display
 
-        self._handle = display(HTML(f'<div><iframe src="{self.url}" style="width: 100%; height: {self.height}px; '
-                                    'border: none"></iframe></div>'), display_id=True)
-        self._caption = display(HTML(f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> (live)</div>'),
-                                display_id=True)
+        caption_id = f"rtt-caption-{uuid.uuid4().hex}"
+        frame = f'<iframe src="{self.url}" style="width: 100%; height: {self.height}px; border: none"></iframe>'
+        self._handle = display(HTML(live_html([self.url], frame, caption_id, self.label)), display_id=True)
+        self._caption = display(HTML(f'<div id="{caption_id}" style="font-size: 90%"><b>{html.escape(self.label)}</b> '
+                                     "(live)</div>"), display_id=True)
 
     def close(self) -> None:
         """Leave a still copy of the scene in the output, then stop the server (kernel thread)."""
