@@ -1,9 +1,11 @@
 """Measuring points the benchmarks attach to the tutorial's own programs.
 
-Both probes write what they saw as JSON to the file named by the
-``RTT_PROBE_FILE`` environment variable when their program ends.  Times are
-``time.monotonic_ns()``, one clock for every process on the machine, so
-times taken in two processes can be subtracted.
+Both probes write what they saw as JSON when their program ends: the step
+clock to the file named by the ``RTT_PROBE_FILE`` environment variable, each
+viewer probe to that name with its body's name before the suffix
+(``view.json`` -> ``view.Tank1.json``), so one viewer can mirror several
+bodies.  Times are ``time.monotonic_ns()``, one clock for every process on
+the machine, so times taken in two processes can be subtracted.
 """
 
 from __future__ import annotations
@@ -16,9 +18,12 @@ from tutorial.controller import SimpleController
 from tutorial.controllers.joint_state_subscriber import RttJointStateMonitor
 
 
-def _write(record: dict) -> None:
+def _write(record: dict, body_name: str | None = None) -> None:
     path = os.environ.get("RTT_PROBE_FILE")
     if path:
+        if body_name is not None:
+            stem, dot, suffix = path.rpartition(".")
+            path = f"{stem}.{body_name}.{suffix}" if dot else f"{path}.{body_name}"
         with open(path, "w") as f:
             json.dump(record, f)
 
@@ -26,8 +31,9 @@ def _write(record: dict) -> None:
 class StepClock(SimpleController):
     """Simulation side: the wall-clock time at which each step started, by its simulation time.
 
-    Attach it before the publisher: it runs first in each step, so its time is
-    the moment that step's state (the publisher's stamp) was taken.
+    Attach it before the publishers (one is enough for a world of several
+    bodies): it runs first in each step, so its time is the moment that
+    step's states (the publishers' stamp) were taken.
     """
 
     def initialize(self, io) -> bool:
@@ -70,4 +76,4 @@ class ProbedJointStateSubscriber(RttJointStateMonitor):
         loop = self.config.call_later.__self__  # the MainLoop: its counters show whether a backlog grew
         _write({"applied": self.applied_log, "frames": self.frame_log,
                 "posted": loop.posted, "coalesced": loop.coalesced, "executed": loop.executed,
-                "max_pending": loop.max_pending})
+                "max_pending": loop.max_pending}, self.config.body_name)

@@ -1,5 +1,7 @@
 """The Step 3 viewer as ``rtt-run`` runs it, with its scene updates timed (benchmark use).
 
+Every body's probe (``benchmarks.probes.ProbedJointStateSubscriber``) hears of each frame.
+
     python -m benchmarks.viewer_proc PROJECT --duration S [--headless]
 """
 
@@ -30,19 +32,24 @@ def main() -> int:
               output=lambda record: print(record, flush=True) if record.get("event") != "status" else None)
     try:
         app.open()
-        probe = next(c for _, c, _ in app.controllers if hasattr(c, "frame_drawn"))
+        probes = [c for _, c, _ in app.controllers if hasattr(c, "frame_drawn")]
+
+        def drawn(seconds: float) -> None:
+            for probe in probes:  # every body's probe notes which of its states this frame shows
+                probe.frame_drawn(seconds)
+
         if app.scene is not None:
             update = app.scene.update
 
             def timed_update(data):
                 t0 = time.perf_counter()
                 sent = update(data)
-                probe.frame_drawn(time.perf_counter() - t0)
+                drawn(time.perf_counter() - t0)
                 return sent
 
             app.scene.update = timed_update
         else:
-            app.loop.call_every(1 / 60, lambda: probe.frame_drawn(0.0))
+            app.loop.call_every(1 / 60, lambda: drawn(0.0))
         app.run()
     finally:
         app.close()
