@@ -22,8 +22,8 @@ def _write(record: dict, body_name: str | None = None) -> None:
     path = os.environ.get("RTT_PROBE_FILE")
     if path:
         if body_name is not None:
-            stem, dot, suffix = path.rpartition(".")
-            path = f"{stem}.{body_name}.{suffix}" if dot else f"{path}.{body_name}"
+            stem, suffix = os.path.splitext(path)  # view.json -> view.Tank1.json
+            path = f"{stem}.{body_name}{suffix}"
         with open(path, "w") as f:
             json.dump(record, f)
 

@@ -47,12 +47,14 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.arm_model import JOINT_COUNTS
+
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results"
 BOOK_STATIC = ROOT / "book" / "_static"
 FRAME_60HZ_MS = 1000.0 / 60.0
 SCALE_TANKS = (1, 2, 4, 8)
-SCALE_JOINTS = (6, 12, 24, 48)
+SCALE_JOINTS = JOINT_COUNTS  # model/arm<N>.xml
 MIN_RUN_S = 0.05  # s: the shortest bare run of a simulation-speed pair
 SCALE_RATE = 50.0  # Hz: the Step 2 publisher's default, every body of the scale runs
 # Where the tanks of an N-tank world start (x, y in m): in two rows across the 6 m room,
@@ -321,19 +323,25 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
         if headless_view:
             view_cmd.append("--headless")
         procs = {}
-        procs["viewer"] = start(view_cmd + ["--duration", str(seconds + 8.0)], view_probe, env)
-        time.sleep(1.0)  # not synchronisation: the viewer starts first so it misses nothing
-        sim_cmd = py("tutorial.runner", str(sim_project), "--headless", "--duration", str(seconds), "--json",
-                     "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}")
-        procs["simulation"] = start(sim_cmd, sim_probe, env)
-        if joystick:
-            procs["joystick"] = start(py("tutorial.joy_node", "--demo", "--duration", str(seconds + 6.0)))
-        cpu = steady_cpu_cores(procs, seconds, warmup)
-        summary = _summary(finish(procs["simulation"], seconds + 30))
-        finish(procs["viewer"], seconds + 30)
-        if joystick:
-            procs["joystick"].send_signal(signal.SIGINT)
-            finish(procs["joystick"], 20)
+        try:
+            procs["viewer"] = start(view_cmd + ["--duration", str(seconds + 8.0)], view_probe, env)
+            time.sleep(1.0)  # not synchronisation: the viewer starts first so it misses nothing
+            sim_cmd = py("tutorial.runner", str(sim_project), "--headless", "--duration", str(seconds),
+                         "--json", "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}")
+            procs["simulation"] = start(sim_cmd, sim_probe, env)
+            if joystick:
+                procs["joystick"] = start(py("tutorial.joy_node", "--demo", "--duration", str(seconds + 6.0)))
+            cpu = steady_cpu_cores(procs, seconds, warmup)
+            summary = _summary(finish(procs["simulation"], seconds + 30))
+            finish(procs["viewer"], seconds + 30)
+            if joystick:
+                procs["joystick"].send_signal(signal.SIGINT)
+                finish(procs["joystick"], 20)
+        finally:  # a failed run leaves no process behind
+            for proc in procs.values():
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.wait(10)
         s = json.loads(sim_probe.read_text())
         views = [json.loads(f.read_text()) for f in sorted(Path(d).glob("view.*.json"))]
     if not views:
@@ -576,7 +584,8 @@ def targets(r: dict) -> list[dict]:
         rtf = eight["real_time_factor"]
         out += [
             {"target": "8 tanks simulate in real time (real-time factor >= 0.99, the lowest run)",
-             "measured": f"{rtf:.3f}", "baseline": "1.000 (wall clock)", "ratio": f"{rtf:.3f}x",
+             "measured": "n/a" if rtf is None else f"{rtf:.3f}", "baseline": "1.000 (wall clock)",
+             "ratio": "" if rtf is None else f"{rtf:.3f}x",
              "pass": rtf is not None and rtf >= 0.99},
             {"target": "the viewer mirrors all 8 at >= 50 frames/s", "measured": f"{eight['frames_per_s']:.1f} frames/s",
              "baseline": "60 frames/s (its cap)", "ratio": f"{eight['frames_per_s'] / 60.0:.2f}x",
@@ -696,7 +705,7 @@ def print_report(r: dict) -> None:
 
 # ---------------------------------------------------------------- plots
 def plot_scale(r: dict, path: Path) -> Path:
-    """The scale curves, one row per kind of growth (tanks, joints), as a PNG."""
+    """The scale curves, one column per kind of growth (tanks, joints), a row per figure, as a PNG."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -704,12 +713,12 @@ def plot_scale(r: dict, path: Path) -> Path:
 
     scale = r["scale"]
     bare50 = r["bare"]["tank_50Hz"]["latency_ms"]["p99"]
-    fig, axes = plt.subplots(2, 5, figsize=(17, 6.6), constrained_layout=True)
-    rows = (("tanks", "tanks in one world (each: Step 1 controller, Step 2 publisher)", SCALE_TANKS),
-            ("joints", "joints of one arm", SCALE_JOINTS))
-    for row, (kind, xlabel, sizes) in enumerate(rows):
+    fig, axes = plt.subplots(5, 2, figsize=(10, 15), constrained_layout=True)  # legible at book width
+    columns = (("tanks", "tanks in one world (each: Step 1 controller, Step 2 publisher)", SCALE_TANKS),
+               ("joints", "joints of one arm", SCALE_JOINTS))
+    for col, (kind, xlabel, sizes) in enumerate(columns):
         data = [scale[kind][str(n)] for n in sizes]
-        ax = axes[row, 0]
+        ax = axes[0, col]
         ax.plot(sizes, [d["simulation_speed"]["publisher_50Hz_ratio"] for d in data], "o-",
                 label="steps/s / bare mj_step's (as fast as possible)")
         ax.plot(sizes, [d["real_time_factor"] for d in data], "s-", label="real-time factor (lowest run)")
@@ -717,25 +726,25 @@ def plot_scale(r: dict, path: Path) -> Path:
         ax.set_ylim(0, 1.1)
         ax.set_title("simulation")
         ax.legend(fontsize=7, loc="lower left")
-        ax = axes[row, 1]
+        ax = axes[1, col]
         ax.plot(sizes, [d["frames_per_s"] for d in data], "o-")
         ax.axhline(50, color="grey", ls=":", lw=1)
         ax.set_ylim(0, 65)
         ax.set_title("viewer: frames/s")
-        ax = axes[row, 2]
+        ax = axes[2, col]
         ax.plot(sizes, [d["scene_update_ms"]["p50"] for d in data], "o-", label="p50")
         ax.plot(sizes, [d["scene_update_ms"]["p99"] for d in data], "s--", label="p99")
         ax.set_ylim(bottom=0)
         ax.set_title("viewer: scene update, ms per frame")
         ax.legend(fontsize=7)
-        ax = axes[row, 3]
+        ax = axes[3, col]
         ax.plot(sizes, [d["first_shown_age_ms"]["p50"] for d in data], "o-", label="p50")
         ax.plot(sizes, [d["first_shown_age_ms"]["p99"] for d in data], "s--", label="p99")
         ax.axhline(FRAME_60HZ_MS + bare50, color="grey", ls=":", lw=1, label="16.7 ms + bare pair p99")
         ax.set_ylim(bottom=0)
         ax.set_title("displayed-state age, ms")
         ax.legend(fontsize=7)
-        ax = axes[row, 4]
+        ax = axes[4, col]
         for proc in data[0]["cpu_cores"]:
             ax.plot(sizes, [d["cpu_cores"][proc] for d in data], "o-" if proc == "total" else ".--", label=proc)
         if kind == "tanks":
@@ -743,10 +752,11 @@ def plot_scale(r: dict, path: Path) -> Path:
         ax.set_ylim(bottom=0)
         ax.set_title("CPU cores per process")
         ax.legend(fontsize=7)
-        for ax in axes[row]:
+        for ax in axes[:, col]:
+            ax.set_title(f"{kind}: {ax.get_title()}")
             ax.set_xscale("log", base=2)
             ax.set_xticks(sizes, [str(n) for n in sizes])
-            ax.set_xlabel(xlabel if ax is axes[row, 2] else kind)
+            ax.set_xlabel(xlabel)
             ax.grid(alpha=0.3)
     fig.suptitle(f"Scale: {SCALE_RATE:g} Hz publishers, one viewer mirroring every body "
                  f"(make bench, {r['when']}; dotted lines: targets)", fontsize=11)

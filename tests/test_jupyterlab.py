@@ -71,6 +71,7 @@ TEARDOWN = 15.0  # s of the budget kept for stopping the servers and browsers
 LANES = 2
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
 TANK_PIXELS = 150  # olive pixels that say the tank is drawn (it covers 300 to 3000 in these views)
+NO_PROXY = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # 127.0.0.1 only, never a proxy
 CELLS = ".jp-NotebookPanel:not(.lm-mod-hidden) .jp-Notebook .jp-Cell"  # one notebook is open at a time
 
 
@@ -387,7 +388,7 @@ def check_views(lane: Lane, stem: str) -> list[str]:
         what = f"{stem} view {k} ({'live ' + src if src else 'recording'})"
         if src is not None:  # a live page: its server answers, it is no error page, and its caption says live
             assert "(live)" in caption, f"{what}: its caption says {caption!r}"
-            assert urllib.request.urlopen(src, timeout=5).status == 200, f"{what}: the server does not answer"
+            assert NO_PROXY.open(src, timeout=5).status == 200, f"{what}: the server does not answer"
             content = frame.element_handle().content_frame()
             assert not content.url.startswith("chrome-error"), f"{what} shows the browser's error page"
             content.locator("canvas").first.wait_for(state="attached", timeout=lane.ms(30))
@@ -410,6 +411,12 @@ def check_views(lane: Lane, stem: str) -> list[str]:
                   every_pane_has_the_tank, 30, every=0.1)
         seen.append(f"view {k}: {'live' if src else 'recording'}, {len(panes)} pane(s)")
     return seen
+
+
+def views_in(notebook: dict) -> int:
+    """How many 3D views (``<iframe>`` elements, live or recordings) a saved notebook's outputs hold."""
+    return sum("".join(output.get("data", {}).get("text/html", "")).count("<iframe")
+               for cell in notebook["cells"] if cell["cell_type"] == "code" for output in cell.get("outputs", []))
 
 
 def stderr_of(cell: dict) -> str:
@@ -576,8 +583,11 @@ def run_notebook(lane: Lane, notebook: Path, outcome: dict) -> None:
         out_of_sight(lane)
         run(lane, "runmenu:run-all", code_positions(committed["cells"], 0, len(committed["cells"])),
             f"{stem}: Run All", 120)
-        check_outputs(save(lane, name), committed, stem, first)
+        saved = save(lane, name)
+        check_outputs(saved, committed, stem, first)
         seen = check_views(lane, stem)
+        expected = views_in(saved)
+        assert len(seen) == expected, f"{stem}: {len(seen)} 3D views on the page, {expected} in its outputs"
         out_of_sight(lane)
         check_panels_closed(lane, stem)
         lane.log(f"{stem}: outputs, views and panels checked: " + "; ".join(seen))

@@ -211,7 +211,7 @@ class App:
         the next frame is due, so frames come at ``FRAME_RATE`` however the
         posted calls are timed (waiting a whole ``timeout`` after a call that
         came just before a frame was due delayed that frame by up to a frame:
-        a viewer of 50 Hz states drew 42 to 47 frames/s, see book/benchmarks.md).
+        the viewer of 1 kHz states drew 54 frames/s, not 60; see book/benchmarks.md).
 
         Returns:
             False when the app is done (duration reached, simulation ended or stop requested).

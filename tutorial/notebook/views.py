@@ -113,9 +113,10 @@ class LiveView:
         if model is None or not frames:
             return None
         qpos = [q for q, _ in frames]
-        arrows = [a for _, a in frames]
-        if any(a is None for a in arrows):  # no arrows, or some frames before the first was drawn
+        if all(a is None for _, a in frames):  # the run drew no arrows
             return replay.record_replay(model, qpos, self.FPS, camera=camera)
+        # A frame before the first arrow was drawn has none: an empty frame (arrows hidden).
+        arrows = [a or {} for _, a in frames]
         return replay.record_replay(model, qpos, self.FPS, camera=camera, overlays=overlays, overlay_frames=arrows)
 
     def recorded_seconds(self) -> float:
@@ -132,14 +133,17 @@ class LiveView:
         self.server.close()
 
 
-# Runs in the browser, in a live output: every 2 s it asks each page's server for its page (HEAD);
-# when one does not answer, its kernel has gone (restarted or shut down: nothing in the kernel can
-# say so any more), and the output says it.  It stops once its output is replaced (by a recording).
+# Runs in the browser, in a live output: every 2 s it asks each page's server for its page (HEAD).
+# When none answers, the kernel has gone (restarted or shut down: nothing in the kernel can say so
+# any more), and the output says it.  One closed view alone (its run reset while the other's is
+# still stopping) is not that.  The box is looked up by its id at every check, so a cell that
+# JupyterLab takes out of the page while scrolled away is watched again when it comes back; the
+# watch ends when its output is replaced (by a recording), or after a minute with no box.
 _WATCH = """<script>
 (() => {
   const urls = %(urls)s, notice = %(notice)s, caption = %(caption)s;
-  let box = null, tries = 0, answered = false;
-  const gone = () => {
+  let missing = 0, answered = false;
+  const gone = (box) => {
     const note = document.createElement("div");
     note.textContent = notice + (answered ? " What you see is its last frame." : "");
     note.style.cssText = "position: absolute; left: 0; right: 0; top: 0; padding: 4px 8px; "
@@ -150,11 +154,18 @@ _WATCH = """<script>
     if (under) under.innerHTML = caption;
   };
   const check = () => {
-    box = box || document.getElementById(%(box_id)s);
-    if (!box) { if (++tries < 100) setTimeout(check, 200); return; }  // not on the page yet
-    if (!box.isConnected) return;  // replaced by its recording: nothing left to watch
-    Promise.all(urls.map((u) => fetch(u, {method: "HEAD", mode: "no-cors", cache: "no-store"})))
-      .then(() => { answered = true; setTimeout(check, 2000); }, gone);
+    const box = document.getElementById(%(box_id)s);
+    if (!box) { if (++missing < 300) setTimeout(check, 200); return; }  // not (or no longer) in the page
+    missing = 0;
+    const ask = (u) => fetch(u, {method: "HEAD", mode: "no-cors", cache: "no-store"});
+    Promise.allSettled(urls.map(ask)).then((results) => {
+      if (results.some((r) => r.status === "fulfilled")) {
+        answered = true;
+        setTimeout(check, 2000);
+      } else if (box.isConnected) {
+        gone(box);
+      }
+    });
   };
   check();
 })();
