@@ -352,12 +352,14 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
            "frames": 0, "frame_span_s": 0.0, "scene_update_s": [],
            "messages": {"applied": 0, "posted": 0, "coalesced": 0, "max_pending": 0},
            "cpu_cores": cpu, "real_time_factor": summary.get("real_time_factor"), "bodies": len(views)}
+    starts = []  # each body's measured window starts here (ns)
     for v in views:
         # The measured window: from the first state this body's viewer applied (discovery can
         # take a few seconds) plus the warm-up, to the simulation's last step.
         if not v["applied"]:
             raise RuntimeError(f"the viewer applied no state in the {sim_project} run")
         start_ns = v["applied"][0][2] + int(warmup * 1e9)
+        starts.append(start_ns)
         window = [(step_wall[round(stamp / 1000)], arrived, applied) for stamp, arrived, applied in v["applied"]
                   if round(stamp / 1000) in step_wall and start_ns <= applied <= end_ns]
         out["latency"] += [applied - step for step, _, applied in window]
@@ -376,8 +378,7 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
     # every probe wrote the same counters; the frames are counted from the first body's probe.
     for k in ("posted", "coalesced", "max_pending"):
         out["messages"][k] = views[0][k]
-    frames0 = [(t, c) for t, stamp, c in views[0]["frames"]
-               if views[0]["applied"] and views[0]["applied"][0][2] + int(warmup * 1e9) <= t <= end_ns]
+    frames0 = [(t, c) for t, _, c in views[0]["frames"] if starts[0] <= t <= end_ns]
     out["frames"] = len(frames0)
     out["frame_span_s"] = (frames0[-1][0] - frames0[0][0]) * 1e-9 if len(frames0) > 1 else 0.0
     out["scene_update_s"] = [c for _, c in frames0]

@@ -143,12 +143,7 @@ class Proc:
         except subprocess.TimeoutExpired:
             # SIGABRT first: with faulthandler on (PYTHONFAULTHANDLER, set above),
             # Python prints every thread's stack, which says where it hung.
-            self.p.send_signal(signal.SIGABRT)
-            try:
-                self.p.wait(5)
-            except subprocess.TimeoutExpired:
-                self.p.kill()
-                self.p.wait()
+            self._signal_then_kill(signal.SIGABRT)
             for t in self._threads:
                 t.join(5)
             raise AssertionError(f"{self.cmd} did not finish in {timeout} s\n{self.out}\n{self.err}")
@@ -172,12 +167,16 @@ class Proc:
         """Stop it at the end of a test: Ctrl-C first, so its node removes its Fast DDS
         shared-memory files (a SIGKILLed node leaves them in /dev/shm), then SIGKILL after 5 s."""
         if self.p.poll() is None:
-            self.p.send_signal(signal.SIGINT)
-            try:
-                self.p.wait(5)
-            except subprocess.TimeoutExpired:
-                self.p.kill()
-                self.p.wait()
+            self._signal_then_kill(signal.SIGINT)
+
+    def _signal_then_kill(self, sig: int, grace: float = 5.0) -> None:
+        """Send ``sig``, wait ``grace`` s for the process to end, then SIGKILL it and reap it."""
+        self.p.send_signal(sig)
+        try:
+            self.p.wait(grace)
+        except subprocess.TimeoutExpired:
+            self.p.kill()
+            self.p.wait()
 
 
 @pytest.fixture
