@@ -76,4 +76,5 @@ class ProbedJointStateSubscriber(RttJointStateMonitor):
         loop = self.config.call_later.__self__  # the MainLoop: its counters show whether a backlog grew
         _write({"applied": self.applied_log, "frames": self.frame_log,
                 "posted": loop.posted, "coalesced": loop.coalesced, "executed": loop.executed,
-                "max_pending": loop.max_pending}, self.config.body_name)
+                "max_pending": loop.max_pending, "yields": loop.yields,
+                "yield_timeouts": loop.yield_timeouts}, self.config.body_name)

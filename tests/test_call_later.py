@@ -160,3 +160,76 @@ def test_wake_from_another_thread_ends_a_wait():
     loop.run_once(10.0)
     assert time.monotonic() - t0 < 5.0
     t.join(10)
+
+
+def _owner_waits_in_run_once(loop, stop, errors):
+    """The owner's side of a yield test: run the loop until ``stop`` is set (the test's main thread)."""
+    try:
+        while not stop.is_set():
+            loop.run_once(0.05)
+    except Exception as exc:  # noqa: BLE001 - collected and asserted on
+        errors.append(exc)
+
+
+def test_yield_to_owner_returns_once_the_waiting_owner_took_the_work():
+    from conftest import wait_until
+
+    loop = MainLoop()
+    ran, results, errors = [], [], []
+    stop = threading.Event()
+
+    def poster():
+        try:
+            assert wait_until(lambda: loop.owner_waiting, timeout=10)
+            loop.call_later(ran.append, "state")
+            taken = loop.yield_to_owner(timeout=10.0)
+            # Taken means taken: nothing of it is left in the queue when yield returns.
+            results.append((taken, loop.pending()))
+        except Exception as exc:  # noqa: BLE001
+            errors.append(exc)
+        finally:
+            stop.set()
+
+    t = threading.Thread(target=poster)
+    t.start()
+    _owner_waits_in_run_once(loop, stop, errors)
+    t.join(10)
+    assert errors == []
+    assert results == [(True, 0)]
+    assert ran == ["state"]
+    assert (loop.yields, loop.yield_timeouts) == (1, 0)
+
+
+def test_yield_to_owner_does_not_wait_for_an_owner_that_is_not_waiting():
+    loop = MainLoop()
+    results = []
+
+    def poster():
+        loop.call_later(print, "never run here")
+        results.append(loop.yield_to_owner(timeout=10.0))  # the owner is not in run_once
+
+    t = threading.Thread(target=poster)
+    t.start()
+    t.join(10)
+    assert not t.is_alive()
+    assert results == [False]
+    assert loop.yield_to_owner() is False  # the owner never waits for itself
+    assert (loop.yields, loop.yield_timeouts) == (0, 0)
+    assert loop.pending() == 1  # nothing was lost: the owner runs it when it comes
+
+
+def test_yield_to_owner_gives_up_after_its_timeout():
+    loop = MainLoop()
+    loop._owner_waiting = True  # as if the owner were waiting but never scheduled (a busy machine)
+    results = []
+
+    def poster():
+        loop.call_later(len, "")
+        results.append(loop.yield_to_owner(timeout=0.05))
+
+    t = threading.Thread(target=poster)
+    t.start()
+    t.join(10)
+    assert results == [False]
+    assert (loop.yields, loop.yield_timeouts) == (0, 1)
+    assert loop.process_pending() == 1

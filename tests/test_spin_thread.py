@@ -74,3 +74,25 @@ def test_an_exception_in_a_callback_is_kept_for_the_owner(node):
         assert isinstance(spin.error, ValueError)
     finally:
         assert spin.stop()
+
+
+def test_after_a_callback_the_spin_thread_steps_aside_for_the_owner(node):
+    from tutorial.call_later import MainLoop
+
+    loop = MainLoop()  # owned by this thread, which runs it below
+    ran = []
+    node.create_subscription(String, "/spin_thread_hand_over",
+                             lambda msg: loop.call_later(ran.append, msg.data, key=msg.data), 10)
+    pub = node.create_publisher(String, "/spin_thread_hand_over", 10)
+    spin = SpinThread(node, hand_over_to=loop).start()
+    try:
+        assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
+        for i in range(5):
+            pub.publish(String(data=str(i)))
+            assert loop.run_until(lambda: len(ran) == i + 1, timeout=10), ran
+    finally:
+        assert spin.stop(timeout=10 * SPIN_POLL + 2.0)
+    assert spin.error is None
+    assert ran == ["0", "1", "2", "3", "4"]
+    # This thread waited in run_once for each message: the spin thread waited for it to take them.
+    assert loop.yields >= 1, (loop.yields, loop.yield_timeouts)

@@ -185,6 +185,7 @@ class Body:
         self.data = data
         self.name = name
         self.prefix = f"{name}/"
+        self.kinematic_state_changes = 0  # notify_kinematic_state_change() calls: the app redraws when it grows
         m = model
         self.root_ids = tuple(b for b in range(1, m.nbody)
                               if m.body_parentid[b] == 0 and self._prefixed(mujoco.mjtObj.mjOBJ_BODY, b))
@@ -337,10 +338,13 @@ class Body:
         """Recompute link poses from ``qpos`` (forward kinematics).
 
         Choreonoid's ``notifyKinematicStateChange(true)`` does this and tells
-        the views to redraw; :class:`tutorial.scene.Scene` redraws on its next frame.
+        the views to redraw.  Here it counts the change in
+        :attr:`kinematic_state_changes`, and a viewer's :class:`tutorial.app.App`
+        draws a frame soon after (:meth:`tutorial.app.App.next_frame_due`).
         Only the owner thread of the data may call it.
         """
         mujoco.mj_kinematics(self.model, self.data)
+        self.kinematic_state_changes += 1
 
 
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:

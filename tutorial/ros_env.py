@@ -137,6 +137,11 @@ class SpinThread:
 
     Args:
         node: the ``rclpy.node.Node`` whose callbacks to run.
+        hand_over_to: the :class:`tutorial.call_later.MainLoop` its callbacks
+            post to, if any: after each callback the thread steps aside
+            (:meth:`~tutorial.call_later.MainLoop.yield_to_owner`, at most
+            1 ms) so the main thread runs the posted work before the
+            executor's own bookkeeping holds the interpreter lock.
 
     Raises:
         RuntimeError: the node was already given to a SpinThread (one per node
@@ -148,8 +153,9 @@ class SpinThread:
     spinning; it is kept in :attr:`error` for the owner to report.
     """
 
-    def __init__(self, node):
+    def __init__(self, node, hand_over_to=None):
         self.node = node
+        self._hand_over_to = hand_over_to
         # One thread, one executor: callbacks of this node never run in
         # parallel with each other, only in parallel with the other threads.
         if node in _spun_nodes:
@@ -168,6 +174,8 @@ class SpinThread:
         try:
             while not self._stop.is_set():
                 self.executor.spin_once(timeout_sec=SPIN_POLL)
+                if self._hand_over_to is not None:
+                    self._hand_over_to.yield_to_owner()
         except ExternalShutdownException:
             pass
         except BaseException as exc:  # noqa: BLE001 - kept for the owner to report

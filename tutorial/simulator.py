@@ -22,12 +22,14 @@ from tutorial.body import Body
 from tutorial.controller import ControllerIO, SimpleController
 
 
-# In real-time mode the simulation thread sleeps only when it is this far ahead of
-# wall-clock time, so steps come in short bursts.  Sleeping before every step was
-# measured (book/benchmarks.md): with rclpy's SingleThreadedExecutor the 1 kHz
-# pipeline then went over one CPU core; with the EventsExecutor it used more CPU
-# and its latency tail grew, for a median gain seen in one comparison of two.
-REALTIME_MIN_SLEEP = 0.002  # s
+# In real-time mode the simulation thread sleeps whenever it is at least this far
+# ahead of wall-clock time: at a 1 ms step, before nearly every step, so a 1 kHz
+# publisher sends one message a millisecond.  Shorter sleeps are lost in the
+# operating system's wake-up time.  Sleeping only when 2 ms ahead (two steps at
+# a time) saved CPU, but a subscriber then got pairs of messages: keeping the
+# newest, it dropped half of them and showed the other half later (1.5x the bare
+# rclpy pair's latency at p50 instead of 1.3x, book/benchmarks.md).
+REALTIME_MIN_SLEEP = 0.0002  # s
 
 
 @dataclass
