@@ -32,8 +32,8 @@ from tutorial.world import build_world
 
 DEFAULT_NODE_NAME = "rtt"
 FRAME_RATE = 60.0  # Hz, the most often the scene is redrawn
-SETTLE = 0.002  # s: a frame waits this long after a change for more of the same burst (see App.next_frame_due)
-SETTLE_MAX = 0.005  # s: ... and at most this long after the first change it shows
+SETTLE = 0.004  # s: a frame waits this long after a change for more of the same burst (see App.next_frame_due)
+SETTLE_MAX = 0.008  # s: ... and at most this long after the first change it shows
 GRAPH_CHECK_PERIOD = 2.0  # s, how often the node graph is checked for a twin name
 
 
