@@ -230,8 +230,10 @@ class App:
         due = self.next_frame_due()
         if now >= due:
             cap = self._last_frame + 1.0 / FRAME_RATE
-            # Keep to the frame clock when drawing at the cap (a frame a little late does
-            # not push the next one back: 60 frames/s, not 59); otherwise count from now.
+            # The frame clock advances one period per frame while a frame comes less than
+            # a period after it was allowed (a frame a little late does not push the next
+            # one back: 60 frames/s, not 59), else it restarts from now.  So frames come
+            # at most FRAME_RATE a second on average, and one may follow a late one sooner.
             self._last_frame = cap if cap <= now < cap + 1.0 / FRAME_RATE else now
             self._first_change = self._last_change = None
             self._draw()
@@ -245,8 +247,9 @@ class App:
         has changed (:meth:`changes`): ``SETTLE`` s after the newest change, so the states of
         one simulation step, which arrive as a burst of messages (one per
         robot), are drawn together; at most ``SETTLE_MAX`` s after the first
-        change, so a steady stream of changes is still drawn; and never
-        sooner than ``1/FRAME_RATE`` s after the previous frame.  A frame
+        change, so a steady stream of changes is still drawn; and not before
+        the frame clock allows (``1/FRAME_RATE`` s per frame on average, see
+        :meth:`step`).  A frame
         drawn at a fixed 60 Hz, whatever came, showed a state that arrived
         just after a frame 16.7 ms late (``book/benchmarks.md``).
         """

@@ -22,9 +22,9 @@ blocks; the woken main thread waits all that time.  So a posting thread that
 has nothing urgent to do may *step aside*: :meth:`MainLoop.yield_to_owner`
 blocks it (which lets go of the lock) until the owner has taken what was
 posted, at most ``HAND_OVER_WAIT``.  :class:`tutorial.ros_env.SpinThread`
-does this after each callback when it is given the loop.  Measured at 1 kHz,
-a state then reaches the main thread in about 0.04 ms instead of 0.12 to
-0.2 ms (``book/benchmarks.md``).
+does this after each callback when it is given the loop.  In the benchmark
+at 1 kHz, callback -> applied on the main thread then takes 0.07 to 0.13 ms
+(p50) instead of 0.16 to 0.19 ms (``book/benchmarks.md``).
 """
 
 from __future__ import annotations
@@ -96,13 +96,14 @@ class MainLoop:
         self._wakeup.set()
 
     def yield_to_owner(self, timeout: float = HAND_OVER_WAIT) -> bool:
-        """Step aside until the owner has taken the calls posted so far (any thread but the owner).
+        """Step aside until the owner has taken the calls posted so far, by any thread (any thread but the owner).
 
         Blocking here lets go of the interpreter lock, so a main thread that
         was woken by the post runs it at once instead of waiting for this
         thread's next blocking call (see the module's docstring).  It waits
-        only when the owner is blocked in :meth:`run_once` with work to take:
-        an owner busy drawing, or not running the loop at all, costs nothing.
+        only when the owner is blocked in :meth:`run_once` and posted calls
+        are still pending: an owner busy drawing, or not running the loop at
+        all, costs nothing.
 
         Args:
             timeout: the longest wait, s.
@@ -195,8 +196,10 @@ class MainLoop:
             if due is not None:
                 timeout = max(0.0, min(timeout, due - time.monotonic()))
             self._owner_waiting = True  # a hint for yield_to_owner(); a stale read only costs a wait
-            self._wakeup.wait(timeout)
-            self._owner_waiting = False
+            try:
+                self._wakeup.wait(timeout)
+            finally:  # a Ctrl-C raised in the wait must not leave posting threads waiting for nobody
+                self._owner_waiting = False
         self._wake_requested = False
         self._wakeup.clear()
         return self.process_pending()
