@@ -249,9 +249,8 @@ class App:
         robot), are drawn together; at most ``SETTLE_MAX`` s after the first
         change, so a steady stream of changes is still drawn; and not before
         the frame clock allows (``1/FRAME_RATE`` s per frame on average, see
-        :meth:`step`).  A frame
-        drawn at a fixed 60 Hz, whatever came, showed a state that arrived
-        just after a frame 16.7 ms late (``book/benchmarks.md``).
+        :meth:`step`).  A frame drawn at a fixed 60 Hz, whatever came, showed
+        a state that arrived just after a frame 16.7 ms late (``book/benchmarks.md``).
         """
         cap = self._last_frame + 1.0 / FRAME_RATE
         if self.sim is not None and not self.sim.finished.is_set():

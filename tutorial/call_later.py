@@ -67,7 +67,6 @@ class MainLoop:
         self.posted = 0
         self.coalesced = 0
         self.executed = 0
-        self.timer_runs = 0  # call_every() functions run
         self.max_pending = 0  # the longest the queue has been: stays at the number of keys, never grows
         self.yields = 0  # yield_to_owner() calls that waited until the owner took the work
         self.yield_timeouts = 0  # ... and that gave up after HAND_OVER_WAIT
@@ -184,7 +183,6 @@ class MainLoop:
         for timer in self._timers:
             if now >= timer[0]:
                 timer[0] = max(timer[0] + timer[1], now)
-                self.timer_runs += 1
                 self._run(timer[2], (), {})
         return len(batch)
 
