@@ -45,20 +45,22 @@ def test_step4_publishes_the_imu_at_20_hz_of_simulated_time(procs, node):
     node.create_subscription(Imu, "/Tank/imu", received.append, qos)
     spin = SpinThread(node).start()
     try:
-        sim = procs(module_command("tutorial.runner", "project/step4.yaml", "--headless", "--duration", "5",
-                                   "--json"))
-        assert sim.wait(60) == 0, sim.err
-        assert wait_until(lambda: received and stamp_ns(received[-1]) == 4_950_000_000, timeout=10)
+        # No --duration: discovery takes a varying time (one of Fast DDS's ~3 s announcement periods on a
+        # loaded machine), so the test does not count on a number of messages within a fixed run. It waits
+        # until 41 have arrived from whenever the subscription matched, then stops the simulation.
+        sim = procs(module_command("tutorial.runner", "project/step4.yaml", "--headless", "--json"))
+        assert wait_until(lambda: len(received) >= 41, timeout=60), (len(received), sim.err)
+        summary = stop(sim)
     finally:
         spin.stop()
     assert spin.error is None, spin.error
-    summary = sim.summary()["controllers"]["RttImuStatePublisher"]
-    assert summary["published"] == 100  # steps 0, 50, ..., 4950
-    assert summary["frame_id"] == "CHASSIS"
+    imu = summary["controllers"]["RttImuStatePublisher"]
+    assert imu["published"] == (summary["steps"] + 49) // 50  # steps 0, 50, 100, ...: one per 0.05 s
+    assert imu["frame_id"] == "CHASSIS"
     stamps = [stamp_ns(m) for m in received]
-    assert len(received) >= 40  # discovery may take one of Fast DDS's ~3 s announcement periods
+    assert stamps[0] % PERIOD_NS == 0
     assert stamps == list(range(stamps[0], stamps[-1] + 1, PERIOD_NS))  # every 0.05 s, none lost
-    assert stamps[-1] == 4_950_000_000
+    assert stamps[-1] <= (imu["published"] - 1) * PERIOD_NS  # nothing received that was not published
     for msg in received:
         assert msg.header.frame_id == "CHASSIS"
         assert msg.orientation_covariance[0] == -1.0
