@@ -69,6 +69,90 @@ def test_a_move_within_the_tolerance_is_not_sent_and_a_nan_pose_is():
     assert scene.update(data) == 1
 
 
+WELDED = """
+<mujoco>
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 0.1"/>
+    <body name="base" pos="0.1 0.2 0.3" quat="0.9 0.1 0.3 0.2">
+      <freejoint/>
+      <geom name="hull" type="box" size="0.2 0.1 0.05"/>
+      <body name="plate" pos="0.05 -0.1 0.02" quat="0.7 0.7 0 0">
+        <geom name="plate" type="box" size="0.02 0.03 0.04" pos="0.01 0.02 0.03" quat="0.8 0 0.6 0"/>
+        <body name="arm" pos="0 0 0.1">
+          <joint name="hinge" type="hinge" axis="0 1 0"/>
+          <geom name="arm" type="box" size="0.1 0.01 0.01" pos="0.1 0 0"/>
+        </body>
+      </body>
+    </body>
+    <body name="target" mocap="true" pos="1 0 0.5">
+      <geom name="target" type="sphere" size="0.05" contype="0" conaffinity="0"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def drawn_world_poses(vis, scene, model):
+    """Each box or sphere geom's world pose as drawn: its frame body's transform times its own."""
+    out = {}
+    for gid in range(model.ngeom):
+        if model.geom_type[gid] not in (int(mujoco.mjtGeom.mjGEOM_BOX), int(mujoco.mjtGeom.mjGEOM_SPHERE)):
+            continue  # drawn with an extra local pose of their own (planes, cylinders, capsules)
+        frame = scene.frame_body(int(model.geom_bodyid[gid]))
+        parent = f"meshcat/{scene.root}/static" if frame == 0 else f"meshcat/{scene.body_path(frame)}"
+        geom = vis.sent[f"{parent}/geom{gid}"]
+        out[gid] = geom if frame == 0 else vis.sent[parent] @ geom
+    return out
+
+
+def test_a_welded_body_rides_in_its_parents_frame_and_is_drawn_where_mujoco_puts_it():
+    model = mujoco.MjModel.from_xml_string(WELDED)
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    vis = RecordingVisualizer()
+    scene = Scene(vis, model)
+    scene.build(data)
+    name = lambda b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
+    assert [name(b) for b in scene.moving_bodies] == ["base", "arm", "target"]  # the plate rides with the base
+    assert scene.frame_body(model.body("plate").id) == model.body("base").id
+
+    rng = np.random.default_rng(3)
+    for _ in range(3):  # move everything: the free joint, the hinge, the mocap body
+        data.qpos[:3] += rng.normal(size=3)
+        quat = rng.normal(size=4)
+        data.qpos[3:7] = quat / np.linalg.norm(quat)
+        data.qpos[7] = rng.uniform(-3, 3)
+        data.mocap_pos[0] += rng.normal(size=3)
+        mujoco.mj_kinematics(model, data)
+        assert scene.update(data) == 3
+        drawn_poses = drawn_world_poses(vis, scene, model)
+        assert len(drawn_poses) == 4
+        for gid, drawn in drawn_poses.items():
+            np.testing.assert_allclose(drawn[:3, 3], data.geom_xpos[gid], atol=1e-12)
+            np.testing.assert_allclose(drawn[:3, :3], data.geom_xmat[gid].reshape(3, 3), atol=1e-12)
+
+
+def test_a_tank_frame_sends_chassis_turret_and_barrel_not_its_tracks():
+    model, data, vis, scene = tank_scene()
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in scene.moving_bodies]
+    assert names == ["Tank/CHASSIS", "Tank/TURRET_Y", "Tank/TURRET_P"]
+
+
+def test_the_pipeline_packs_what_meshcat_python_packs():
+    import msgpack
+    import umsgpack
+    from meshcat.commands import SetTransform
+
+    class Path:
+        def lower(self):
+            return "/meshcat/rtt/Tank/CHASSIS"
+
+    pose = np.eye(4)
+    pose[:3, 3] = (0.1234567890123, -2.5, 1e-300)
+    command = SetTransform(pose, Path()).lower()
+    assert msgpack.packb(command) == umsgpack.packb(command)
+
+
 # ---- overlays: arrows a controller draws over the view ----------------------------------
 
 class CommandVisualizer(RecordingVisualizer):
