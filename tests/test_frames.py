@@ -1,4 +1,4 @@
-"""When a viewer draws: once a change has settled, at most FRAME_RATE times a second, never for nothing."""
+"""When a viewer draws: once a burst is complete or has settled, at most FRAME_RATE times a second, never for nothing."""
 
 import math
 import time
@@ -13,9 +13,10 @@ from tutorial.project import load_project
 
 @pytest.fixture
 def viewer(tmp_path, node):
-    """A project without a simulator (a viewer's), headless, its frames' times in a list."""
+    """A project without a simulator (a viewer's) of three tanks, headless, its frames' times in a list."""
     path = tmp_path / "viewer.yaml"
-    path.write_text(f"name: frames\nmodels:\n  - name: Tank\n    file: {MODEL / 'tank.xml'}\n")
+    path.write_text("name: frames\nmodels:\n" + "".join(
+        f"  - name: Tank{i}\n    file: {MODEL / 'tank.xml'}\n    position: [{i}, 0, 0]\n" for i in (1, 2, 3)))
     app = App(load_project(path), node=node, headless=True, output=lambda r: None)
     app.open()
     frames = []
@@ -26,8 +27,19 @@ def viewer(tmp_path, node):
         app.close()
 
 
-def move(app) -> None:
-    app.bodies["Tank"].notify_kinematic_state_change()
+def move(app, name="Tank1") -> None:
+    app.bodies[name].notify_kinematic_state_change()
+
+
+def move_all(app) -> None:
+    for name in app.bodies:
+        move(app, name)
+
+
+def wait_for_frames(app, frames, n: int, timeout: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout
+    while len(frames) < n and time.monotonic() < deadline:
+        app.step(timeout=0.01)
 
 
 def step_for(app, seconds: float, post=None) -> None:
@@ -45,25 +57,41 @@ def test_nothing_changed_nothing_drawn(viewer):
     assert app.next_frame_due() == math.inf
 
 
-def test_a_burst_of_changes_is_drawn_once_after_it_settles(viewer, monkeypatch):
+def test_a_complete_burst_is_drawn_at_once(viewer, monkeypatch):
     app, frames = viewer
+    monkeypatch.setattr(app_module, "SETTLE", 5.0)  # the settle wait must play no part
+    monkeypatch.setattr(app_module, "SETTLE_MAX", 5.0)
+    for name in ("Tank1", "Tank2", "Tank3"):  # the states of one step, one per robot
+        assert not app.burst_complete()
+        app.loop.call_later(move, app, name, key=object())
+        app.step(timeout=0)
+    wait_for_frames(app, frames, 1, timeout=2.0)
+    assert len(frames) == 1
+    assert not app.burst_complete()  # drawn: nobody has moved since
+
+
+def test_an_incomplete_burst_is_drawn_once_after_it_settles(viewer, monkeypatch):
+    app, frames = viewer
+    move_all(app)  # every tank has moved once: each is expected in every burst
+    wait_for_frames(app, frames, 1)
     monkeypatch.setattr(app_module, "SETTLE", 0.3)  # long, so a slow machine cannot split the burst
     monkeypatch.setattr(app_module, "SETTLE_MAX", 2.0)
-    for _ in range(3):  # three states of one step (three robots), one after another
-        app.loop.call_later(move, app, key=object())
+    for name in ("Tank1", "Tank2"):  # Tank3's state does not come
+        app.loop.call_later(move, app, name, key=object())
         app.step(timeout=0)
     last_change = time.monotonic()
-    assert frames == []  # not yet: more of the burst may come
-    deadline = time.monotonic() + 10
-    while not frames and time.monotonic() < deadline:
-        app.step(timeout=0.05)
-    assert len(frames) == 1 and frames[0] - last_change >= 0.3 * 0.9
+    assert frames[1:] == []  # not yet: more of the burst may come
+    wait_for_frames(app, frames, 2)
+    assert len(frames) == 2 and frames[1] - last_change >= 0.3 * 0.9
     step_for(app, 0.3)
-    assert len(frames) == 1  # nothing new since
+    assert len(frames) == 2  # nothing new since
 
 
 def test_a_steady_stream_is_still_drawn_and_at_most_frame_rate_times_a_second(viewer, monkeypatch):
     app, frames = viewer
+    move_all(app)
+    wait_for_frames(app, frames, 1)
+    frames.clear()  # from here on only Tank1 moves: no burst is ever complete
     monkeypatch.setattr(app_module, "SETTLE", 0.2)  # every change would put the frame off again ...
     monkeypatch.setattr(app_module, "SETTLE_MAX", 0.25)  # ... but not past this
     step_for(app, 1.0, post=move)
@@ -73,3 +101,9 @@ def test_a_steady_stream_is_still_drawn_and_at_most_frame_rate_times_a_second(vi
     frames.clear()
     step_for(app, 1.0, post=move)
     assert 10 <= len(frames) <= FRAME_RATE + 2, len(frames)
+
+
+def test_complete_bursts_back_to_back_are_drawn_at_most_frame_rate_times_a_second(viewer):
+    app, frames = viewer
+    step_for(app, 1.0, post=move_all)  # every posted call completes a burst
+    assert FRAME_RATE * 0.5 <= len(frames) <= FRAME_RATE + 2, len(frames)

@@ -96,6 +96,7 @@ class App:
         self._changes_seen = 0  # self.changes() when step() last looked
         self._first_change = None  # time.monotonic() of the first change not yet drawn, or None
         self._last_change = None  # ... and of the newest
+        self._drawn_changes: dict[str, int] = {}  # each body's kinematic_state_changes at the last frame
         self._drawn_step = -1
         self.stop_requested = False
 
@@ -236,6 +237,7 @@ class App:
             # at most FRAME_RATE a second on average, and one may follow a late one sooner.
             self._last_frame = cap if cap <= now < cap + 1.0 / FRAME_RATE else now
             self._first_change = self._last_change = None
+            self._drawn_changes = {name: b.kinematic_state_changes for name, b in self.bodies.items()}
             self._draw()
         return not self.done()
 
@@ -244,20 +246,35 @@ class App:
 
         While the project simulates, every frame has something new: frames
         come ``1/FRAME_RATE`` s apart.  Otherwise a frame is due when the view
-        has changed (:meth:`changes`): ``SETTLE`` s after the newest change, so the states of
-        one simulation step, which arrive as a burst of messages (one per
-        robot), are drawn together; at most ``SETTLE_MAX`` s after the first
-        change, so a steady stream of changes is still drawn; and not before
-        the frame clock allows (``1/FRAME_RATE`` s per frame on average, see
-        :meth:`step`).  A frame drawn at a fixed 60 Hz, whatever came, showed
-        a state that arrived just after a frame 16.7 ms late (``book/benchmarks.md``).
+        has changed (:meth:`changes`).  The states of one simulation step
+        arrive as a burst of messages, one per robot, and are drawn together:
+        at once when every body that has ever moved has moved again since the
+        last frame (the burst is complete, :meth:`burst_complete`); else
+        ``SETTLE`` s after the newest change, for the rest of the burst, and at
+        most ``SETTLE_MAX`` s after the first change, so a steady stream of
+        changes is still drawn.  Never before the frame clock allows
+        (``1/FRAME_RATE`` s per frame on average, see :meth:`step`).  A frame
+        drawn at a fixed 60 Hz, whatever came, showed a state that arrived
+        just after a frame 16.7 ms late (``book/benchmarks.md``).
         """
         cap = self._last_frame + 1.0 / FRAME_RATE
         if self.sim is not None and not self.sim.finished.is_set():
             return cap
         if self._first_change is None:
             return math.inf
+        if self.burst_complete():
+            return cap
         return max(cap, min(self._last_change + SETTLE, self._first_change + SETTLE_MAX))
+
+    def burst_complete(self) -> bool:
+        """True when every body that has ever moved has moved since the last frame (owner thread).
+
+        A body whose states stopped coming (its publisher ended) keeps this
+        False, and frames then wait ``SETTLE`` s after the newest change.
+        """
+        moved_since = [b.kinematic_state_changes > self._drawn_changes.get(name, 0)
+                       for name, b in self.bodies.items() if b.kinematic_state_changes]
+        return bool(moved_since) and all(moved_since)
 
     def changes(self) -> int:
         """Counts what changed the view (owner thread): bodies' kinematic-state changes and arrows.
