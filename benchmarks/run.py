@@ -482,7 +482,7 @@ def scene_update_cost(model_file: str, frames: int) -> dict:
     finally:
         server.close()
     out = {k: pct(v, 1000.0) for k, v in times.items()}
-    out["bodies"] = len(scene.moving_bodies)
+    out["transforms"] = len(scene.moving_bodies)  # per frame, all moving (a tank: chassis, turret, barrel)
     out["speedup_p50"] = round(out["round_trip_per_body"]["p50"] / out["pipelined"]["p50"], 2)
     return out
 
@@ -684,7 +684,7 @@ def print_report(r: dict) -> None:
               f"{run['cpu_cores']['viewer']}, total {run['cpu_cores']['total']} (bare pair {r['bare'][key]['cpu_cores']})")
     print("\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, same server, interleaved")
     for name, u in r["scene_update"].items():
-        print(f"  {name:6s} {u['bodies']} bodies: pipelined p50 {u['pipelined']['p50']:.3f} p99 {u['pipelined']['p99']:.3f}; "
+        print(f"  {name:6s} {u['transforms']} transforms: pipelined p50 {u['pipelined']['p50']:.3f} p99 {u['pipelined']['p99']:.3f}; "
               f"round trip per body p50 {u['round_trip_per_body']['p50']:.3f} p99 {u['round_trip_per_body']['p99']:.3f} "
               f"({u['speedup_p50']}x)")
     print(f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, median {r['startup']['median_s']} s")

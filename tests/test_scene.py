@@ -78,6 +78,9 @@ WELDED = """
       <geom name="hull" type="box" size="0.2 0.1 0.05"/>
       <body name="plate" pos="0.05 -0.1 0.02" quat="0.7 0.7 0 0">
         <geom name="plate" type="box" size="0.02 0.03 0.04" pos="0.01 0.02 0.03" quat="0.8 0 0.6 0"/>
+        <body name="bracket" pos="0.2 0.05 -0.1" quat="0.5 0.5 0.5 0.5">
+          <geom name="bracket" type="box" size="0.03 0.01 0.02" pos="0.02 0 0.01"/>
+        </body>
         <body name="arm" pos="0 0 0.1">
           <joint name="hinge" type="hinge" axis="0 1 0"/>
           <geom name="arm" type="box" size="0.1 0.01 0.01" pos="0.1 0 0"/>
@@ -113,8 +116,9 @@ def test_a_welded_body_rides_in_its_parents_frame_and_is_drawn_where_mujoco_puts
     scene = Scene(vis, model)
     scene.build(data)
     name = lambda b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
-    assert [name(b) for b in scene.moving_bodies] == ["base", "arm", "target"]  # the plate rides with the base
+    assert [name(b) for b in scene.moving_bodies] == ["base", "arm", "target"]  # plate, bracket ride with the base
     assert scene.frame_body(model.body("plate").id) == model.body("base").id
+    assert scene.frame_body(model.body("bracket").id) == model.body("base").id  # two welds up
 
     rng = np.random.default_rng(3)
     for _ in range(3):  # move everything: the free joint, the hinge, the mocap body
@@ -126,7 +130,7 @@ def test_a_welded_body_rides_in_its_parents_frame_and_is_drawn_where_mujoco_puts
         mujoco.mj_kinematics(model, data)
         assert scene.update(data) == 3
         drawn_poses = drawn_world_poses(vis, scene, model)
-        assert len(drawn_poses) == 4
+        assert len(drawn_poses) == 5
         for gid, drawn in drawn_poses.items():
             np.testing.assert_allclose(drawn[:3, 3], data.geom_xpos[gid], atol=1e-12)
             np.testing.assert_allclose(drawn[:3, :3], data.geom_xmat[gid].reshape(3, 3), atol=1e-12)
@@ -139,9 +143,10 @@ def test_a_tank_frame_sends_chassis_turret_and_barrel_not_its_tracks():
 
 
 def test_the_pipeline_packs_what_meshcat_python_packs():
-    import msgpack
     import umsgpack
     from meshcat.commands import SetTransform
+
+    from tutorial.scene import pack_command
 
     class Path:
         def lower(self):
@@ -150,7 +155,7 @@ def test_the_pipeline_packs_what_meshcat_python_packs():
     pose = np.eye(4)
     pose[:3, 3] = (0.1234567890123, -2.5, 1e-300)
     command = SetTransform(pose, Path()).lower()
-    assert msgpack.packb(command) == umsgpack.packb(command)
+    assert pack_command(command) == umsgpack.packb(command)
 
 
 # ---- overlays: arrows a controller draws over the view ----------------------------------

@@ -96,7 +96,7 @@ class App:
         self._changes_seen = 0  # self.changes() when step() last looked
         self._first_change = None  # time.monotonic() of the first change not yet drawn, or None
         self._last_change = None  # ... and of the newest
-        self._drawn_changes: dict[str, int] = {}  # each body's kinematic_state_changes at the last frame
+        self._drawn_changes: dict[tuple[str, str], int] = {}  # each burst member's count at the last frame
         self._drawn_step = -1
         self.stop_requested = False
 
@@ -214,8 +214,9 @@ class App:
         """Run posted calls, and draw a frame when there is something new to show (owner thread).
 
         Waits for posted calls at most ``timeout`` s, and never past the time
-        the next frame is due (:meth:`next_frame_due`): a frame is drawn as
-        soon as a change has settled, at most ``FRAME_RATE`` times a second.
+        the next frame is due (:meth:`next_frame_due`): a frame is drawn once a
+        burst of changes is complete or has settled, at most ``FRAME_RATE``
+        times a second.
 
         Returns:
             False when the app is done (duration reached, simulation ended or stop requested).
@@ -237,7 +238,7 @@ class App:
             # at most FRAME_RATE a second on average, and one may follow a late one sooner.
             self._last_frame = cap if cap <= now < cap + 1.0 / FRAME_RATE else now
             self._first_change = self._last_change = None
-            self._drawn_changes = {name: b.kinematic_state_changes for name, b in self.bodies.items()}
+            self._drawn_changes = dict(self._burst_members())
             self._draw()
         return not self.done()
 
@@ -248,8 +249,9 @@ class App:
         come ``1/FRAME_RATE`` s apart.  Otherwise a frame is due when the view
         has changed (:meth:`changes`).  The states of one simulation step
         arrive as a burst of messages, one per robot, and are drawn together:
-        at once when every body that has ever moved has moved again since the
-        last frame (the burst is complete, :meth:`burst_complete`); else
+        at once when every body (and arrow) that has ever changed has changed
+        again since the last frame (the burst is complete, :meth:`burst_complete`,
+        which says what it cannot know); else
         ``SETTLE`` s after the newest change, for the rest of the burst, and at
         most ``SETTLE_MAX`` s after the first change, so a steady stream of
         changes is still drawn.  Never before the frame clock allows
@@ -267,14 +269,29 @@ class App:
         return max(cap, min(self._last_change + SETTLE, self._first_change + SETTLE_MAX))
 
     def burst_complete(self) -> bool:
-        """True when every body that has ever moved has moved since the last frame (owner thread).
+        """True when everything that has ever changed the view has changed since the last frame (owner thread).
 
-        A body whose states stopped coming (its publisher ended) keeps this
-        False, and frames then wait ``SETTLE`` s after the newest change.
+        The members of a burst are the bodies (their kinematic-state
+        changes) and the overlay arrows (their versions) that have changed at
+        least once.  What it cannot know:
+
+        - a member whose updates stopped (its publisher ended) keeps it False:
+          frames then wait ``SETTLE`` s after the newest change;
+        - members updated at different rates (a 20 Hz IMU's arrows beside
+          50 Hz joint states) complete it only when their updates coincide;
+        - states faster than ``FRAME_RATE``: a burst completed early waits for
+          the frame clock, and the frame may show part of the next burst too;
+        - the first state of a new robot alone completes it, once.
         """
-        moved_since = [b.kinematic_state_changes > self._drawn_changes.get(name, 0)
-                       for name, b in self.bodies.items() if b.kinematic_state_changes]
+        moved_since = [count > self._drawn_changes.get(key, 0) for key, count in self._burst_members() if count]
         return bool(moved_since) and all(moved_since)
+
+    def _burst_members(self):
+        """((kind, name), change count) of every body and overlay arrow (owner thread)."""
+        for name, b in self.bodies.items():
+            yield ("body", name), b.kinematic_state_changes
+        for name, a in self.overlays.arrows.items():
+            yield ("arrow", name), a.version
 
     def changes(self) -> int:
         """Counts what changed the view (owner thread): bodies' kinematic-state changes and arrows.
