@@ -299,7 +299,7 @@ class App:
         A controller that moves a body calls ``body.notify_kinematic_state_change()``,
         as in Choreonoid, and that is what makes the view redraw.
         """
-        return sum(b.kinematic_state_changes for b in self.bodies.values()) + self.overlays.version
+        return sum(count for _, count in self._burst_members())
 
     def _sync_from_simulation(self) -> None:
         """Copy the simulation's newest snapshot into the main thread's data (owner thread)."""

@@ -95,7 +95,7 @@ class MainLoop:
         self._wakeup.set()
 
     def yield_to_owner(self, timeout: float = HAND_OVER_WAIT) -> bool:
-        """Step aside until the owner has taken the calls posted so far, by any thread (any thread but the owner).
+        """Step aside until the owner has taken every call posted so far (any thread but the owner).
 
         Blocking here lets go of the interpreter lock, so a main thread that
         was woken by the post runs it at once instead of waiting for this

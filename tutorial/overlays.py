@@ -98,11 +98,6 @@ class Overlays:
         arrow = self.arrows[name] = Arrow(name, color, opacity)
         return arrow
 
-    @property
-    def version(self) -> int:
-        """Counts changes to any arrow (main thread): a viewer redraws when it grows."""
-        return sum(a.version for a in self.arrows.values())
-
     def snapshot(self) -> dict[str, tuple[np.ndarray, np.ndarray, bool]]:
         """Every arrow's state now: ``{name: (origin (3,), vector (3,), visible)}``, copies (main thread).
 
