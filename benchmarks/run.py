@@ -169,8 +169,42 @@ def arm_projects(joints: int, directory: Path) -> tuple[Path, Path]:
 
 
 # ---------------------------------------------------------------- 1. simulation speed
+def in_thread(fn):
+    """``fn()`` run on a new thread, as the simulation runs on its own; returns its result."""
+    import threading
+
+    out = []
+    t = threading.Thread(target=lambda: out.append(fn()))
+    t.start()
+    t.join()
+    return out[0]
+
+
+def bare_steps_per_s(model, steps: int) -> float:
+    """Steps/s of a bare ``mj_step`` loop of ``steps`` steps on a fresh ``MjData`` of ``model`` (this thread)."""
+    import mujoco
+
+    data = mujoco.MjData(model)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        mujoco.mj_step(model, data)
+    return steps / (time.perf_counter() - t0)
+
+
+def run_steps(model, steps: int) -> int:
+    """``steps``, raised so that a bare run takes at least ``MIN_RUN_S``."""
+    fastest = max(in_thread(lambda: bare_steps_per_s(model, steps)) for _ in range(3))
+    return max(steps, int(np.ceil(MIN_RUN_S * fastest)))
+
+
 def median_ci95(values, resamples: int = 2000) -> tuple[float, float]:
-    """Bootstrap 95 % confidence interval of the median of ``values`` (a fixed seed: the same data, the same answer)."""
+    """Bootstrap 95 % confidence interval of the median of ``values`` (a fixed seed: the same data, the same answer).
+
+    It resamples single values, so it covers the scatter among them and
+    nothing that moves them all together: the simulation-speed pairs of one
+    run share the machine's state of that half minute, and two runs'
+    intervals need not overlap (set F's first and third did not).
+    """
     x = np.asarray(values, dtype=float)
     rng = np.random.default_rng(0)
     medians = np.median(x[rng.integers(0, x.size, size=(resamples, x.size))], axis=1)
@@ -186,13 +220,11 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
     interleaved runs of ``steps`` steps (bare, pipeline, bare, ...) on the
     same kind of thread; each pipeline run is divided by the mean of the bare runs on
     either side, and the median of those ratios is reported with its
-    quartiles and a bootstrap 95 % confidence interval of the median (how
-    far another run of as many pairs might land).  A run takes at least ``MIN_RUN_S`` of bare stepping
+    quartiles and a bootstrap 95 % confidence interval of the median (the
+    scatter among this run's pairs only, see :func:`median_ci95`).  A run takes at least ``MIN_RUN_S`` of bare stepping
     (``steps`` grows for a small model: a run of a few ms measures the
     scheduler, not the code).  No joystick drives the tanks here.
     """
-    import threading
-
     import mujoco
     import rclpy
 
@@ -206,21 +238,10 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
     model = build_world(proj.models, time_step=proj.simulator.time_step)
     node = rclpy.create_node(f"bench_speed_{random.randrange(10**6)}")
 
-    def in_thread(fn):
-        out = []
-        t = threading.Thread(target=lambda: out.append(fn()))
-        t.start()
-        t.join()
-        return out[0]
-
     def bare() -> float:
-        data = mujoco.MjData(model)
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            mujoco.mj_step(model, data)
-        return steps / (time.perf_counter() - t0)
+        return bare_steps_per_s(model, steps)
 
-    steps = max(steps, int(np.ceil(MIN_RUN_S * max(in_thread(bare) for _ in range(3)))))
+    steps = run_steps(model, steps)
     out: dict = {}
     bare_all = []
     try:
