@@ -57,9 +57,10 @@ SCALE_TANKS = (1, 2, 4, 8)
 SCALE_JOINTS = JOINT_COUNTS  # model/arm<N>.xml
 MIN_RUN_S = 0.05  # s: the shortest bare run of a simulation-speed pair
 # Interleaved pairs behind the targeted simulation-speed figure (the tank).  Here a
-# bare run against another bare run of ~50 ms spreads 0.8x to 1.15x (quartiles),
-# so the median of 60 pairs moved by +-0.04 from one run to the next: as much as
-# the target's margin.  Four times the pairs halve that (about 30 s per rate).
+# bare run of ~50 ms timed against other bare runs spreads 0.8-0.9x to 1.1-1.17x
+# (quartiles), so the median of 60 pairs moved by up to 0.1 from one figure to the
+# next, as much as the target's margin; with 240 pairs (about 30 s per rate) three
+# figures in a row spread by 0.02 (python -m benchmarks.speed_noise).
 SPEED_PAIRS = 240
 SPEED_PAIRS_OTHER = 60  # the 24-joint arm's figures: reported, not targeted
 SCALE_RATE = 50.0  # Hz: the Step 2 publisher's default, every body of the scale runs
@@ -221,9 +222,11 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
     same kind of thread; each pipeline run is divided by the mean of the bare runs on
     either side, and the median of those ratios is reported with its
     quartiles and a bootstrap 95 % confidence interval of the median (the
-    scatter among this run's pairs only, see :func:`median_ci95`).  A run takes at least ``MIN_RUN_S`` of bare stepping
-    (``steps`` grows for a small model: a run of a few ms measures the
-    scheduler, not the code).  No joystick drives the tanks here.
+    scatter among this run's pairs only, see :func:`median_ci95`).  A run
+    takes at least ``MIN_RUN_S`` of bare stepping (``steps`` grows for a
+    small model: a run of a few ms measures the scheduler, not the code).
+    No joystick drives the tanks here.  ``python -m benchmarks.speed_noise``
+    shows how precise the figure is on the machine at hand.
     """
     import mujoco
     import rclpy
