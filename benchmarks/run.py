@@ -198,6 +198,28 @@ def run_steps(model, steps: int) -> int:
     return max(steps, int(np.ceil(MIN_RUN_S * fastest)))
 
 
+def interleaved_ratios(run, bare, more) -> tuple[list[float], list[float], list[float]]:
+    """Time ``run()`` between bare runs (``bare()`` on a thread of its own) while ``more(pairs so far)``.
+
+    Each ``run()`` (steps/s) is divided by the mean of the bare runs on
+    either side; a bare run is shared by the pairs before and after it, so
+    a drift of the machine's speed over seconds cancels out.
+
+    Returns:
+        (ratios, the run() speeds, the bare speeds: two per pair).
+    """
+    ratios, speeds, bares = [], [], []
+    before = in_thread(bare)
+    while more(len(ratios)):
+        speed = run()
+        after = in_thread(bare)
+        ratios.append(speed / ((before + after) / 2))
+        speeds.append(speed)
+        bares += [before, after]
+        before = after
+    return ratios, speeds, bares
+
+
 def median_ci95(values, resamples: int = 2000) -> tuple[float, float]:
     """Bootstrap 95 % confidence interval of the median of ``values`` (a fixed seed: the same data, the same answer).
 
@@ -272,15 +294,8 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
                     raise RuntimeError(sim.error)
                 return sim.steps / sim.wall_time
 
-            ratios, speeds = [], []
-            before = in_thread(bare)
-            for _ in range(pairs):
-                p = pipeline()
-                after = in_thread(bare)
-                ratios.append(p / ((before + after) / 2))
-                speeds.append(p)
-                bare_all += [before, after]
-                before = after
+            ratios, speeds, bares = interleaved_ratios(pipeline, bare, lambda done: done < pairs)
+            bare_all += bares
             q1, med, q3 = np.percentile(ratios, [25, 50, 75])
             out[f"{label}_steps_per_s"] = round(float(np.median(speeds)))
             out[f"{label}_ratio"] = round(float(med), 3)

@@ -26,22 +26,22 @@ import time
 
 import numpy as np
 
-from benchmarks.run import ROOT, SPEED_PAIRS, bare_steps_per_s, in_thread, run_steps, simulation_speed
+from benchmarks.run import (ROOT, SPEED_PAIRS, bare_steps_per_s, in_thread, interleaved_ratios, run_steps,
+                            simulation_speed)
 
 PROJECT = "project/step2.yaml"
 
 
 def bare_against_bare(model, steps: int, seconds: float) -> list[float]:
-    """Ratios of bare runs to the mean of the bare runs on either side, for ``seconds`` s (any thread)."""
-    def run() -> float:
-        return in_thread(lambda: bare_steps_per_s(model, steps))
+    """Ratios of bare runs to the mean of the bare runs on either side, for ``seconds`` s (any thread).
 
-    ratios, before = [], run()
+    Paired exactly as the figure pairs its runs (:func:`benchmarks.run.interleaved_ratios`).
+    """
+    def bare() -> float:
+        return bare_steps_per_s(model, steps)
+
     deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
-        middle, after = run(), run()
-        ratios.append(middle / ((before + after) / 2))
-        before = after
+    ratios, _, _ = interleaved_ratios(lambda: in_thread(bare), bare, lambda done: time.monotonic() < deadline)
     return ratios
 
 
