@@ -2,7 +2,8 @@
 #   make demo   - the main job: Step 3 (simulation, demo joystick, viewer) in two meshcat pages
 #   make test   - the whole test suite: library, cross-process, launch, browser, and the notebooks (nbval)
 # Both create the virtual environment .venv on first use and reuse it after.
-# More: make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
+# More: make test-fast (the unit tier, under a minute: the inner loop), make lint (ruff check and format),
+#       make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test),
 #       make export (write the controllers from the notebooks that build them),
 #       make run-notebooks (run every notebook and save its outputs, the ones nbval checks).
@@ -11,7 +12,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test notebooks book bench export run-notebooks venv clean
+.PHONY: demo test test-fast lint notebooks book bench export run-notebooks venv clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -23,9 +24,18 @@ venv: $(VENV)/.installed
 demo: $(VENV)/.installed
 	$(PY) launch_py/step3_launch.py --demo
 
-test: $(VENV)/.installed
+# Every tier (tests/conftest.py lists them), the notebooks under nbval, after the lint gate.
+test: $(VENV)/.installed lint
 	bash scripts/ensure-chromium.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
+
+# The unit tier only: no ROS, no process, no browser.
+test-fast: $(VENV)/.installed
+	RTT_TEST_MODE=1 $(PY) -m pytest tests -m unit -q
+
+lint: $(VENV)/.installed
+	$(VENV)/bin/ruff check .
+	$(VENV)/bin/ruff format --check .
 
 # The notebooks carry recorded 3D views (scripts in their outputs): trusting the project's own
 # notebooks lets JupyterLab show them; an untrusted notebook shows those outputs empty.

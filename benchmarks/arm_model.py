@@ -45,9 +45,11 @@ def arm_xml(joints: int) -> str:
         indent = "  " * (k + 1)
         pos = "0 0 0.1" if k == 1 else f"0 0 {LINK_LENGTH:g}"
         axis = "0 1 0" if k % 2 else "0 0 1"
-        lines += [f'{indent}<body name="L{k}" pos="{pos}">',
-                  f'{indent}  <joint name="J{k:0{width}d}" axis="{axis}"/>',
-                  f'{indent}  <geom fromto="0 0 0 0 0 {LINK_LENGTH:g}"/>']
+        lines += [
+            f'{indent}<body name="L{k}" pos="{pos}">',
+            f'{indent}  <joint name="J{k:0{width}d}" axis="{axis}"/>',
+            f'{indent}  <geom fromto="0 0 0 0 0 {LINK_LENGTH:g}"/>',
+        ]
     for k in range(joints, 0, -1):
         lines.append("  " * (k + 1) + "</body>")
     lines += ["  </worldbody>", "  <actuator>"]

@@ -41,8 +41,12 @@ DEPTH = 1000  # keep last, publisher and readers: no drop by history under a sho
 def _qos():
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=DEPTH, reliability=ReliabilityPolicy.RELIABLE,
-                      durability=DurabilityPolicy.VOLATILE)
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST,
+        depth=DEPTH,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.VOLATILE,
+    )
 
 
 # ---------------------------------------------------------------- the two roles run as processes
@@ -52,7 +56,7 @@ def publish(rate: float, seconds: float, subscribers: int) -> int:
     from rclpy.duration import Duration
     from sensor_msgs.msg import JointState
 
-    from tutorial import ros_env
+    from tutorial.ros import env as ros_env
 
     ros_env.use_localhost_by_default()
     rclpy.init()
@@ -92,7 +96,7 @@ def count() -> int:
     from rclpy.signals import SignalHandlerOptions
     from sensor_msgs.msg import JointState
 
-    from tutorial import ros_env
+    from tutorial.ros import env as ros_env
 
     stop = []
     signal.signal(signal.SIGINT, lambda *a: stop.append(1))  # a plain list: see tutorial/bag/cli.py
@@ -146,14 +150,16 @@ def run(rate: float, seconds: float, compression: str, keep: str | None) -> dict
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     popen = dict(cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     counter = subprocess.Popen(py("benchmarks.bag", "count"), **popen)
-    recorder = subprocess.Popen(py("tutorial.bag", "record", TOPIC, "-o", str(bag), "--compression", compression,
-                                   "--overwrite"), **popen)
+    recorder = subprocess.Popen(
+        py("tutorial.bag", "record", TOPIC, "-o", str(bag), "--compression", compression, "--overwrite"), **popen
+    )
     procs = [counter, recorder]
     try:
         wait_line(counter, lambda line: '"ready"' in line, 60)
         wait_line(recorder, lambda line: "recording" in line, 60)
-        publisher = subprocess.Popen(py("benchmarks.bag", "pub", "--rate", str(rate), "--seconds", str(seconds)),
-                                     **popen)
+        publisher = subprocess.Popen(
+            py("benchmarks.bag", "pub", "--rate", str(rate), "--seconds", str(seconds)), **popen
+        )
         procs.append(publisher)
         wait_line(publisher, lambda line: '"start"' in line, 90)
         cpu0 = {p.pid: cpu_seconds(p.pid) for p in (counter, recorder)}
@@ -181,12 +187,21 @@ def run(rate: float, seconds: float, compression: str, keep: str | None) -> dict
     numbers = file_numbers(bag)
     sent = done["sent"]
     result = {
-        "rate_hz": rate, "seconds": seconds, "compression": compression,
-        "sent": sent, "send_seconds": round(done["seconds"], 3), "acked": done["acked"],
+        "rate_hz": rate,
+        "seconds": seconds,
+        "compression": compression,
+        "sent": sent,
+        "send_seconds": round(done["seconds"], 3),
+        "acked": done["acked"],
         "baseline": {"received": baseline["received"], "cpu_s": round(cpu[counter.pid], 3)},
-        "recorder": {"received": received, "written": written, "in_file": len(numbers),
-                     "missing_from_file": sent - len(set(numbers) & set(range(sent))),
-                     "in_order": numbers == sorted(numbers), "cpu_s": round(cpu[recorder.pid], 3)},
+        "recorder": {
+            "received": received,
+            "written": written,
+            "in_file": len(numbers),
+            "missing_from_file": sent - len(set(numbers) & set(range(sent))),
+            "in_order": numbers == sorted(numbers),
+            "cpu_s": round(cpu[recorder.pid], 3),
+        },
         "window_s": round(wall, 3),
         "file_bytes": bag.stat().st_size,
     }
@@ -207,19 +222,27 @@ def file_numbers(path: Path) -> list[int]:
 def report(r: dict) -> None:
     w = r["window_s"]
     b, rec = r["baseline"], r["recorder"]
-    print(f"\nrtt-bag record at {r['rate_hz']:.0f} Hz for {r['seconds']:.0f} s: sensor_msgs/JointState, 2 joints, "
-          f"reliable, keep last {DEPTH}; chunk compression {r['compression']}")
+    print(
+        f"\nrtt-bag record at {r['rate_hz']:.0f} Hz for {r['seconds']:.0f} s: sensor_msgs/JointState, 2 joints, "
+        f"reliable, keep last {DEPTH}; chunk compression {r['compression']}"
+    )
     print(f"sent {r['sent']} messages in {r['send_seconds']:.1f} s (all acknowledged: {r['acked']})")
     print(f"{'':24}{'received':>10}{'written':>10}{'missing':>9}{'CPU s':>8}{'CPU %':>7}{'us/msg':>8}")
-    for name, x, written, missing in (("bare raw subscriber", b, "-", r["sent"] - b["received"]),
-                                      ("rtt-bag record", rec, rec["written"], rec["missing_from_file"])):
+    for name, x, written, missing in (
+        ("bare raw subscriber", b, "-", r["sent"] - b["received"]),
+        ("rtt-bag record", rec, rec["written"], rec["missing_from_file"]),
+    ):
         per = x["cpu_s"] / max(1, x["received"]) * 1e6
-        print(f"{name:<24}{x['received']:>10}{written!s:>10}{missing:>9}{x['cpu_s']:>8.2f}"
-              f"{100 * x['cpu_s'] / w:>6.1f}%{per:>8.1f}")
+        print(
+            f"{name:<24}{x['received']:>10}{written!s:>10}{missing:>9}{x['cpu_s']:>8.2f}"
+            f"{100 * x['cpu_s'] / w:>6.1f}%{per:>8.1f}"
+        )
     print(f"recorder / baseline CPU: {r['cpu_ratio']}  (CPU over the {w:.1f} s window: sending, then 1 s for the tail)")
     size = r["file_bytes"]
-    print(f"file: {size / 2**20:.2f} MiB, {size / max(1, rec['written']):.1f} bytes per message; "
-          f"{rec['in_file']} messages in the file, in order: {rec['in_order']}")
+    print(
+        f"file: {size / 2**20:.2f} MiB, {size / max(1, rec['written']):.1f} bytes per message; "
+        f"{rec['in_file']} messages in the file, in order: {rec['in_order']}"
+    )
 
 
 def main(argv=None) -> int:

@@ -20,8 +20,8 @@ import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from sensor_msgs.msg import JointState
 
-from tutorial import ros_env
-from tutorial.controllers.joint_state_publisher import joint_state_qos
+from tutorial.interfaces.joint_state import joint_state_qos
+from tutorial.ros import env as ros_env
 
 TOPIC = "/Bare/joint_state"
 
@@ -32,8 +32,12 @@ def main() -> int:
     p.add_argument("--rate", type=float, default=1000.0)
     p.add_argument("--duration", type=float, default=8.0)
     p.add_argument("--joints", type=int, default=2)
-    p.add_argument("--executor", choices=["single", "events"], default="single",
-                   help="single: rclpy's default SingleThreadedExecutor (the baseline); events: EventsExecutor")
+    p.add_argument(
+        "--executor",
+        choices=["single", "events"],
+        default="single",
+        help="single: rclpy's default SingleThreadedExecutor (the baseline); events: EventsExecutor",
+    )
     args = p.parse_args()
     ros_env.use_localhost_by_default()
     rclpy.init()
@@ -62,6 +66,7 @@ def main() -> int:
 
         node.create_timer(1.0 / args.rate, tick)
     else:
+
         def on_message(msg):
             log.append((msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec, time.monotonic_ns()))
 

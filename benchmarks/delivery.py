@@ -5,7 +5,7 @@
 
 A publisher process sends ``--messages`` JointStates ``--gap`` s apart, each
 numbered in ``header.frame_id``.  Two subscriber processes read the same
-stream at the same time, each spun by :class:`tutorial.ros_env.SpinThread`:
+stream at the same time, each spun by :class:`tutorial.ros.env.SpinThread`:
 one on rclpy's ``SingleThreadedExecutor``, one on its ``EventsExecutor``.
 The publisher starts only after both subscribers' own sides have matched
 (their *matched* events), so no message can be lost to discovery.  With
@@ -43,7 +43,7 @@ BUSY_RATE = 60.0  # frames/s with --busy
 
 
 def _qos(depth: int):
-    from tutorial.controllers.joint_state_publisher import joint_state_qos
+    from tutorial.interfaces.joint_state import joint_state_qos
 
     qos = joint_state_qos()
     qos.depth = depth
@@ -72,7 +72,7 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float, busy: bool)
     from rclpy.event_handler import SubscriptionEventCallbacks
     from sensor_msgs.msg import JointState
 
-    from tutorial import ros_env
+    from tutorial.ros import env as ros_env
 
     ros_env.init()
     node = rclpy.create_node("delivery_sub_" + os.environ[ros_env.EXECUTOR_VARIABLE])
@@ -82,8 +82,13 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float, busy: bool)
         if status.current_count:
             out.with_suffix(".matched").touch()
 
-    node.create_subscription(JointState, TOPIC, lambda m: log.append((int(m.header.frame_id), time.monotonic_ns())),
-                             _qos(depth), event_callbacks=SubscriptionEventCallbacks(matched=matched))
+    node.create_subscription(
+        JointState,
+        TOPIC,
+        lambda m: log.append((int(m.header.frame_id), time.monotonic_ns())),
+        _qos(depth),
+        event_callbacks=SubscriptionEventCallbacks(matched=matched),
+    )
     spin = ros_env.SpinThread(node).start()
     _wait_for(out.parent / "done", timeout, busy)
     # The publisher is done once the last message is acknowledged; wait (at most 2 s)
@@ -104,14 +109,15 @@ def publisher(folder: Path, depth: int, messages: int, gap: float) -> None:
     from rclpy.duration import Duration
     from sensor_msgs.msg import JointState
 
-    from tutorial import ros_env
+    from tutorial.ros import env as ros_env
 
     ros_env.init()
     node = rclpy.create_node("delivery_pub")
     pub = node.create_publisher(JointState, TOPIC, _qos(depth))
     deadline = time.monotonic() + 30
-    while not (pub.get_subscription_count() >= len(EXECUTORS)
-               and all((folder / f"{e}.matched").exists() for e in EXECUTORS)):
+    while not (
+        pub.get_subscription_count() >= len(EXECUTORS) and all((folder / f"{e}.matched").exists() for e in EXECUTORS)
+    ):
         if time.monotonic() > deadline:
             raise SystemExit("the subscribers did not match within 30 s")
         time.sleep(0.01)
@@ -138,8 +144,13 @@ def one_run(messages: int, gap: float, depth: int, busy: bool) -> dict:
         folder = Path(d)
         me = [sys.executable, "-m", "benchmarks.delivery"]
         common = ["--depth", str(depth), "--messages", str(messages), "--gap", str(gap)] + (["--busy"] if busy else [])
-        procs = {e: subprocess.Popen(me + ["--role", "sub", "--out", str(folder / f"{e}.json")] + common,
-                                     env={**os.environ, "RTT_EXECUTOR": e}) for e in EXECUTORS}
+        procs = {
+            e: subprocess.Popen(
+                me + ["--role", "sub", "--out", str(folder / f"{e}.json")] + common,
+                env={**os.environ, "RTT_EXECUTOR": e},
+            )
+            for e in EXECUTORS
+        }
         procs["publisher"] = subprocess.Popen(me + ["--role", "pub", "--out", str(folder / "sent.json")] + common)
         limit = messages * gap + 60
         codes = {name: p.wait(timeout=limit) for name, p in procs.items()}
@@ -158,10 +169,20 @@ def one_run(messages: int, gap: float, depth: int, busy: bool) -> dict:
             if m in both:
                 continue
             nxt = next((t for n, t in received if n > m), None)
-            only.append((m, round((sent_ns[m + 1] - sent_ns[m]) * 1e-6, 1) if m + 1 < messages else None,
-                         round((nxt - sent_ns[m]) * 1e-6, 1) if nxt is not None else None))
-        report[e] = {"received": len(got[e]), "duplicates": len(received) - len(got[e]),
-                     "missing": len(missing[e]), "only_this_executor": only, "spin_error": r["spin_error"]}
+            only.append(
+                (
+                    m,
+                    round((sent_ns[m + 1] - sent_ns[m]) * 1e-6, 1) if m + 1 < messages else None,
+                    round((nxt - sent_ns[m]) * 1e-6, 1) if nxt is not None else None,
+                )
+            )
+        report[e] = {
+            "received": len(got[e]),
+            "duplicates": len(received) - len(got[e]),
+            "missing": len(missing[e]),
+            "only_this_executor": only,
+            "spin_error": r["spin_error"],
+        }
     return report
 
 
@@ -183,15 +204,21 @@ def main(argv=None) -> int:
         return 0
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
     report = one_run(args.messages, args.gap, args.depth, args.busy)
-    print(f"{report['sent']} messages {args.gap * 1000:g} ms apart, depth {args.depth}"
-          f"{', busy readers' if args.busy else ''}: missed by both executors {report['missed_by_both']}")
+    print(
+        f"{report['sent']} messages {args.gap * 1000:g} ms apart, depth {args.depth}"
+        f"{', busy readers' if args.busy else ''}: missed by both executors {report['missed_by_both']}"
+    )
     for e in EXECUTORS:
         r = report[e]
         only = r["only_this_executor"]
-        print(f"  {e:6s}: received {r['received']}, missing {r['missing']}, of which only here {len(only)}; "
-              f"duplicates {r['duplicates']}, spin error {r['spin_error']}")
-        print(f"          only here (number, next sent after ms, next taken after ms): {only[:12]}"
-              f"{' ...' if len(only) > 12 else ''}")
+        print(
+            f"  {e:6s}: received {r['received']}, missing {r['missing']}, of which only here {len(only)}; "
+            f"duplicates {r['duplicates']}, spin error {r['spin_error']}"
+        )
+        print(
+            f"          only here (number, next sent after ms, next taken after ms): {only[:12]}"
+            f"{' ...' if len(only) > 12 else ''}"
+        )
     return 0
 
 

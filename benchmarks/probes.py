@@ -14,8 +14,8 @@ import json
 import os
 import time
 
-from tutorial.controller import SimpleController
 from tutorial.controllers.joint_state_subscriber import RttJointStateMonitor
+from tutorial.core.controller import SimpleController
 
 
 def _write(record: dict, body_name: str | None = None) -> None:
@@ -74,7 +74,16 @@ class ProbedJointStateSubscriber(RttJointStateMonitor):
     def unconfigure(self) -> None:
         super().unconfigure()
         loop = self.config.call_later.__self__  # the MainLoop: its counters show whether a backlog grew
-        _write({"applied": self.applied_log, "frames": self.frame_log,
-                "posted": loop.posted, "coalesced": loop.coalesced, "executed": loop.executed,
-                "max_pending": loop.max_pending, "yields": loop.yields,
-                "yield_timeouts": loop.yield_timeouts}, self.config.body_name)
+        _write(
+            {
+                "applied": self.applied_log,
+                "frames": self.frame_log,
+                "posted": loop.posted,
+                "coalesced": loop.coalesced,
+                "executed": loop.executed,
+                "max_pending": loop.max_pending,
+                "yields": loop.yields,
+                "yield_timeouts": loop.yield_timeouts,
+            },
+            self.config.body_name,
+        )

@@ -66,8 +66,16 @@ SPEED_PAIRS_OTHER = 60  # the 24-joint arm's figures: reported, not targeted
 SCALE_RATE = 50.0  # Hz: the Step 2 publisher's default, every body of the scale runs
 # Where the tanks of an N-tank world start (x, y in m): in two rows across the 6 m room,
 # clear of its crates and pillar and of each other.
-TANK_POSITIONS = ((-2.1, -0.6), (-0.7, 0.6), (0.7, -0.6), (2.1, 0.6),
-                  (-2.1, 0.6), (-0.7, -0.6), (0.7, 0.6), (2.1, -0.6))
+TANK_POSITIONS = (
+    (-2.1, -0.6),
+    (-0.7, 0.6),
+    (0.7, -0.6),
+    (2.1, 0.6),
+    (-2.1, 0.6),
+    (-0.7, -0.6),
+    (0.7, 0.6),
+    (2.1, -0.6),
+)
 
 
 # ---------------------------------------------------------------- helpers
@@ -76,8 +84,13 @@ def pct(values, scale=1.0) -> dict:
     if len(values) == 0:
         return {"n": 0, "p50": None, "p90": None, "p99": None, "max": None}
     a = np.asarray(values, dtype=float) * scale
-    return {"n": int(a.size), "p50": round(float(np.percentile(a, 50)), 3), "p90": round(float(np.percentile(a, 90)), 3),
-            "p99": round(float(np.percentile(a, 99)), 3), "max": round(float(a.max()), 3)}
+    return {
+        "n": int(a.size),
+        "p50": round(float(np.percentile(a, 50)), 3),
+        "p90": round(float(np.percentile(a, 90)), 3),
+        "p99": round(float(np.percentile(a, 99)), 3),
+        "max": round(float(a.max()), 3),
+    }
 
 
 def cpu_seconds(pid: int) -> float:
@@ -131,7 +144,7 @@ def write_yaml(path: Path, project: dict) -> Path:
 STEP_CLOCK = ("StepClock", "benchmarks.probes:StepClock")
 STEP1 = ("RttTankController", "tutorial.controllers.tank_controller:RttTankController")
 STEP2 = ("RttJointStatePublisher", "tutorial.controllers.joint_state_publisher:RttJointStatePublisher")
-SWING = ("SwingController", "tutorial.controllers.swing_controller:SwingController")
+SWING = ("SwingController", "tests.fixtures.swing_controller:SwingController")
 MONITOR = ("RttJointStateMonitor", "benchmarks.probes:ProbedJointStateSubscriber")
 SIMULATOR = {"time_step": 0.001, "realtime_sync": True}
 
@@ -153,8 +166,10 @@ def tanks_projects(n: int, directory: Path) -> tuple[Path, Path]:
         place = {"name": f"Tank{i + 1}", "file": tank, "position": [x, y, 0.0]}
         sim_models.append({**place, "controllers": _controllers(*([STEP_CLOCK] if i == 0 else []), STEP1, STEP2)})
         view_models.append({**place, "position": list(place["position"]), "controllers": _controllers(MONITOR)})
-    sim = write_yaml(directory / f"tanks{n}_sim.yaml", {"name": f"bench_tanks{n}_sim", "models": sim_models,
-                                                        "simulator": dict(SIMULATOR)})
+    sim = write_yaml(
+        directory / f"tanks{n}_sim.yaml",
+        {"name": f"bench_tanks{n}_sim", "models": sim_models, "simulator": dict(SIMULATOR)},
+    )
     view = write_yaml(directory / f"tanks{n}_view.yaml", {"name": f"bench_tanks{n}_view", "models": view_models})
     return sim, view
 
@@ -162,10 +177,18 @@ def tanks_projects(n: int, directory: Path) -> tuple[Path, Path]:
 def arm_projects(joints: int, directory: Path) -> tuple[Path, Path]:
     """Project files of one ``model/arm<joints>.xml`` arm swinging (step clock, sine PD, publisher) and its viewer."""
     arm = {"name": f"Arm{joints}", "file": str(ROOT / "model" / f"arm{joints}.xml")}
-    sim = write_yaml(directory / f"arm{joints}_sim.yaml", {"name": f"bench_arm{joints}_sim", "models": [
-        {**arm, "controllers": _controllers(STEP_CLOCK, SWING, STEP2)}], "simulator": dict(SIMULATOR)})
-    view = write_yaml(directory / f"arm{joints}_view.yaml", {"name": f"bench_arm{joints}_view", "models": [
-        {**arm, "controllers": _controllers(MONITOR)}]})
+    sim = write_yaml(
+        directory / f"arm{joints}_sim.yaml",
+        {
+            "name": f"bench_arm{joints}_sim",
+            "models": [{**arm, "controllers": _controllers(STEP_CLOCK, SWING, STEP2)}],
+            "simulator": dict(SIMULATOR),
+        },
+    )
+    view = write_yaml(
+        directory / f"arm{joints}_view.yaml",
+        {"name": f"bench_arm{joints}_view", "models": [{**arm, "controllers": _controllers(MONITOR)}]},
+    )
     return sim, view
 
 
@@ -253,11 +276,11 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
     import mujoco
     import rclpy
 
-    from tutorial.body import Body
-    from tutorial.controller import ControllerConfig
-    from tutorial.project import load_project
-    from tutorial.simulator import Attachment, Simulator
-    from tutorial.world import build_world
+    from tutorial.core.body import Body
+    from tutorial.core.controller import ControllerConfig
+    from tutorial.core.project import load_project
+    from tutorial.core.simulator import Attachment, Simulator
+    from tutorial.core.world import build_world
 
     proj = load_project(ROOT / project)
     model = build_world(proj.models, time_step=proj.simulator.time_step)
@@ -280,15 +303,17 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
                     if "rate" in params:
                         params["rate"] = rate
                     controller = c.cls()
-                    config = ControllerConfig(name=c.name, body=Body(model, mujoco.MjData(model), m.name), node=node,
-                                              parameters=params)
+                    config = ControllerConfig(
+                        name=c.name, body=Body(model, mujoco.MjData(model), m.name), node=node, parameters=params
+                    )
                     assert controller.configure(config)
                     attachments.append(Attachment(c.name, controller, m.name))
 
             def pipeline() -> float:
                 data = mujoco.MjData(model)
-                sim = Simulator(model, data, attachments, node=node, realtime_sync=False,
-                                duration=steps * model.opt.timestep).start()
+                sim = Simulator(
+                    model, data, attachments, node=node, realtime_sync=False, duration=steps * model.opt.timestep
+                ).start()
                 sim.join()
                 if sim.error:
                     raise RuntimeError(sim.error)
@@ -313,14 +338,21 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
 
 def realtime_mode(project: str, seconds: float) -> dict:
     """Real-time factor and step overrun percentiles with every controller on, in real-time mode."""
-    from tutorial.app import App
-    from tutorial.project import load_project
+    from tutorial.core.app import App
+    from tutorial.core.project import load_project
 
     proj = load_project(ROOT / project)
     for m in proj.models:
         m.controllers = [c for c in m.controllers if c.name != "StepClock"]
-    app = App(proj, node_name=f"bench_rt_{random.randrange(10**6)}", headless=True, realtime_sync=True,
-              duration=seconds, output=lambda r: None, record_timing=True)
+    app = App(
+        proj,
+        node_name=f"bench_rt_{random.randrange(10**6)}",
+        headless=True,
+        realtime_sync=True,
+        duration=seconds,
+        output=lambda r: None,
+        record_timing=True,
+    )
     try:
         app.open()
         app.run()
@@ -356,8 +388,16 @@ def _summary(stdout: str) -> dict:
     raise RuntimeError(f"no summary in the simulation's output:\n{stdout[-2000:]}")
 
 
-def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float, seconds: float, warmup: float,
-                 headless_view: bool = False, executor: str | None = None, joystick: bool = False) -> dict:
+def pipeline_run(
+    sim_project: str | Path,
+    view_project: str | Path,
+    rate: float,
+    seconds: float,
+    warmup: float,
+    headless_view: bool = False,
+    executor: str | None = None,
+    joystick: bool = False,
+) -> dict:
     """One run of simulation and viewer as two processes: raw samples, joined on the states' stamps.
 
     ``executor`` is the spin threads' (``RTT_EXECUTOR``; None: the
@@ -382,11 +422,20 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
         try:
             procs["viewer"] = start(view_cmd + ["--duration", str(seconds + 8.0)], view_probe, env)
             time.sleep(1.0)  # not synchronisation: the viewer starts first so it misses nothing
-            sim_cmd = py("tutorial.runner", str(sim_project), "--headless", "--duration", str(seconds),
-                         "--json", "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}")
+            sim_cmd = py(
+                "tutorial.tools.rtt_run",
+                str(sim_project),
+                "--headless",
+                "--duration",
+                str(seconds),
+                "--json",
+                "--ros-args",
+                "-p",
+                f"RttJointStatePublisher.rate:={rate}",
+            )
             procs["simulation"] = start(sim_cmd, sim_probe, env)
             if joystick:
-                procs["joystick"] = start(py("tutorial.joy_node", "--demo", "--duration", str(seconds + 6.0)))
+                procs["joystick"] = start(py("tutorial.tools.rtt_joy", "--demo", "--duration", str(seconds + 6.0)))
             cpu = steady_cpu_cores(procs, seconds, warmup)
             summary = _summary(finish(procs["simulation"], seconds + 30))
             finish(procs["viewer"], seconds + 30)
@@ -404,11 +453,20 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
         raise RuntimeError(f"the viewer of {view_project} wrote no probe file")
     step_wall = {round(t / 1000): w for t, w in zip(s["sim_ns"], s["wall_ns"])}
     end_ns = s["wall_ns"][-1]  # the simulation's last step: frames after it show an old state
-    out = {"latency": [], "step_to_callback": [], "callback_to_applied": [], "ages": [], "first_shown_ages": [],
-           "frames": 0, "frame_span_s": 0.0, "scene_update_s": [],
-           "messages": {"applied": 0, "posted": 0, "coalesced": 0, "max_pending": 0, "yields": 0,
-                        "yield_timeouts": 0},
-           "cpu_cores": cpu, "real_time_factor": summary.get("real_time_factor"), "bodies": len(views)}
+    out = {
+        "latency": [],
+        "step_to_callback": [],
+        "callback_to_applied": [],
+        "ages": [],
+        "first_shown_ages": [],
+        "frames": 0,
+        "frame_span_s": 0.0,
+        "scene_update_s": [],
+        "messages": {"applied": 0, "posted": 0, "coalesced": 0, "max_pending": 0, "yields": 0, "yield_timeouts": 0},
+        "cpu_cores": cpu,
+        "real_time_factor": summary.get("real_time_factor"),
+        "bodies": len(views),
+    }
     starts = []  # each body's measured window starts here (ns)
     for v in views:
         # The measured window: from the first state this body's viewer applied (discovery can
@@ -417,13 +475,19 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
             raise RuntimeError(f"the viewer applied no state in the {sim_project} run")
         start_ns = v["applied"][0][2] + int(warmup * 1e9)
         starts.append(start_ns)
-        window = [(step_wall[round(stamp / 1000)], arrived, applied) for stamp, arrived, applied in v["applied"]
-                  if round(stamp / 1000) in step_wall and start_ns <= applied <= end_ns]
+        window = [
+            (step_wall[round(stamp / 1000)], arrived, applied)
+            for stamp, arrived, applied in v["applied"]
+            if round(stamp / 1000) in step_wall and start_ns <= applied <= end_ns
+        ]
         out["latency"] += [applied - step for step, _, applied in window]
         out["step_to_callback"] += [arrived - step for step, arrived, _ in window]
         out["callback_to_applied"] += [applied - arrived for _, arrived, applied in window]
-        frames = [(t, stamp, cost) for t, stamp, cost in v["frames"]
-                  if start_ns <= t <= end_ns and round(stamp / 1000) in step_wall]
+        frames = [
+            (t, stamp, cost)
+            for t, stamp, cost in v["frames"]
+            if start_ns <= t <= end_ns and round(stamp / 1000) in step_wall
+        ]
         out["ages"] += [t - step_wall[round(stamp / 1000)] for t, stamp, _ in frames]
         shown = None
         for t, stamp, _ in frames:
@@ -445,7 +509,7 @@ def pipeline_run(sim_project: str | Path, view_project: str | Path, rate: float,
 def pool_pipeline(runs: list[dict], rate: float) -> dict:
     """The pipeline's figures over interleaved runs: samples pooled, CPU averaged, counts summed."""
     ages_first = [a for r in runs for a in r["ages"][: len(r["ages"]) // 2]]
-    ages_second = [a for r in runs for a in r["ages"][len(r["ages"]) // 2:]]
+    ages_second = [a for r in runs for a in r["ages"][len(r["ages"]) // 2 :]]
     span = sum(r["frame_span_s"] for r in runs)
     cpu = {k: round(statistics.mean(r["cpu_cores"][k] for r in runs), 3) for k in runs[0]["cpu_cores"]}
     rtf = [r["real_time_factor"] for r in runs if r.get("real_time_factor") is not None]
@@ -462,12 +526,14 @@ def pool_pipeline(runs: list[dict], rate: float) -> dict:
         "first_shown_age_ms": pct([a for r in runs for a in r["first_shown_ages"]], 1e-6),
         "frames_per_s": round(sum(r["frames"] for r in runs) / span, 1) if span > 0 else 0.0,
         "scene_update_ms": pct([c for r in runs for c in r["scene_update_s"]], 1000.0),
-        "messages": {"applied": sum(r["messages"]["applied"] for r in runs),
-                     "posted": sum(r["messages"]["posted"] for r in runs),
-                     "coalesced": sum(r["messages"]["coalesced"] for r in runs),
-                     "max_pending": max(r["messages"]["max_pending"] for r in runs),
-                     "yields": sum(r["messages"]["yields"] for r in runs),
-                     "yield_timeouts": sum(r["messages"]["yield_timeouts"] for r in runs)},
+        "messages": {
+            "applied": sum(r["messages"]["applied"] for r in runs),
+            "posted": sum(r["messages"]["posted"] for r in runs),
+            "coalesced": sum(r["messages"]["coalesced"] for r in runs),
+            "max_pending": max(r["messages"]["max_pending"] for r in runs),
+            "yields": sum(r["messages"]["yields"] for r in runs),
+            "yield_timeouts": sum(r["messages"]["yield_timeouts"] for r in runs),
+        },
         "cpu_cores": {**cpu, "total": round(sum(cpu.values()), 3)},
         "real_time_factor": round(min(rtf), 4) if rtf else None,
         "real_time_factors": [round(x, 4) for x in rtf],
@@ -485,23 +551,31 @@ def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, execu
         probe = Path(d) / "bare.json"
         sub = start(py("benchmarks.bare_pair", "sub", "--duration", str(seconds + 8.0), "--executor", executor), probe)
         time.sleep(1.0)  # not synchronisation: the subscriber starts first so it misses nothing
-        pub = start(py("benchmarks.bare_pair", "pub", "--rate", str(rate), "--duration", str(seconds),
-                       "--joints", str(joints)))
+        pub = start(
+            py("benchmarks.bare_pair", "pub", "--rate", str(rate), "--duration", str(seconds), "--joints", str(joints))
+        )
         cpu = sum(steady_cpu_cores({"pub": pub, "sub": sub}, seconds, warmup).values())
         finish(pub, seconds + 30)
         finish(sub, seconds + 30)
         received = json.loads(probe.read_text())["received"]
     first = received[0][1] if received else 0
-    return {"latency": [r - s for s, r in received if r >= first + int(warmup * 1e9)], "received": len(received),
-            "cpu_cores": cpu}
+    return {
+        "latency": [r - s for s, r in received if r >= first + int(warmup * 1e9)],
+        "received": len(received),
+        "cpu_cores": cpu,
+    }
 
 
 def pool_bare(runs: list[dict], rate: float) -> dict:
     latency = [x for r in runs for x in r["latency"]]
-    return {"rate_hz": rate, "runs": len(runs), "latency_ms": pct(latency, 1e-6),
-            "received": sum(r["received"] for r in runs),
-            "cpu_cores": round(statistics.mean(r["cpu_cores"] for r in runs), 3),
-            "latency_samples_ms": sorted(round(x * 1e-6, 4) for x in latency)}
+    return {
+        "rate_hz": rate,
+        "runs": len(runs),
+        "latency_ms": pct(latency, 1e-6),
+        "received": sum(r["received"] for r in runs),
+        "cpu_cores": round(statistics.mean(r["cpu_cores"] for r in runs), 3),
+        "latency_samples_ms": sorted(round(x * 1e-6, 4) for x in latency),
+    }
 
 
 # ---------------------------------------------------------------- 3b. meshcat cost per frame
@@ -513,9 +587,9 @@ def scene_update_cost(model_file: str, frames: int) -> dict:
     """
     import mujoco
 
-    from tutorial.meshcat_server import start_server
-    from tutorial.scene import Scene
-    from tutorial.world import ModelEntry, build_world
+    from tutorial.core.world import ModelEntry, build_world
+    from tutorial.view.meshcat_server import start_server
+    from tutorial.view.scene import Scene
 
     model = build_world([ModelEntry("M", ROOT / model_file)])
     data = mujoco.MjData(model)
@@ -549,8 +623,13 @@ def startup(repeats: int) -> dict:
     times = []
     for _ in range(repeats):
         t0 = time.monotonic()
-        proc = subprocess.Popen([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"],
-                                cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        proc = subprocess.Popen(
+            [sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         first = None
         deadline = t0 + 60
         for line in proc.stdout:
@@ -590,8 +669,10 @@ def scale_curves(seconds: float, warmup: float, rounds: int, pairs: int, directo
         configs[("joints", n)] = (*arm_projects(n, directory), False)
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     try:
-        speeds = {key: simulation_speed(sim, {"publisher_50Hz": SCALE_RATE}, pairs, 1000)
-                  for key, (sim, _, _) in configs.items()}
+        speeds = {
+            key: simulation_speed(sim, {"publisher_50Hz": SCALE_RATE}, pairs, 1000)
+            for key, (sim, _, _) in configs.items()
+        }
     finally:
         rclpy.try_shutdown()
     runs: dict = {key: [] for key in configs}
@@ -615,26 +696,48 @@ def targets(r: dict) -> list[dict]:
     sim = r["simulation_speed"]["tank"]
     lat, blat = tank1k["latency_ms"], bare1k["latency_ms"]
     out = [
-        {"target": "simulation with the 50 Hz publisher >= 0.8x bare mj_step (steps/s)",
-         "measured": f"{sim['publisher_50Hz_steps_per_s']:,} steps/s", "baseline": f"{sim['bare_steps_per_s']:,} steps/s",
-         "ratio": f"{sim['publisher_50Hz_ratio']:.3f}x", "pass": sim["publisher_50Hz_ratio"] >= 0.8},
-        {"target": "end-to-end p50 <= 1.5x the bare rclpy pair at 1 kHz",
-         "measured": f"{lat['p50']:.3f} ms", "baseline": f"{blat['p50']:.3f} ms",
-         "ratio": f"{lat['p50'] / blat['p50']:.2f}x", "pass": lat["p50"] <= 1.5 * blat["p50"]},
-        {"target": "end-to-end p99 <= 2x the bare rclpy pair at 1 kHz",
-         "measured": f"{lat['p99']:.3f} ms", "baseline": f"{blat['p99']:.3f} ms",
-         "ratio": f"{lat['p99'] / blat['p99']:.2f}x", "pass": lat["p99"] <= 2 * blat["p99"]},
-        {"target": "displayed-state age p99 at 1 kHz <= 16.7 ms + the bare pair's p99",
-         "measured": f"{tank1k['displayed_age_ms']['p99']:.2f} ms",
-         "baseline": f"{FRAME_60HZ_MS:.1f} + {blat['p99']:.2f} ms",
-         "ratio": f"{tank1k['displayed_age_ms']['p99'] / (FRAME_60HZ_MS + blat['p99']):.2f}x",
-         "pass": tank1k["displayed_age_ms"]["p99"] <= FRAME_60HZ_MS + blat["p99"]},
-        {"target": "Step 3 pipeline at 1 kHz <= 1 CPU core", "measured": f"{tank1k['cpu_cores']['total']:.2f} cores",
-         "baseline": f"bare pair {bare1k['cpu_cores']:.2f} cores",
-         "ratio": f"{tank1k['cpu_cores']['total'] / bare1k['cpu_cores']:.2f}x",
-         "pass": tank1k["cpu_cores"]["total"] <= 1.0},
-        {"target": "first state shown <= 3 s after launch", "measured": f"{r['startup']['median_s']:.2f} s",
-         "baseline": "", "ratio": "", "pass": r["startup"]["median_s"] <= 3.0},
+        {
+            "target": "simulation with the 50 Hz publisher >= 0.8x bare mj_step (steps/s)",
+            "measured": f"{sim['publisher_50Hz_steps_per_s']:,} steps/s",
+            "baseline": f"{sim['bare_steps_per_s']:,} steps/s",
+            "ratio": f"{sim['publisher_50Hz_ratio']:.3f}x",
+            "pass": sim["publisher_50Hz_ratio"] >= 0.8,
+        },
+        {
+            "target": "end-to-end p50 <= 1.5x the bare rclpy pair at 1 kHz",
+            "measured": f"{lat['p50']:.3f} ms",
+            "baseline": f"{blat['p50']:.3f} ms",
+            "ratio": f"{lat['p50'] / blat['p50']:.2f}x",
+            "pass": lat["p50"] <= 1.5 * blat["p50"],
+        },
+        {
+            "target": "end-to-end p99 <= 2x the bare rclpy pair at 1 kHz",
+            "measured": f"{lat['p99']:.3f} ms",
+            "baseline": f"{blat['p99']:.3f} ms",
+            "ratio": f"{lat['p99'] / blat['p99']:.2f}x",
+            "pass": lat["p99"] <= 2 * blat["p99"],
+        },
+        {
+            "target": "displayed-state age p99 at 1 kHz <= 16.7 ms + the bare pair's p99",
+            "measured": f"{tank1k['displayed_age_ms']['p99']:.2f} ms",
+            "baseline": f"{FRAME_60HZ_MS:.1f} + {blat['p99']:.2f} ms",
+            "ratio": f"{tank1k['displayed_age_ms']['p99'] / (FRAME_60HZ_MS + blat['p99']):.2f}x",
+            "pass": tank1k["displayed_age_ms"]["p99"] <= FRAME_60HZ_MS + blat["p99"],
+        },
+        {
+            "target": "Step 3 pipeline at 1 kHz <= 1 CPU core",
+            "measured": f"{tank1k['cpu_cores']['total']:.2f} cores",
+            "baseline": f"bare pair {bare1k['cpu_cores']:.2f} cores",
+            "ratio": f"{tank1k['cpu_cores']['total'] / bare1k['cpu_cores']:.2f}x",
+            "pass": tank1k["cpu_cores"]["total"] <= 1.0,
+        },
+        {
+            "target": "first state shown <= 3 s after launch",
+            "measured": f"{r['startup']['median_s']:.2f} s",
+            "baseline": "",
+            "ratio": "",
+            "pass": r["startup"]["median_s"] <= 3.0,
+        },
     ]
     scale = r.get("scale")
     if scale:
@@ -643,21 +746,34 @@ def targets(r: dict) -> list[dict]:
         age = eight["first_shown_age_ms"]["p99"]
         rtf = eight["real_time_factor"]
         out += [
-            {"target": "8 tanks simulate in real time (real-time factor >= 0.99, the lowest run)",
-             "measured": "n/a" if rtf is None else f"{rtf:.3f}", "baseline": "1.000 (wall clock)",
-             "ratio": "" if rtf is None else f"{rtf:.3f}x",
-             "pass": rtf is not None and rtf >= 0.99},
-            {"target": "the viewer mirrors all 8 at >= 50 frames/s", "measured": f"{eight['frames_per_s']:.1f} frames/s",
-             "baseline": f"{SCALE_RATE:.0f} states/s per tank (cap 60)",
-             "ratio": f"{eight['frames_per_s'] / SCALE_RATE:.2f}x",
-             "pass": eight["frames_per_s"] >= 50.0},
-            {"target": "8 tanks: displayed-state age p99 <= 16.7 ms + the bare pair's p99 (50 Hz)",
-             "measured": f"{age:.2f} ms", "baseline": f"{FRAME_60HZ_MS:.1f} + {bare50['p99']:.2f} ms",
-             "ratio": f"{age / (FRAME_60HZ_MS + bare50['p99']):.2f}x",
-             "pass": age <= FRAME_60HZ_MS + bare50["p99"]},
-            {"target": "8 tanks: the whole pipeline <= 1.5 CPU cores",
-             "measured": f"{eight['cpu_cores']['total']:.2f} cores", "baseline": "", "ratio": "",
-             "pass": eight["cpu_cores"]["total"] <= 1.5},
+            {
+                "target": "8 tanks simulate in real time (real-time factor >= 0.99, the lowest run)",
+                "measured": "n/a" if rtf is None else f"{rtf:.3f}",
+                "baseline": "1.000 (wall clock)",
+                "ratio": "" if rtf is None else f"{rtf:.3f}x",
+                "pass": rtf is not None and rtf >= 0.99,
+            },
+            {
+                "target": "the viewer mirrors all 8 at >= 50 frames/s",
+                "measured": f"{eight['frames_per_s']:.1f} frames/s",
+                "baseline": f"{SCALE_RATE:.0f} states/s per tank (cap 60)",
+                "ratio": f"{eight['frames_per_s'] / SCALE_RATE:.2f}x",
+                "pass": eight["frames_per_s"] >= 50.0,
+            },
+            {
+                "target": "8 tanks: displayed-state age p99 <= 16.7 ms + the bare pair's p99 (50 Hz)",
+                "measured": f"{age:.2f} ms",
+                "baseline": f"{FRAME_60HZ_MS:.1f} + {bare50['p99']:.2f} ms",
+                "ratio": f"{age / (FRAME_60HZ_MS + bare50['p99']):.2f}x",
+                "pass": age <= FRAME_60HZ_MS + bare50["p99"],
+            },
+            {
+                "target": "8 tanks: the whole pipeline <= 1.5 CPU cores",
+                "measured": f"{eight['cpu_cores']['total']:.2f} cores",
+                "baseline": "",
+                "ratio": "",
+                "pass": eight["cpu_cores"]["total"] <= 1.5,
+            },
         ]
     return out
 
@@ -666,8 +782,10 @@ def targets_markdown(r: dict) -> str:
     """The targets as a Markdown table (the book's first table)."""
     lines = ["| target | measured | baseline, same run | ratio | |", "|---|---|---|---|---|"]
     for t in r["targets"]:
-        lines.append(f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | "
-                     f"{'pass' if t['pass'] else '**FAIL**'} |")
+        lines.append(
+            f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | "
+            f"{'pass' if t['pass'] else '**FAIL**'} |"
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -679,8 +797,10 @@ def runs_table(paths: list[str]) -> str:
     """
     runs = [json.loads(Path(p).read_text()) for p in paths]
     last = runs[-1]
-    lines = [f"| target | measured | baseline, same run | ratio | runs {', '.join(str(i + 1) for i in range(len(runs)))} |",
-             "|---|---|---|---|---|"]
+    lines = [
+        f"| target | measured | baseline, same run | ratio | runs {', '.join(str(i + 1) for i in range(len(runs)))} |",
+        "|---|---|---|---|---|",
+    ]
     for i, t in enumerate(last["targets"]):
         each = []
         for r in runs:
@@ -700,32 +820,46 @@ def print_report(r: dict) -> None:
                 label = k[: -len("_steps_per_s")]
                 q1, q3 = s[label + "_ratio_quartiles"]
                 lo, hi = s.get(label + "_ratio_ci95", (float("nan"),) * 2)
-                parts.append(f"{label} {s[k]} ({s[label + '_ratio']:.3f}x, 95% CI {lo:.3f}-{hi:.3f}, "
-                             f"quartiles {q1:.2f}-{q3:.2f})")
+                parts.append(
+                    f"{label} {s[k]} ({s[label + '_ratio']:.3f}x, 95% CI {lo:.3f}-{hi:.3f}, "
+                    f"quartiles {q1:.2f}-{q3:.2f})"
+                )
         print(f"  {name:5s} " + ", ".join(parts) + f"  [{s['pairs']} interleaved pairs of {s['steps_per_run']} steps]")
     rt = r["realtime"]
-    print(f"  real-time mode (tank, all controllers): real-time factor {rt['real_time_factor']}, "
-          f"step overrun p50 {rt['overrun_ms']['p50']} ms, p99 {rt['overrun_ms']['p99']} ms, max {rt['overrun_ms']['max']} ms")
-    print(f"\n== end-to-end latency across processes (ms): step -> applied on the viewer's main thread; bare pair: "
-          f"publish -> callback ({r['rounds']} interleaved rounds of {r['seconds_per_run']:g} s each, samples pooled)")
-    print(f"  {'run':14s} {'p50':>7s} {'p90':>7s} {'p99':>7s} {'max':>8s}   {'bare p50':>8s} {'bare p99':>8s}  ratio p50/p99")
+    print(
+        f"  real-time mode (tank, all controllers): real-time factor {rt['real_time_factor']}, "
+        f"step overrun p50 {rt['overrun_ms']['p50']} ms, p99 {rt['overrun_ms']['p99']} ms, max {rt['overrun_ms']['max']} ms"
+    )
+    print(
+        f"\n== end-to-end latency across processes (ms): step -> applied on the viewer's main thread; bare pair: "
+        f"publish -> callback ({r['rounds']} interleaved rounds of {r['seconds_per_run']:g} s each, samples pooled)"
+    )
+    print(
+        f"  {'run':14s} {'p50':>7s} {'p90':>7s} {'p99':>7s} {'max':>8s}   {'bare p50':>8s} {'bare p99':>8s}  ratio p50/p99"
+    )
     for key, run in r["pipeline"].items():
         bare = r["bare"][key]["latency_ms"]
         lat = run["latency_ms"]
-        print(f"  {key:14s} {lat['p50']:7.3f} {lat['p90']:7.3f} {lat['p99']:7.3f} {lat['max']:8.3f}   {bare['p50']:8.3f} "
-              f"{bare['p99']:8.3f}  {lat['p50'] / bare['p50']:.2f} / {lat['p99'] / bare['p99']:.2f}")
+        print(
+            f"  {key:14s} {lat['p50']:7.3f} {lat['p90']:7.3f} {lat['p99']:7.3f} {lat['max']:8.3f}   {bare['p50']:8.3f} "
+            f"{bare['p99']:8.3f}  {lat['p50'] / bare['p50']:.2f} / {lat['p99'] / bare['p99']:.2f}"
+        )
     for key, bare in r.get("bare_events_executor", {}).items():
         lat = bare["latency_ms"]
-        print(f"  (not a target: {key} bare pair with its subscriber on the EventsExecutor: p50 {lat['p50']:.3f}, "
-              f"p99 {lat['p99']:.3f}; the tutorial's p50/p99 are {r['pipeline'][key]['latency_ms']['p50'] / lat['p50']:.2f}x"
-              f" / {r['pipeline'][key]['latency_ms']['p99'] / lat['p99']:.2f}x these)")
+        print(
+            f"  (not a target: {key} bare pair with its subscriber on the EventsExecutor: p50 {lat['p50']:.3f}, "
+            f"p99 {lat['p99']:.3f}; the tutorial's p50/p99 are {r['pipeline'][key]['latency_ms']['p50'] / lat['p50']:.2f}x"
+            f" / {r['pipeline'][key]['latency_ms']['p99'] / lat['p99']:.2f}x these)"
+        )
     for key, run in r.get("pipeline_events_executor", {}).items():
         lat, cpu = run["latency_ms"], run["cpu_cores"]
-        print(f"  (not a target: {key} pipeline with RTT_EXECUTOR=events: p50 {lat['p50']:.3f}, "
-              f"p99 {lat['p99']:.3f} ({lat['p50'] / r['bare'][key]['latency_ms']['p50']:.2f}x / "
-              f"{lat['p99'] / r['bare'][key]['latency_ms']['p99']:.2f}x the bare pair); callback -> applied p50 "
-              f"{run['callback_to_applied_ms']['p50']:.3f}; CPU cores sim {cpu['simulation']}, viewer "
-              f"{cpu['viewer']}, total {cpu['total']})")
+        print(
+            f"  (not a target: {key} pipeline with RTT_EXECUTOR=events: p50 {lat['p50']:.3f}, "
+            f"p99 {lat['p99']:.3f} ({lat['p50'] / r['bare'][key]['latency_ms']['p50']:.2f}x / "
+            f"{lat['p99'] / r['bare'][key]['latency_ms']['p99']:.2f}x the bare pair); callback -> applied p50 "
+            f"{run['callback_to_applied_ms']['p50']:.3f}; CPU cores sim {cpu['simulation']}, viewer "
+            f"{cpu['viewer']}, total {cpu['total']})"
+        )
     print("  where it goes (p50 / p99 ms): step -> viewer's callback | callback -> applied on the main thread")
     for key, run in r["pipeline"].items():
         a, b = run["step_to_callback_ms"], run["callback_to_applied_ms"]
@@ -733,37 +867,52 @@ def print_report(r: dict) -> None:
     print("\n== the viewer (meshcat on), per run")
     for key, run in r["pipeline"].items():
         m = run["messages"]
-        print(f"  {key:14s} displayed age p50 {run['displayed_age_ms']['p50']:.2f} ms, p99 {run['displayed_age_ms']['p99']:.2f} ms "
-              f"(first half {run['displayed_age_p99_ms_first_half']}, second half {run['displayed_age_p99_ms_second_half']}); "
-              f"{run['frames_per_s']} frames/s; scene update p50 {run['scene_update_ms']['p50']:.3f} ms, "
-              f"p99 {run['scene_update_ms']['p99']:.3f} ms; messages applied {m['applied']}, coalesced {m['coalesced']}, "
-              f"max pending {m['max_pending']}, spin thread stepped aside {m['yields']} times "
-              f"({m['yield_timeouts']} gave up); CPU cores sim {run['cpu_cores']['simulation']}, viewer "
-              f"{run['cpu_cores']['viewer']}, total {run['cpu_cores']['total']} (bare pair {r['bare'][key]['cpu_cores']})")
-    print("\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, same server, interleaved")
+        print(
+            f"  {key:14s} displayed age p50 {run['displayed_age_ms']['p50']:.2f} ms, p99 {run['displayed_age_ms']['p99']:.2f} ms "
+            f"(first half {run['displayed_age_p99_ms_first_half']}, second half {run['displayed_age_p99_ms_second_half']}); "
+            f"{run['frames_per_s']} frames/s; scene update p50 {run['scene_update_ms']['p50']:.3f} ms, "
+            f"p99 {run['scene_update_ms']['p99']:.3f} ms; messages applied {m['applied']}, coalesced {m['coalesced']}, "
+            f"max pending {m['max_pending']}, spin thread stepped aside {m['yields']} times "
+            f"({m['yield_timeouts']} gave up); CPU cores sim {run['cpu_cores']['simulation']}, viewer "
+            f"{run['cpu_cores']['viewer']}, total {run['cpu_cores']['total']} (bare pair {r['bare'][key]['cpu_cores']})"
+        )
+    print(
+        "\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, same server, interleaved"
+    )
     for name, u in r["scene_update"].items():
-        print(f"  {name:6s} {u['transforms']} transforms: pipelined p50 {u['pipelined']['p50']:.3f} p99 {u['pipelined']['p99']:.3f}; "
-              f"round trip per body p50 {u['round_trip_per_body']['p50']:.3f} p99 {u['round_trip_per_body']['p99']:.3f} "
-              f"({u['speedup_p50']}x)")
-    print(f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, median {r['startup']['median_s']} s")
+        print(
+            f"  {name:6s} {u['transforms']} transforms: pipelined p50 {u['pipelined']['p50']:.3f} p99 {u['pipelined']['p99']:.3f}; "
+            f"round trip per body p50 {u['round_trip_per_body']['p50']:.3f} p99 {u['round_trip_per_body']['p99']:.3f} "
+            f"({u['speedup_p50']}x)"
+        )
+    print(
+        f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, median {r['startup']['median_s']} s"
+    )
     scale = r.get("scale")
     if scale:
-        print(f"\n== scale ({scale['rate_hz']:g} Hz publishers, {scale['rounds']} rounds of {scale['seconds_per_run']:g} s, "
-              "pooled): simulation speed vs bare mj_step (as fast as possible) and real-time factor (lowest run); "
-              "the viewer; displayed-state age at first display p99; CPU cores")
+        print(
+            f"\n== scale ({scale['rate_hz']:g} Hz publishers, {scale['rounds']} rounds of {scale['seconds_per_run']:g} s, "
+            "pooled): simulation speed vs bare mj_step (as fast as possible) and real-time factor (lowest run); "
+            "the viewer; displayed-state age at first display p99; CPU cores"
+        )
         for kind, label in (("tanks", "tanks"), ("joints", "joints")):
             for n, s in scale[kind].items():
                 sp, cpu = s["simulation_speed"], s["cpu_cores"]
                 parts = ", ".join(f"{k} {v:.2f}" for k, v in cpu.items())
-                print(f"  {n:>2s} {label:6s}: {sp['publisher_50Hz_ratio']:.3f}x bare ({sp['publisher_50Hz_steps_per_s']:,}"
-                      f" vs {sp['bare_steps_per_s']:,} steps/s), RTF {s['real_time_factor']}; {s['frames_per_s']} frames/s,"
-                      f" scene update p50 {s['scene_update_ms']['p50']:.2f} p99 {s['scene_update_ms']['p99']:.2f} ms; "
-                      f"age p99 {s['first_shown_age_ms']['p99']:.2f} ms (every frame: {s['displayed_age_ms']['p99']:.2f});"
-                      f" CPU {parts}")
+                print(
+                    f"  {n:>2s} {label:6s}: {sp['publisher_50Hz_ratio']:.3f}x bare ({sp['publisher_50Hz_steps_per_s']:,}"
+                    f" vs {sp['bare_steps_per_s']:,} steps/s), RTF {s['real_time_factor']}; {s['frames_per_s']} frames/s,"
+                    f" scene update p50 {s['scene_update_ms']['p50']:.2f} p99 {s['scene_update_ms']['p99']:.2f} ms; "
+                    f"age p99 {s['first_shown_age_ms']['p99']:.2f} ms (every frame: {s['displayed_age_ms']['p99']:.2f});"
+                    f" CPU {parts}"
+                )
     print("\n== targets")
     for t in r["targets"]:
-        figure = t["measured"] + (f" vs {t['baseline']}" if t["baseline"] else "") + (
-            f" ({t['ratio']})" if t["ratio"] else "")
+        figure = (
+            t["measured"]
+            + (f" vs {t['baseline']}" if t["baseline"] else "")
+            + (f" ({t['ratio']})" if t["ratio"] else "")
+        )
         print(f"  [{'PASS' if t['pass'] else 'FAIL'}] {t['target']}: {figure}")
 
 
@@ -778,13 +927,19 @@ def plot_scale(r: dict, path: Path) -> Path:
     scale = r["scale"]
     bare50 = r["bare"]["tank_50Hz"]["latency_ms"]["p99"]
     fig, axes = plt.subplots(5, 2, figsize=(10, 15), constrained_layout=True)  # legible at book width
-    columns = (("tanks", "tanks in one world (each: Step 1 controller, Step 2 publisher)", SCALE_TANKS),
-               ("joints", "joints of one arm", SCALE_JOINTS))
+    columns = (
+        ("tanks", "tanks in one world (each: Step 1 controller, Step 2 publisher)", SCALE_TANKS),
+        ("joints", "joints of one arm", SCALE_JOINTS),
+    )
     for col, (kind, xlabel, sizes) in enumerate(columns):
         data = [scale[kind][str(n)] for n in sizes]
         ax = axes[0, col]
-        ax.plot(sizes, [d["simulation_speed"]["publisher_50Hz_ratio"] for d in data], "o-",
-                label="steps/s / bare mj_step's (as fast as possible)")
+        ax.plot(
+            sizes,
+            [d["simulation_speed"]["publisher_50Hz_ratio"] for d in data],
+            "o-",
+            label="steps/s / bare mj_step's (as fast as possible)",
+        )
         ax.plot(sizes, [d["real_time_factor"] for d in data], "s-", label="real-time factor (lowest run)")
         ax.axhline(0.99 if kind == "tanks" else 1.0, color="grey", ls=":", lw=1)
         ax.set_ylim(0, 1.1)
@@ -822,8 +977,11 @@ def plot_scale(r: dict, path: Path) -> Path:
             ax.set_xticks(sizes, [str(n) for n in sizes])
             ax.set_xlabel(xlabel)
             ax.grid(alpha=0.3)
-    fig.suptitle(f"Scale: {SCALE_RATE:g} Hz publishers, one viewer mirroring every body "
-                 f"(make bench, {r['when']}; dotted lines: targets)", fontsize=11)
+    fig.suptitle(
+        f"Scale: {SCALE_RATE:g} Hz publishers, one viewer mirroring every body "
+        f"(make bench, {r['when']}; dotted lines: targets)",
+        fontsize=11,
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=80)
     plt.close(fig)
@@ -837,10 +995,12 @@ def plot_latency(r: dict, path: Path) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    series = [("bare rclpy pair (baseline)", r["bare"]["tank_1kHz"]),
-              ("bare pair, subscriber on the EventsExecutor", r.get("bare_events_executor", {}).get("tank_1kHz")),
-              ("tutorial (default: SingleThreadedExecutor)", r["pipeline"]["tank_1kHz"]),
-              ("tutorial, RTT_EXECUTOR=events", r.get("pipeline_events_executor", {}).get("tank_1kHz"))]
+    series = [
+        ("bare rclpy pair (baseline)", r["bare"]["tank_1kHz"]),
+        ("bare pair, subscriber on the EventsExecutor", r.get("bare_events_executor", {}).get("tank_1kHz")),
+        ("tutorial (default: SingleThreadedExecutor)", r["pipeline"]["tank_1kHz"]),
+        ("tutorial, RTT_EXECUTOR=events", r.get("pipeline_events_executor", {}).get("tank_1kHz")),
+    ]
     fig, ax = plt.subplots(figsize=(8, 4.2), constrained_layout=True)
     for label, s in series:
         if not s:
@@ -867,16 +1027,27 @@ def plot_latency(r: dict, path: Path) -> Path:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seconds", type=float, default=8.0, help="length of each cross-process run (default 8)")
-    p.add_argument("--rounds", type=int, default=3,
-                   help="interleaved rounds of bare pair and pipeline per cross-process figure (default 3)")
+    p.add_argument(
+        "--rounds",
+        type=int,
+        default=3,
+        help="interleaved rounds of bare pair and pipeline per cross-process figure (default 3)",
+    )
     p.add_argument("--scale-rounds", type=int, default=2, help="cross-process runs per scale point (default 2)")
     p.add_argument("--quick", action="store_true", help="shorter runs, fewer repeats (a smoke test of the suite)")
     p.add_argument("--output", default=str(RESULTS / "latest.json"))
-    p.add_argument("--table", nargs="+", metavar="RUN_JSON",
-                   help="print the targets of these saved runs as one Markdown table, and exit")
-    p.add_argument("--plots", default=None,
-                   help=f"directory for the plots (default {BOOK_STATIC.relative_to(ROOT)}; "
-                        f"with --quick {RESULTS.relative_to(ROOT)})")
+    p.add_argument(
+        "--table",
+        nargs="+",
+        metavar="RUN_JSON",
+        help="print the targets of these saved runs as one Markdown table, and exit",
+    )
+    p.add_argument(
+        "--plots",
+        default=None,
+        help=f"directory for the plots (default {BOOK_STATIC.relative_to(ROOT)}; "
+        f"with --quick {RESULTS.relative_to(ROOT)})",
+    )
     args = p.parse_args(argv)
     if args.table:
         print(runs_table(args.table), end="")
@@ -891,9 +1062,13 @@ def main(argv=None) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    r: dict = {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(), "platform": platform.platform()},
-               "when": time.strftime("%Y-%m-%d %H:%M"), "seconds_per_run": seconds, "rounds": rounds,
-               "load_average_at_start": [round(x, 2) for x in os.getloadavg()]}
+    r: dict = {
+        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(), "platform": platform.platform()},
+        "when": time.strftime("%Y-%m-%d %H:%M"),
+        "seconds_per_run": seconds,
+        "rounds": rounds,
+        "load_average_at_start": [round(x, 2) for x in os.getloadavg()],
+    }
     pairs, other_pairs = (8, 8) if args.quick else (SPEED_PAIRS, SPEED_PAIRS_OTHER)
     rates = {"publisher_50Hz": 50.0, "publisher_every_step": 0.0}
     r["simulation_speed"] = {
@@ -923,12 +1098,15 @@ def main(argv=None) -> int:
         if events_runs:
             r["bare_events_executor"][key] = pool_bare(events_runs, rate)
             r["pipeline_events_executor"][key] = pool_pipeline(pipe_events_runs, rate)
-    r["scene_update"] = {"tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
-                         "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200)}
+    r["scene_update"] = {
+        "tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
+        "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200),
+    }
     r["startup"] = startup(1 if args.quick else 3)
     with tempfile.TemporaryDirectory() as d:
-        r["scale"] = scale_curves(seconds, warmup, 1 if args.quick else args.scale_rounds, 8 if args.quick else 20,
-                                  Path(d))
+        r["scale"] = scale_curves(
+            seconds, warmup, 1 if args.quick else args.scale_rounds, 8 if args.quick else 20, Path(d)
+        )
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
     r["targets"] = targets(r)
     print_report(r)

@@ -45,7 +45,7 @@ from pathlib import Path
 
 import psutil
 
-from tutorial.launch import fast_dds_shm_files, remove_unused_fast_dds_shm
+from tutorial.ros.launch import fast_dds_shm_files, remove_unused_fast_dds_shm
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results"
@@ -60,8 +60,9 @@ class Program:
 
     def __init__(self, name: str, cmd: list[str], env: dict):
         self.name = name
-        self.proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE,
-                                     stderr=subprocess.STDOUT, text=True)
+        self.proc = subprocess.Popen(
+            cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        )
         self.lines: list[tuple[float, str]] = []  # (time.monotonic(), line); appended by the reader only
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
@@ -145,22 +146,48 @@ def soak(minutes: float, warmup: float, period: float, rate: float, headless: bo
     window = minutes * 60.0
     meshcat = [] if not headless else ["--headless"]
     programs = [
-        Program("rtt_viewer", py("tutorial.runner", "project/step3.yaml", "--json", *meshcat,
-                                 "--ros-args", "-r", "__node:=rtt_viewer"), env),
-        Program("rtt", py("tutorial.runner", "project/step2.yaml", "--json", *meshcat,
-                          "--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}"), env),
-        Program("rtt_joy", py("tutorial.joy_node", "--demo"), env),
+        Program(
+            "rtt_viewer",
+            py(
+                "tutorial.tools.rtt_run",
+                "project/step3.yaml",
+                "--json",
+                *meshcat,
+                "--ros-args",
+                "-r",
+                "__node:=rtt_viewer",
+            ),
+            env,
+        ),
+        Program(
+            "rtt",
+            py(
+                "tutorial.tools.rtt_run",
+                "project/step2.yaml",
+                "--json",
+                *meshcat,
+                "--ros-args",
+                "-p",
+                f"RttJointStatePublisher.rate:={rate}",
+            ),
+            env,
+        ),
+        Program("rtt_joy", py("tutorial.tools.rtt_joy", "--demo"), env),
     ]
     if baseline:
-        programs += [Program("bare_sub", py("benchmarks.soak", "--bare", "sub"), env),
-                     Program("bare_pub", py("benchmarks.soak", "--bare", "pub", "--rate", str(rate)), env)]
+        programs += [
+            Program("bare_sub", py("benchmarks.soak", "--bare", "sub"), env),
+            Program("bare_pub", py("benchmarks.soak", "--bare", "pub", "--rate", str(rate)), env),
+        ]
     viewer, sim, joy = programs[:3]
     try:
         deadline = time.monotonic() + 60.0
         while not viewer.records("first_state"):
             if time.monotonic() > deadline or any(p.proc.poll() is not None for p in programs):
-                raise RuntimeError("the viewer showed no state within 60 s:\n"
-                                   + "\n".join(f"--- {p.name}\n{p.text()}" for p in programs))
+                raise RuntimeError(
+                    "the viewer showed no state within 60 s:\n"
+                    + "\n".join(f"--- {p.name}\n{p.text()}" for p in programs)
+                )
             time.sleep(0.2)
         first_state_at = time.monotonic()
         print(f"pipeline up; warm-up {warmup:.0f} s, then {minutes:g} min measured", flush=True)
@@ -175,13 +202,18 @@ def soak(minutes: float, warmup: float, period: float, rate: float, headless: bo
             samples.append(sample(rows))
             dead = [p.name for p in programs if p.proc.poll() is not None]
             if dead:
-                raise RuntimeError(f"{', '.join(dead)} ended during the soak:\n"
-                                   + "\n".join(f"--- {p.name}\n{p.text()}" for p in programs))
+                raise RuntimeError(
+                    f"{', '.join(dead)} ended during the soak:\n"
+                    + "\n".join(f"--- {p.name}\n{p.text()}" for p in programs)
+                )
             if time.monotonic() >= next_print:
                 next_print += 60.0
                 status = viewer.records("status")[-1]
-                print(f"  {(time.monotonic() - start) / 60:4.1f} min: viewer {status['rate_hz']:.0f} msg/s, "
-                      f"newest state {status['age_ms']} ms old", flush=True)
+                print(
+                    f"  {(time.monotonic() - start) / 60:4.1f} min: viewer {status['rate_hz']:.0f} msg/s, "
+                    f"newest state {status['age_ms']} ms old",
+                    flush=True,
+                )
         stopped_at = time.monotonic()
     finally:
         shm_files = set()
@@ -197,10 +229,13 @@ def soak(minutes: float, warmup: float, period: float, rate: float, headless: bo
         if len(points) < 2:
             continue
         (t0, rss0, cpu0), (t1, rss1, cpu1) = points[0], points[-1]
-        processes[name] = {"rss_start_mb": round(rss0, 2), "rss_end_mb": round(rss1, 2),
-                           "growth_mb": round(rss1 - rss0, 2),
-                           "slope_mb_per_10min": round(slope_per_10_min([(t, r) for t, r, _ in points]) or 0.0, 2),
-                           "cpu_cores": round((cpu1 - cpu0) / (t1 - t0), 3)}
+        processes[name] = {
+            "rss_start_mb": round(rss0, 2),
+            "rss_end_mb": round(rss1, 2),
+            "growth_mb": round(rss1 - rss0, 2),
+            "slope_mb_per_10min": round(slope_per_10_min([(t, r) for t, r, _ in points]) or 0.0, 2),
+            "cpu_cores": round((cpu1 - cpu0) / (t1 - t0), 3),
+        }
 
     # -- the viewer's status lines in the window
     statuses = viewer.records("status", start, stopped_at)
@@ -222,74 +257,123 @@ def soak(minutes: float, warmup: float, period: float, rate: float, headless: bo
         "status_lines": len(statuses),
         "status_lines_per_s": round((len(statuses) - 1) / span, 3) if span else None,
         "rate_hz": {"min": min(rates, default=None), "p50": median(rates), "max": max(rates, default=None)},
-        "received": d_received, "received_per_s": round(d_received / span, 1) if span else None,
-        "applied": d_applied, "coalesced": d_received - d_applied,
+        "received": d_received,
+        "received_per_s": round(d_received / span, 1) if span else None,
+        "applied": d_applied,
+        "coalesced": d_received - d_applied,
         "coalesced_fraction": round((d_received - d_applied) / d_received, 4) if d_received else None,
-        "age_ms": {"p50": median([a for _, a in ages]),
-                   "p99": round(sorted(a for _, a in ages)[int(0.99 * (len(ages) - 1))], 3) if ages else None,
-                   "max": max((a for _, a in ages), default=None),
-                   "first_minute_p50": median(first_min), "last_minute_p50": median(last_min),
-                   "p50_by_minute": [median([a for t, a in ages if start + 60 * m <= t < start + 60 * (m + 1)])
-                                     for m in range(max(1, round((stopped_at - start) / 60.0)))]},
-        "stale_records": len(stale_records), "stale_status_lines": len(stale_lines),
+        "age_ms": {
+            "p50": median([a for _, a in ages]),
+            "p99": round(sorted(a for _, a in ages)[int(0.99 * (len(ages) - 1))], 3) if ages else None,
+            "max": max((a for _, a in ages), default=None),
+            "first_minute_p50": median(first_min),
+            "last_minute_p50": median(last_min),
+            "p50_by_minute": [
+                median([a for t, a in ages if start + 60 * m <= t < start + 60 * (m + 1)])
+                for m in range(max(1, round((stopped_at - start) / 60.0)))
+            ],
+        },
+        "stale_records": len(stale_records),
+        "stale_status_lines": len(stale_lines),
         "rejected": statuses[-1]["rejected"] if statuses else None,
         "summary_received": viewer_summary.get("controllers", {}).get("RttJointStateMonitor", {}).get("received"),
     }
-    simulation = {"real_time_factor": sim_summary.get("real_time_factor"),
-                  "simulated_time": sim_summary.get("simulated_time"), "published": published}
-    age_growth = (viewer_figures["age_ms"]["last_minute_p50"] - viewer_figures["age_ms"]["first_minute_p50"]
-                  if first_min and last_min else None)
+    simulation = {
+        "real_time_factor": sim_summary.get("real_time_factor"),
+        "simulated_time": sim_summary.get("simulated_time"),
+        "published": published,
+    }
+    age_growth = (
+        viewer_figures["age_ms"]["last_minute_p50"] - viewer_figures["age_ms"]["first_minute_p50"]
+        if first_min and last_min
+        else None
+    )
     ours = [n for n in processes if not n.startswith("bare_")]
     targets = {
         "memory_growth_under_5_MB_per_process": {
             "pass": bool(ours) and all(processes[n]["growth_mb"] < MEMORY_GROWTH_LIMIT_MB for n in ours),
-            "worst": max(((processes[n]["growth_mb"], n) for n in ours), default=None)},
+            "worst": max(((processes[n]["growth_mb"], n) for n in ours), default=None),
+        },
         "no_backlog": {
-            "pass": age_growth is not None and age_growth <= AGE_GROWTH_LIMIT_MS
+            "pass": age_growth is not None
+            and age_growth <= AGE_GROWTH_LIMIT_MS
             and (simulation["real_time_factor"] or 0) >= REAL_TIME_FACTOR_MIN,
             "age_growth_ms": None if age_growth is None else round(age_growth, 3),
-            "real_time_factor": simulation["real_time_factor"]},
-        "no_stale_period": {"pass": not stale_records and not stale_lines and len(statuses) > 0,
-                            "stale_records": len(stale_records), "stale_status_lines": len(stale_lines)},
+            "real_time_factor": simulation["real_time_factor"],
+        },
+        "no_stale_period": {
+            "pass": not stale_records and not stale_lines and len(statuses) > 0,
+            "stale_records": len(stale_records),
+            "stale_status_lines": len(stale_lines),
+        },
     }
-    return {"when": time.strftime("%Y-%m-%d %H:%M:%S"),
-            "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                        "platform": platform.platform(), "load_avg_at_end": os.getloadavg()},
-            "settings": {"minutes": minutes, "warmup_s": warmup, "sample_s": period, "rate_hz": rate,
-                         "meshcat": not headless, "baseline": baseline,
-                         "executor": os.environ.get("RTT_EXECUTOR", "the default of tutorial.ros_env"),
-                         "ros_domain_id": env["ROS_DOMAIN_ID"]},
-            "window_s": round(stopped_at - start, 1), "processes": processes, "viewer": viewer_figures,
-            "simulation": simulation, "joy": {"last_line": joy.text().splitlines()[-1:]},
-            "exit_codes": codes, "targets": targets}
+    return {
+        "when": time.strftime("%Y-%m-%d %H:%M:%S"),
+        "machine": {
+            "cpus": os.cpu_count(),
+            "python": platform.python_version(),
+            "platform": platform.platform(),
+            "load_avg_at_end": os.getloadavg(),
+        },
+        "settings": {
+            "minutes": minutes,
+            "warmup_s": warmup,
+            "sample_s": period,
+            "rate_hz": rate,
+            "meshcat": not headless,
+            "baseline": baseline,
+            "executor": os.environ.get("RTT_EXECUTOR", "the default of tutorial.ros.env"),
+            "ros_domain_id": env["ROS_DOMAIN_ID"],
+        },
+        "window_s": round(stopped_at - start, 1),
+        "processes": processes,
+        "viewer": viewer_figures,
+        "simulation": simulation,
+        "joy": {"last_line": joy.text().splitlines()[-1:]},
+        "exit_codes": codes,
+        "targets": targets,
+    }
 
 
 def report(r: dict) -> None:
     s = r["settings"]
-    print(f"\n== soak: Step 3 at {s['rate_hz']:g} Hz, {r['window_s']:.0f} s measured after {s['warmup_s']:g} s "
-          f"of warm-up, meshcat {'on' if s['meshcat'] else 'off'}, executor: {s['executor']}; "
-          f"{r['machine']['cpus']} CPUs, load at the end "
-          f"{', '.join(f'{x:.2f}' for x in r['machine']['load_avg_at_end'])}")
-    print(f"{'process':<22}{'RSS start MB':>13}{'RSS end MB':>12}{'growth MB':>11}{'slope MB/10min':>16}"
-          f"{'CPU cores':>11}")
+    print(
+        f"\n== soak: Step 3 at {s['rate_hz']:g} Hz, {r['window_s']:.0f} s measured after {s['warmup_s']:g} s "
+        f"of warm-up, meshcat {'on' if s['meshcat'] else 'off'}, executor: {s['executor']}; "
+        f"{r['machine']['cpus']} CPUs, load at the end "
+        f"{', '.join(f'{x:.2f}' for x in r['machine']['load_avg_at_end'])}"
+    )
+    print(
+        f"{'process':<22}{'RSS start MB':>13}{'RSS end MB':>12}{'growth MB':>11}{'slope MB/10min':>16}{'CPU cores':>11}"
+    )
     for name, p in r["processes"].items():
-        print(f"{name:<22}{p['rss_start_mb']:>13.1f}{p['rss_end_mb']:>12.1f}{p['growth_mb']:>11.2f}"
-              f"{p['slope_mb_per_10min']:>16.2f}{p['cpu_cores']:>11.3f}")
+        print(
+            f"{name:<22}{p['rss_start_mb']:>13.1f}{p['rss_end_mb']:>12.1f}{p['growth_mb']:>11.2f}"
+            f"{p['slope_mb_per_10min']:>16.2f}{p['cpu_cores']:>11.3f}"
+        )
     base = [n for n in r["processes"] if n.startswith("bare_")]
     if base:
         print("  (bare_pub, bare_sub: the same-run baseline, a bare rclpy pair of the same message at the same rate)")
     v, a = r["viewer"], r["viewer"]["age_ms"]
-    print(f"viewer: {v['status_lines']} status lines ({v['status_lines_per_s']} per s); "
-          f"{v['rate_hz']['p50']} msg/s median (min {v['rate_hz']['min']}, max {v['rate_hz']['max']})")
-    print(f"  states received {v['received']} ({v['received_per_s']} per s of {s['rate_hz']:g} published), "
-          f"applied {v['applied']}, coalesced {v['coalesced']} ({100 * (v['coalesced_fraction'] or 0):.2f} %); "
-          f"rejected {v['rejected']}")
-    print(f"  newest state's age ms: p50 {a['p50']}, p99 {a['p99']}, max {a['max']}; "
-          f"p50 minute by minute {a['p50_by_minute']}")
+    print(
+        f"viewer: {v['status_lines']} status lines ({v['status_lines_per_s']} per s); "
+        f"{v['rate_hz']['p50']} msg/s median (min {v['rate_hz']['min']}, max {v['rate_hz']['max']})"
+    )
+    print(
+        f"  states received {v['received']} ({v['received_per_s']} per s of {s['rate_hz']:g} published), "
+        f"applied {v['applied']}, coalesced {v['coalesced']} ({100 * (v['coalesced_fraction'] or 0):.2f} %); "
+        f"rejected {v['rejected']}"
+    )
+    print(
+        f"  newest state's age ms: p50 {a['p50']}, p99 {a['p99']}, max {a['max']}; "
+        f"p50 minute by minute {a['p50_by_minute']}"
+    )
     print(f"  stale records {v['stale_records']}, status lines saying stale {v['stale_status_lines']}")
     sim = r["simulation"]
-    print(f"simulation: real-time factor {sim['real_time_factor']}, {sim['simulated_time']} s simulated, "
-          f"{sim['published']} states published")
+    print(
+        f"simulation: real-time factor {sim['real_time_factor']}, {sim['simulated_time']} s simulated, "
+        f"{sim['published']} states published"
+    )
     print(f"exit codes: {r['exit_codes']}")
     print("\n== targets")
     for name, t in r["targets"].items():
@@ -308,7 +392,7 @@ def bare(role: str, rate: float) -> int:
     from rclpy.executors import ExternalShutdownException
     from sensor_msgs.msg import JointState
 
-    from tutorial.controllers.joint_state_publisher import joint_state_qos
+    from tutorial.interfaces.joint_state import joint_state_qos
 
     rclpy.init()
     node = rclpy.create_node(f"soak_bare_{role}")
@@ -346,8 +430,9 @@ def main(argv=None) -> int:
     p.add_argument("--sample", type=float, default=10.0, help="s between memory and CPU samples (default 10)")
     p.add_argument("--rate", type=float, default=1000.0, help="joint state rate, Hz (default 1000)")
     p.add_argument("--headless", action="store_true", help="no meshcat pages (make demo has them)")
-    p.add_argument("--no-baseline", dest="baseline", action="store_false",
-                   help="without the bare rclpy pair running alongside")
+    p.add_argument(
+        "--no-baseline", dest="baseline", action="store_false", help="without the bare rclpy pair running alongside"
+    )
     p.add_argument("--output", default=str(RESULTS / "soak.json"))
     args = p.parse_args(argv)
     if args.bare:

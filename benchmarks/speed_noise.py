@@ -26,8 +26,15 @@ import time
 
 import numpy as np
 
-from benchmarks.run import (ROOT, SPEED_PAIRS, bare_steps_per_s, in_thread, interleaved_ratios, run_steps,
-                            simulation_speed)
+from benchmarks.run import (
+    ROOT,
+    SPEED_PAIRS,
+    bare_steps_per_s,
+    in_thread,
+    interleaved_ratios,
+    run_steps,
+    simulation_speed,
+)
 
 PROJECT = "project/step2.yaml"
 
@@ -37,6 +44,7 @@ def bare_against_bare(model, steps: int, seconds: float) -> list[float]:
 
     Paired exactly as the figure pairs its runs (:func:`benchmarks.run.interleaved_ratios`).
     """
+
     def bare() -> float:
         return bare_steps_per_s(model, steps)
 
@@ -56,8 +64,8 @@ def main(argv=None) -> int:
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
-    from tutorial.project import load_project
-    from tutorial.world import build_world
+    from tutorial.core.project import load_project
+    from tutorial.core.world import build_world
 
     proj = load_project(ROOT / PROJECT)
     model = build_world(proj.models, time_step=proj.simulator.time_step)
@@ -66,8 +74,11 @@ def main(argv=None) -> int:
     for n in (steps, 4 * steps):
         r = bare_against_bare(model, n, args.seconds)
         q1, med, q3 = np.percentile(r, [25, 50, 75])
-        print(f"  runs of {n} steps: {len(r)} ratios, median {med:.3f}, quartiles {q1:.3f}-{q3:.3f} "
-              f"(width {q3 - q1:.3f})", flush=True)
+        print(
+            f"  runs of {n} steps: {len(r)} ratios, median {med:.3f}, quartiles {q1:.3f}-{q3:.3f} "
+            f"(width {q3 - q1:.3f})",
+            flush=True,
+        )
 
     print(f"== the figure (50 Hz publisher), {args.repeats} times back to back per pair count")
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)

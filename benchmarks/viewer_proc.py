@@ -14,9 +14,9 @@ import time
 import rclpy
 from rclpy.signals import SignalHandlerOptions
 
-from tutorial import ros_env
-from tutorial.app import App
-from tutorial.project import load_project
+from tutorial.core.app import App
+from tutorial.core.project import load_project
+from tutorial.ros import env as ros_env
 
 
 def main() -> int:
@@ -28,8 +28,13 @@ def main() -> int:
     args = p.parse_args()
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-    app = App(load_project(args.project), node_name=args.name, headless=args.headless, duration=args.duration,
-              output=lambda record: print(record, flush=True) if record.get("event") != "status" else None)
+    app = App(
+        load_project(args.project),
+        node_name=args.name,
+        headless=args.headless,
+        duration=args.duration,
+        output=lambda record: print(record, flush=True) if record.get("event") != "status" else None,
+    )
     try:
         app.open()
         probes = [c for _, c, _ in app.controllers if hasattr(c, "frame_drawn")]

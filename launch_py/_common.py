@@ -7,18 +7,18 @@ ROOT = Path(__file__).resolve().parent.parent
 PROJECT = ROOT / "project"
 sys.path.insert(0, str(ROOT))  # run from a clone without installing, too
 
-from tutorial.launch import Node  # noqa: E402
+from tutorial.ros.launch import Node  # noqa: E402
 
 
 def joy_node(args, script: str = "drive") -> Node:
     """The joystick: with --demo the demo ``script`` (``drive`` or ``wall``), else a gamepad or the keyboard."""
-    return Node("rtt_joy", "tutorial.joy_node", ["--demo", "--script", script] if args.demo else [])
+    return Node("rtt_joy", "tutorial.tools.rtt_joy", ["--demo", "--script", script] if args.demo else [])
 
 
 def simulation_node(args, project: str) -> Node:
     """The simulation (``rtt``), required: when it ends, the launch ends."""
     extra = (["--headless"] if args.headless else []) + (["--duration", str(args.duration)] if args.duration else [])
-    return Node("rtt", "tutorial.runner", [str(PROJECT / project), *extra], required=True)
+    return Node("rtt", "tutorial.tools.rtt_run", [str(PROJECT / project), *extra], required=True)
 
 
 def record_nodes(args, topics: list[str]) -> list[Node]:

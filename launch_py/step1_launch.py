@@ -1,14 +1,14 @@
 """Step 1: the joystick and the tank simulation, each its own process.
 
-    python launch_py/step1_launch.py --demo
-    python launch_py/step1_launch.py --demo --record drive.mcap   # also record /joy
+python launch_py/step1_launch.py --demo
+python launch_py/step1_launch.py --demo --record drive.mcap   # also record /joy
 """
 
 import sys
 
 from _common import joy_node, record_nodes, simulation_node
 
-from tutorial.launch import LaunchDescription, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, launch_parser, run
 
 
 def generate_launch_description(args) -> LaunchDescription:

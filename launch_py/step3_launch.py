@@ -9,17 +9,19 @@ import sys
 
 from _common import PROJECT, joy_node, record_nodes, simulation_node
 
-from tutorial.launch import LaunchDescription, Node, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, Node, launch_parser, run
 
 
 def generate_launch_description(args) -> LaunchDescription:
     viewer_args = [str(PROJECT / "step3.yaml")] + (["--headless"] if args.headless else [])
-    return LaunchDescription([
-        *record_nodes(args, ["/joy", "/Tank/joint_state"]),  # first: up before the publishers start
-        joy_node(args),
-        simulation_node(args, "step2.yaml"),
-        Node("rtt_viewer", "tutorial.runner", viewer_args),
-    ])
+    return LaunchDescription(
+        [
+            *record_nodes(args, ["/joy", "/Tank/joint_state"]),  # first: up before the publishers start
+            joy_node(args),
+            simulation_node(args, "step2.yaml"),
+            Node("rtt_viewer", "tutorial.tools.rtt_run", viewer_args),
+        ]
+    )
 
 
 if __name__ == "__main__":

@@ -10,19 +10,21 @@ import sys
 
 from _common import PROJECT, joy_node, record_nodes, simulation_node
 
-from tutorial.launch import LaunchDescription, Node, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, Node, launch_parser, run
 
 TOPICS = ["/joy", "/Tank/joint_state", "/Tank/imu"]  # what --record records
 
 
 def generate_launch_description(args) -> LaunchDescription:
     viewer_args = [str(PROJECT / "step5.yaml")] + (["--headless"] if args.headless else [])
-    return LaunchDescription([
-        *record_nodes(args, TOPICS),  # first: up before the publishers start
-        joy_node(args, script="wall"),  # ram the wall ahead: the viewer shakes
-        simulation_node(args, "step4.yaml"),
-        Node("rtt_viewer", "tutorial.runner", viewer_args),
-    ])
+    return LaunchDescription(
+        [
+            *record_nodes(args, TOPICS),  # first: up before the publishers start
+            joy_node(args, script="wall"),  # ram the wall ahead: the viewer shakes
+            simulation_node(args, "step4.yaml"),
+            Node("rtt_viewer", "tutorial.tools.rtt_run", viewer_args),
+        ]
+    )
 
 
 if __name__ == "__main__":

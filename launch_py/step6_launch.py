@@ -10,24 +10,30 @@ import sys
 
 from _common import joy_node, record_nodes, simulation_node
 
-from tutorial.launch import LaunchDescription, Node, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, Node, launch_parser, run
 
 TOPICS = ["/joy", "/Tank/joint_state", "/Tank/camera/image"]  # --record: pictures are 230 KB, 30 a second
 
 
 def generate_launch_description(args) -> LaunchDescription:
-    return LaunchDescription([
-        *record_nodes(args, TOPICS),
-        joy_node(args),
-        simulation_node(args, "step6.yaml"),
-        Node("rtt_image", "tutorial.image_node", ["/Tank/camera/image", "--output", args.image_output]),
-    ])
+    return LaunchDescription(
+        [
+            *record_nodes(args, TOPICS),
+            joy_node(args),
+            simulation_node(args, "step6.yaml"),
+            Node("rtt_image", "tutorial.tools.rtt_image", ["/Tank/camera/image", "--output", args.image_output]),
+        ]
+    )
 
 
 def parser():
     p = launch_parser(__doc__)
-    p.add_argument("--image-output", default="step6_image.png", metavar="FILE.png",
-                   help="the PNG rtt-image writes where there is no display (default step6_image.png)")
+    p.add_argument(
+        "--image-output",
+        default="step6_image.png",
+        metavar="FILE.png",
+        help="the PNG rtt-image writes where there is no display (default step6_image.png)",
+    )
     return p
 
 

@@ -34,8 +34,13 @@ def run(path: Path, timeout: float) -> float:
 
     nb = nbformat.read(path, as_version=4)
     start = time.monotonic()
-    NotebookClient(nb, timeout=timeout, kernel_name="python3", resources={"metadata": {"path": str(path.parent)}},
-                   store_widget_state=True).execute()
+    NotebookClient(
+        nb,
+        timeout=timeout,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(path.parent)}},
+        store_widget_state=True,
+    ).execute()
     nbformat.write(nb, path)
     return time.monotonic() - start
 

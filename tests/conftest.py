@@ -1,9 +1,30 @@
-"""Test set-up: every ROS 2 participant of this session stays on this machine.
+"""Test set-up: every ROS 2 participant of this session stays on this machine; each test has one tier.
 
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` keeps discovery traffic on the
 loopback interface, and a ``ROS_DOMAIN_ID`` unique to this test session keeps
 it apart from any other session running here.  Both are set before rclpy is
-imported and are inherited by every process a test starts.
+imported and are inherited by every process a test starts.  (The network
+tier's own hosts, network namespaces the test makes, are the one place
+``SUBNET`` is used: ``tests/netns.py``.)
+
+Tiers, as pytest markers (``pytest -m unit``, ``make test-fast``):
+
+===============  ==============================================================
+tier             what a test of it does
+===============  ==============================================================
+``unit``         plain Python, MuJoCo and files: no ROS context, no process
+``ros``          rclpy in this process (the ``ros`` or ``node`` fixture)
+``cross_process`` our programs as separate processes, talking over ROS 2
+``launch``       the ``launch_py/`` files, every node a process
+``browser``      a real (headless) Chromium: meshcat pages, JupyterLab
+``notebooks``    the notebooks, cell by cell, against their saved outputs (nbval)
+``network``      two or three hosts in network namespaces, with faults (root only)
+===============  ==============================================================
+
+A test's tier is the tier marker closest to it (the function's, else its
+module's ``pytestmark``); a test with none is ``cross_process`` when it uses
+the ``procs`` fixture, ``ros`` when it uses ``ros`` or ``node``, else ``unit``.
+A test that ends up with two tiers stops the collection.
 """
 
 from __future__ import annotations
@@ -30,6 +51,34 @@ from tutorial.notebook.session import wait_until  # noqa: E402,F401 - after the 
 ROOT = Path(__file__).resolve().parent.parent
 PROJECT = ROOT / "project"
 MODEL = ROOT / "model"
+
+
+TIERS = ("unit", "ros", "cross_process", "launch", "browser", "notebooks", "network")
+
+
+def pytest_configure(config):
+    for tier in TIERS:
+        config.addinivalue_line("markers", f"{tier}: the {tier.replace('_', '-')} tier (see tests/conftest.py)")
+
+
+def pytest_collection_modifyitems(config, items):
+    """Give every test exactly one tier marker (see the module's docstring)."""
+    for item in items:
+        marked = {m.name for m in item.iter_markers() if m.name in TIERS}
+        if len(marked) > 1:
+            raise pytest.UsageError(f"{item.nodeid} has more than one tier: {sorted(marked)}")
+        if marked:
+            continue
+        fixtures = set(getattr(item, "fixturenames", ()))
+        if item.path.suffix == ".ipynb":
+            tier = "notebooks"
+        elif "procs" in fixtures:
+            tier = "cross_process"
+        elif fixtures & {"ros", "node"}:
+            tier = "ros"
+        else:
+            tier = "unit"
+        item.add_marker(getattr(pytest.mark, tier))
 
 
 @pytest.fixture(scope="session")
@@ -73,8 +122,14 @@ def publish_and_wait_applied(pub, view, names, positions, applied: int, timeout:
     msg = JointState()
     msg.name, msg.position = names, positions
     pub.publish(msg)
-    view.wait_for_line(lambda line: line.startswith("{") and json.loads(line).get("event") == "status"
-                       and json.loads(line)["applied"] >= applied, timeout=timeout)
+    view.wait_for_line(
+        lambda line: (
+            line.startswith("{")
+            and json.loads(line).get("event") == "status"
+            and json.loads(line)["applied"] >= applied
+        ),
+        timeout=timeout,
+    )
 
 
 def module_command(module: str, *args: str) -> list[str]:
@@ -93,8 +148,10 @@ class Proc:
         self.lines: list[str] = []
         self._cond = threading.Condition()
         self._err: list[str] = []
-        self._threads = [threading.Thread(target=self._read, args=(self.p.stdout, self.lines), daemon=True),
-                         threading.Thread(target=self._read, args=(self.p.stderr, self._err), daemon=True)]
+        self._threads = [
+            threading.Thread(target=self._read, args=(self.p.stdout, self.lines), daemon=True),
+            threading.Thread(target=self._read, args=(self.p.stderr, self._err), daemon=True),
+        ]
         for t in self._threads:
             t.start()
 
@@ -146,7 +203,7 @@ class Proc:
             self._signal_then_kill(signal.SIGABRT)
             for t in self._threads:
                 t.join(5)
-            raise AssertionError(f"{self.cmd} did not finish in {timeout} s\n{self.out}\n{self.err}")
+            raise AssertionError(f"{self.cmd} did not finish in {timeout} s\n{self.out}\n{self.err}") from None
         for t in self._threads:
             t.join(10)
         return self.p.returncode

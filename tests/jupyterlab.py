@@ -30,11 +30,20 @@ from pathlib import Path
 import psutil
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser") or "/usr/bin/chromium"
-CHROMIUM_FLAGS = ["--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader", "--disable-background-networking",
-                  "--disable-component-update", "--disable-sync", "--disable-quic", "--no-first-run",
-                  "--disable-breakpad", "--disable-crash-reporter",
-                  # no name resolves to anything but 127.0.0.1: a stray lookup cannot leave the machine
-                  "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1"]
+CHROMIUM_FLAGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--enable-unsafe-swiftshader",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-breakpad",
+    "--disable-crash-reporter",
+    # no name resolves to anything but 127.0.0.1: a stray lookup cannot leave the machine
+    "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
+]
 # Every URL the browser may load: this server's pages and meshcat's, all on 127.0.0.1, and in-page data.
 _OFF_HOST = re.compile(r"^(?!(https?|wss?)://127\.0\.0\.1[:/]|data:|blob:|about:|chrome-error:)")
 
@@ -81,9 +90,14 @@ class JupyterLab:
             folder = self._tmp / "settings" / "@jupyterlab" / extension
             folder.mkdir(parents=True, exist_ok=True)
             (folder / f"{plugin}.jupyterlab-settings").write_text(json.dumps(values))
-        home = {"JUPYTERLAB_SETTINGS_DIR": "settings", "JUPYTERLAB_WORKSPACES_DIR": "workspaces",
-                "JUPYTER_CONFIG_DIR": "config", "JUPYTER_DATA_DIR": "data", "JUPYTER_RUNTIME_DIR": "runtime",
-                "IPYTHONDIR": "ipython"}
+        home = {
+            "JUPYTERLAB_SETTINGS_DIR": "settings",
+            "JUPYTERLAB_WORKSPACES_DIR": "workspaces",
+            "JUPYTER_CONFIG_DIR": "config",
+            "JUPYTER_DATA_DIR": "data",
+            "JUPYTER_RUNTIME_DIR": "runtime",
+            "IPYTHONDIR": "ipython",
+        }
         self.env = dict(os.environ, **{k: str(self._tmp / v) for k, v in home.items()})
         for key, value in (env or {}).items():
             if value is None:
@@ -93,11 +107,24 @@ class JupyterLab:
         self._descendants: dict[int, object] = {}
         jupyter = str(Path(sys.executable).parent / "jupyter")
         self.proc = subprocess.Popen(
-            [jupyter, "lab", "--allow-root", "--no-browser", "--ip=127.0.0.1", f"--port={self.port}",
-             "--ServerApp.token=", "--ServerApp.password=", "--ServerApp.port_retries=0",
-             "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
-             f"--ServerApp.root_dir={self.root}"],
-            env=self.env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+            [
+                jupyter,
+                "lab",
+                "--allow-root",
+                "--no-browser",
+                "--ip=127.0.0.1",
+                f"--port={self.port}",
+                "--ServerApp.token=",
+                "--ServerApp.password=",
+                "--ServerApp.port_retries=0",
+                "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+                f"--ServerApp.root_dir={self.root}",
+            ],
+            env=self.env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         deadline = time.monotonic() + timeout
         while True:
             with contextlib.suppress(OSError):
@@ -143,7 +170,7 @@ class JupyterLab:
         psutil.wait_procs(alive, timeout=5)
         shutil.rmtree(self._tmp, ignore_errors=True)
 
-    def __enter__(self) -> "JupyterLab":
+    def __enter__(self) -> JupyterLab:
         return self
 
     def __exit__(self, *exc) -> None:

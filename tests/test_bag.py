@@ -7,12 +7,13 @@ import sys
 import pytest
 import yaml
 
-from conftest import ROOT, module_command, wait_until
 from tutorial.bag import cli, definitions, qos
 from tutorial.bag.definitions import UnknownMessageType
 from tutorial.bag.info import bag_info, format_info
 from tutorial.bag.reader import check_file, iter_raw, joint_series
 from tutorial.bag.writer import BagWriter
+
+from conftest import ROOT, module_command, wait_until
 
 SEP = "\n" + "=" * 80 + "\n"
 INFINITE = {"sec": 9223372036, "nsec": 854775807}
@@ -30,9 +31,15 @@ def msg_text(package: str, name: str) -> str:
 def test_definition_is_the_installed_msg_files_joined_as_rosbag2_joins_them():
     encoding, text = definitions.full_text("sensor_msgs/msg/JointState")
     assert encoding == "ros2msg"
-    assert text == (msg_text("sensor_msgs", "JointState")
-                    + SEP + "MSG: std_msgs/Header\n" + msg_text("std_msgs", "Header")
-                    + SEP + "MSG: builtin_interfaces/Time\n" + msg_text("builtin_interfaces", "Time"))
+    assert text == (
+        msg_text("sensor_msgs", "JointState")
+        + SEP
+        + "MSG: std_msgs/Header\n"
+        + msg_text("std_msgs", "Header")
+        + SEP
+        + "MSG: builtin_interfaces/Time\n"
+        + msg_text("builtin_interfaces", "Time")
+    )
     assert "# This is a message that holds data" in text  # comments kept, as rosbag2 keeps them
 
 
@@ -42,9 +49,14 @@ def test_dependencies_come_depth_first_in_sorted_order_each_once():
 
     _, text = definitions.full_text("sensor_msgs/msg/MultiDOFJointState")
     assert [line for line in text.splitlines() if line.startswith("MSG: ")] == [
-        "MSG: geometry_msgs/Transform", "MSG: geometry_msgs/Quaternion", "MSG: geometry_msgs/Vector3",
-        "MSG: geometry_msgs/Twist", "MSG: geometry_msgs/Wrench", "MSG: std_msgs/Header",
-        "MSG: builtin_interfaces/Time"]  # Vector3 is used three times, written once
+        "MSG: geometry_msgs/Transform",
+        "MSG: geometry_msgs/Quaternion",
+        "MSG: geometry_msgs/Vector3",
+        "MSG: geometry_msgs/Twist",
+        "MSG: geometry_msgs/Wrench",
+        "MSG: std_msgs/Header",
+        "MSG: builtin_interfaces/Time",
+    ]  # Vector3 is used three times, written once
     parsed = get_types_from_msg(text, "sensor_msgs/msg/MultiDOFJointState")
     store = get_typestore(Stores.ROS2_JAZZY)
     assert len(parsed) == 8
@@ -101,9 +113,11 @@ def test_offered_qos_is_written_in_rosbag2s_yaml(node):
 
 def test_older_formats_are_read_as_rosbag2_reads_them():
     # rosbag2's own test string for bags of format version 4 (policies as integers).
-    v4 = ("- history: 1\n  depth: 10\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 0\n    nsec: 0\n"
-          "  lifespan:\n    sec: 0\n    nsec: 0\n  liveliness: 0\n  liveliness_lease_duration:\n    sec: 0\n"
-          "    nsec: 0\n  avoid_ros_namespace_conventions: false\n")
+    v4 = (
+        "- history: 1\n  depth: 10\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 0\n    nsec: 0\n"
+        "  lifespan:\n    sec: 0\n    nsec: 0\n  liveliness: 0\n  liveliness_lease_duration:\n    sec: 0\n"
+        "    nsec: 0\n  avoid_ros_namespace_conventions: false\n"
+    )
     [p] = qos.parse_profiles(v4)
     assert p == {**qos.DEFAULT_PROFILE}
     # Foxy-era Fast DDS wrote "infinite" as {2147483647, 4294967295}.
@@ -129,12 +143,18 @@ def test_player_and_recorder_adapt_qos_as_rosbag2_does():
     assert qos.offer_for_recorded([]) == (qos.DEFAULT_PROFILE, None)
     profile = qos.to_qos_profile(qos.offer_for_recorded([latched])[0])
     assert (profile.reliability, profile.durability, profile.history, profile.depth) == (
-        ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL, HistoryPolicy.KEEP_LAST, 10)
+        ReliabilityPolicy.RELIABLE,
+        DurabilityPolicy.TRANSIENT_LOCAL,
+        HistoryPolicy.KEEP_LAST,
+        10,
+    )
     assert profile.deadline.nanoseconds == qos.INFINITE_NS
+
     # Recorder: reliable / transient local only when every publisher offers it.
     def request(*offers):
         r = qos.request_for_offers(list(offers), 1000)
         return r["reliability"], r["durability"], r["depth"]
+
     assert request(reliable, reliable) == ("reliable", "volatile", 1000)
     assert request(reliable, best_effort) == ("best_effort", "volatile", 1000)
     assert request(latched, latched) == ("reliable", "transient_local", 1000)
@@ -186,8 +206,10 @@ def test_recorded_file_is_what_rosbag2_writes_and_stock_readers_open_it(ros, nod
         summary = reader.get_summary()
         assert summary.statistics.message_count == 40
         channels = {c.topic: c for c in summary.channels.values()}
-        for topic, type_name, reliability in (("/bag_test/joint_state", "sensor_msgs/msg/JointState", "reliable"),
-                                              ("/bag_test/joy", "sensor_msgs/msg/Joy", "best_effort")):
+        for topic, type_name, reliability in (
+            ("/bag_test/joint_state", "sensor_msgs/msg/JointState", "reliable"),
+            ("/bag_test/joy", "sensor_msgs/msg/Joy", "best_effort"),
+        ):
             channel = channels[topic]
             schema = summary.schemas[channel.schema_id]
             assert (schema.name, schema.encoding) == (type_name, "ros2msg")
@@ -201,8 +223,9 @@ def test_recorded_file_is_what_rosbag2_writes_and_stock_readers_open_it(ros, nod
         [meta] = list(reader.iter_metadata())
         bag = yaml.safe_load(meta.metadata["serialized_metadata"])
         assert meta.name == "rosbag2" and bag["version"] == 9 and bag["storage_identifier"] == "mcap"
-        assert {t["topic_metadata"]["name"]: t["message_count"] for t in bag["topics_with_message_count"]} == \
-            stats.per_topic
+        assert {
+            t["topic_metadata"]["name"]: t["message_count"] for t in bag["topics_with_message_count"]
+        } == stats.per_topic
         got = {"/bag_test/joint_state": [], "/bag_test/joy": []}
         for _schema, channel, message in reader.iter_messages(log_time_order=True):
             assert before <= message.log_time <= after
@@ -215,9 +238,12 @@ def test_recorded_file_is_what_rosbag2_writes_and_stock_readers_open_it(ros, nod
     # A second, independent reader: rosbags.
     with AnyReader([path]) as other:
         assert sorted((c.topic, c.msgtype, c.msgcount) for c in other.connections) == [
-            ("/bag_test/joint_state", "sensor_msgs/msg/JointState", 20), ("/bag_test/joy", "sensor_msgs/msg/Joy", 20)]
-        last = [other.deserialize(raw, c.msgtype) for c, _t, raw in other.messages()
-                if c.topic == "/bag_test/joint_state"][-1]
+            ("/bag_test/joint_state", "sensor_msgs/msg/JointState", 20),
+            ("/bag_test/joy", "sensor_msgs/msg/Joy", 20),
+        ]
+        last = [
+            other.deserialize(raw, c.msgtype) for c, _t, raw in other.messages() if c.topic == "/bag_test/joint_state"
+        ][-1]
         assert list(last.name) == ["TURRET_Y", "TURRET_P"] and list(last.position) == [0.19, -0.38]
 
     # Our own ROS-free reading.
@@ -237,7 +263,7 @@ def test_all_topics_takes_late_publishers_but_not_hidden_topics(ros, node, tmp_p
     from std_msgs.msg import String
 
     from tutorial.bag.record import BagRecorder
-    from tutorial.ros_env import SpinThread
+    from tutorial.ros.env import SpinThread
 
     own = ros.create_node("test_bag_own_node")
     spin = SpinThread(own).start()
@@ -285,7 +311,7 @@ def test_player_keeps_the_timing_and_honours_rate_offset_topics_and_loop(ros, no
     from sensor_msgs.msg import Joy
 
     from tutorial.bag.play import BagPlayer
-    from tutorial.ros_env import SpinThread
+    from tutorial.ros.env import SpinThread
 
     bag = timed_bag(tmp_path / "timed.mcap")
     lock = threading.Lock()  # the spin thread appends, the test thread reads
@@ -295,6 +321,7 @@ def test_player_keeps_the_timing_and_honours_rate_offset_topics_and_loop(ros, no
         def on_message(msg):
             with lock:
                 got[topic].append((int(msg.axes[0]), time.monotonic()))
+
         return on_message
 
     for topic in got:
@@ -305,8 +332,10 @@ def test_player_keeps_the_timing_and_honours_rate_offset_topics_and_loop(ros, no
         player = BagPlayer(bag, rate=2.0, start_offset=0.2, topics=["bag_test/a"], delay=0.5, output=None)
         stats = player.play()
         [offer] = node.get_publishers_info_by_topic("/bag_test/a")
-        assert (offer.qos_profile.reliability.short_key, offer.qos_profile.durability.short_key) == \
-            ("reliable", "transient_local")  # as recorded
+        assert (offer.qos_profile.reliability.short_key, offer.qos_profile.durability.short_key) == (
+            "reliable",
+            "transient_local",
+        )  # as recorded
         player.close()
         assert stats.published == {"/bag_test/a": 6} and stats.loops == 1 and not stats.stopped
         assert wait_until(lambda: len(got["/bag_test/a"]) == 6, timeout=5), got
@@ -352,7 +381,7 @@ def bad_bags(tmp_path) -> dict:
         [chunk] = make_reader(f).get_summary().chunk_indexes
     corrupt = bytearray(data)
     middle = chunk.chunk_start_offset + chunk.chunk_length // 2  # zstd data: no longer decompresses or matches its CRC
-    corrupt[middle:middle + 64] = bytes(64)
+    corrupt[middle : middle + 64] = bytes(64)
     files["corrupt"] = bytes(corrupt)
     paths = {}
     for name, content in files.items():
@@ -362,8 +391,13 @@ def bad_bags(tmp_path) -> dict:
     return paths
 
 
-REASONS = {"truncated": "truncated MCAP file", "garbage": "not an MCAP file", "empty": "empty",
-           "corrupt": "corrupt MCAP file", "missing": "no such file"}
+REASONS = {
+    "truncated": "truncated MCAP file",
+    "garbage": "not an MCAP file",
+    "empty": "empty",
+    "corrupt": "corrupt MCAP file",
+    "missing": "no such file",
+}
 
 
 @pytest.mark.parametrize("command", ["info", "play"])
@@ -377,15 +411,19 @@ def test_a_bad_file_gives_one_clear_line_and_status_2(tmp_path, capsys, command)
         assert REASONS[name] in lines[0], (name, err)
 
 
+@pytest.mark.cross_process
 def test_a_bad_file_is_one_line_from_the_real_program_too(tmp_path):
     import subprocess
 
     path = bad_bags(tmp_path)["truncated"]
-    done = subprocess.run(module_command("tutorial.bag", "info", str(path)), capture_output=True, text=True,
-                          timeout=60, cwd=ROOT)
+    done = subprocess.run(
+        module_command("tutorial.bag", "info", str(path)), capture_output=True, text=True, timeout=60, cwd=ROOT
+    )
     assert done.returncode == 2 and done.stdout == ""
-    assert done.stderr.splitlines() == [f"rtt-bag: info: {path}: truncated MCAP file (no closing magic at its end): "
-                                        "the recording was not closed, or the copy is incomplete"]
+    assert done.stderr.splitlines() == [
+        f"rtt-bag: info: {path}: truncated MCAP file (no closing magic at its end): "
+        "the recording was not closed, or the copy is incomplete"
+    ]
 
 
 def test_an_unknown_message_type_is_listed_but_not_played(tmp_path, capsys):
@@ -395,11 +433,17 @@ def test_an_unknown_message_type_is_listed_but_not_played(tmp_path, capsys):
     assert cli.main(["rtt-bag", "info", str(path), "--json"]) == 0
     [topic] = json.loads(capsys.readouterr().out)["topics"]
     assert (topic["topic"], topic["type"], topic["count"], topic["rate_hz"]) == (
-        "/Tank/joint_state", "nope_msgs/msg/Thing", 3, pytest.approx(1000.0))
+        "/Tank/joint_state",
+        "nope_msgs/msg/Thing",
+        3,
+        pytest.approx(1000.0),
+    )
     assert cli.main(["rtt-bag", "play", str(path)]) == 2
     err = capsys.readouterr().err
-    assert err.splitlines() == [f"rtt-bag: play: {path}: cannot play /Tank/joint_state: message type "
-                                "nope_msgs/msg/Thing is not installed here (no Python module nope_msgs.msg)"]
+    assert err.splitlines() == [
+        f"rtt-bag: play: {path}: cannot play /Tank/joint_state: message type "
+        "nope_msgs/msg/Thing is not installed here (no Python module nope_msgs.msg)"
+    ]
     assert cli.main(["rtt-bag", "play", str(tmp_path / "unknown.mcap"), "--topics", "/nothing"]) == 2
     assert "no messages on /nothing" in capsys.readouterr().err
 
@@ -409,7 +453,8 @@ def test_record_refuses_an_existing_file(tmp_path, capsys):
     before = path.read_bytes()
     assert cli.main(["rtt-bag", "record", "/joy", "-o", str(path)]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        f"rtt-bag: record: {path} exists already; choose another name or pass --overwrite"]
+        f"rtt-bag: record: {path} exists already; choose another name or pass --overwrite"
+    ]
     assert path.read_bytes() == before
 
 
@@ -448,12 +493,15 @@ def test_duration_ends_a_recording_by_itself(procs, tmp_path):
     assert bag_info(path).count == 0
 
 
+@pytest.mark.cross_process
 def test_reading_needs_no_ros():
     """The reading half imports neither rclpy nor a message package (a notebook can read a bag anywhere)."""
     import subprocess
 
-    code = ("import sys; import tutorial.bag; from tutorial.bag import joint_series, bag_info, format_info; "
-            "import tutorial.bag.reader, tutorial.bag.info; "
-            "bad = [m for m in sys.modules if m.startswith(('rclpy', 'sensor_msgs'))]; print(bad)")
+    code = (
+        "import sys; import tutorial.bag; from tutorial.bag import joint_series, bag_info, format_info; "
+        "import tutorial.bag.reader, tutorial.bag.info; "
+        "bad = [m for m in sys.modules if m.startswith(('rclpy', 'sensor_msgs'))]; print(bad)"
+    )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, cwd=ROOT)
     assert done.stdout.strip() == "[]", done.stderr

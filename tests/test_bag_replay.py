@@ -4,10 +4,11 @@ import signal
 
 import pytest
 
-from conftest import module_command, publishers_seen, wait_until
 from tutorial.bag.info import bag_info
 from tutorial.bag.qos import offer_for_recorded
 from tutorial.bag.reader import joint_series
+
+from conftest import module_command, publishers_seen, wait_until
 
 
 def is_stale(line: str) -> bool:
@@ -19,8 +20,10 @@ def test_a_replayed_drive_drives_the_viewer_as_the_live_one_did(procs, tmp_path)
     # 1. Record a demo drive: the recorder first, so it is in the graph when the publishers appear.
     rec = procs(module_command("tutorial.bag", "record", "/joy", "/Tank/joint_state", "-o", str(bag)))
     rec.wait_for_line(lambda line: "recording /joy /Tank/joint_state" in line, timeout=30)
-    joy = procs(module_command("tutorial.joy_node", "--demo", "--duration", "9"))
-    sim = procs(module_command("tutorial.runner", "project/step2.yaml", "--headless", "--duration", "10", "--json"))
+    joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "9"))
+    sim = procs(
+        module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--duration", "10", "--json")
+    )
     assert sim.wait(60) == 0, sim.err
     assert joy.wait(30) == 0, joy.err
     rec.p.send_signal(signal.SIGINT)
@@ -40,15 +43,26 @@ def test_a_replayed_drive_drives_the_viewer_as_the_live_one_did(procs, tmp_path)
     assert max(abs(q).max() for q in recorded.positions.values()) > 0.05  # the demo moved the turret
 
     # 2. Play it, twice as fast, into a fresh viewer.
-    view = procs(module_command("tutorial.runner", "project/step3.yaml", "--headless", "--json",
-                                "--ros-args", "-r", "__node:=rtt_viewer"))
+    view = procs(
+        module_command(
+            "tutorial.tools.rtt_run",
+            "project/step3.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-r",
+            "__node:=rtt_viewer",
+        )
+    )
     play = procs(module_command("tutorial.bag", "play", str(bag), "--rate", "2", "--delay", "1"))
     assert wait_until(lambda: publishers_seen(view) >= 1, timeout=30), view.out
     stale_before = view.count(is_stale)  # the player is still playing
     assert play.wait(60) == 0, play.err
     offer, _ = offer_for_recorded(states.offered_qos_profiles)  # the QoS the file says the simulation offered
-    assert f"publishing /Tank/joint_state (sensor_msgs/msg/JointState; {offer['reliability']}, " \
-           f"{offer['durability']})" in play.out
+    assert (
+        f"publishing /Tank/joint_state (sensor_msgs/msg/JointState; {offer['reliability']}, "
+        f"{offer['durability']})" in play.out
+    )
     # The data stopped: every state delivered has been applied. Then stop the viewer.
     view.wait_for_count(is_stale, stale_before + 1, timeout=30)
     view.p.send_signal(signal.SIGINT)

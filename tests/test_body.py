@@ -5,8 +5,9 @@ from pathlib import Path
 import mujoco
 import pytest
 
-from tutorial.body import Body
-from tutorial.world import ModelEntry, build_world, name_unnamed_elements
+from tutorial.core.body import Body
+from tutorial.core.world import ModelEntry, build_world, name_unnamed_elements
+
 from conftest import MODEL
 
 FIXTURES = Path(__file__).resolve().parent / "fixtures"
@@ -56,7 +57,11 @@ def test_unnamed_joints_are_named_after_their_id_in_the_file():
     alone = mujoco.MjModel.from_xml_path(str(UNNAMED))  # the ids the rule refers to
     kinds = mujoco.mjtJoint
     assert [int(alone.jnt_type[i]) for i in (0, 1, 3, 5)] == [
-        int(kinds.mjJNT_FREE), int(kinds.mjJNT_HINGE), int(kinds.mjJNT_BALL), int(kinds.mjJNT_HINGE)]
+        int(kinds.mjJNT_FREE),
+        int(kinds.mjJNT_HINGE),
+        int(kinds.mjJNT_BALL),
+        int(kinds.mjJNT_HINGE),
+    ]
     assert body.joint("shoulder").info.motor >= 0 and body.joint("joint3").info.gear == 5.0
     assert body.joint("joint1").info.motor == -1
 
@@ -74,8 +79,11 @@ def test_a_body_owns_its_whole_kinematic_tree_and_what_it_fixed_to_the_world():
 
 
 def test_two_copies_of_an_unnamed_model_and_the_tank_share_nothing():
-    entries = [ModelEntry("A", UNNAMED), ModelEntry("B", UNNAMED, (3, 0, 0)),
-               ModelEntry("Tank", MODEL / "tank.xml", (0, 3, 0))]
+    entries = [
+        ModelEntry("A", UNNAMED),
+        ModelEntry("B", UNNAMED, (3, 0, 0)),
+        ModelEntry("Tank", MODEL / "tank.xml", (0, 3, 0)),
+    ]
     model = build_world(entries)
     data = mujoco.MjData(model)
     a, b, tank = (Body(model, data, e.name) for e in entries)

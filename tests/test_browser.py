@@ -8,15 +8,22 @@ import pytest
 from browser import chromium, greenish_pixels, screenshot
 from conftest import module_command, publish_and_wait_applied, publishers_seen, wait_until
 
-pytestmark = pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)"),
+]
 
 
 def test_viewer_page_draws_the_tank_and_follows_the_turret(procs, node, tmp_path):
-    from tutorial.controllers.joint_state_publisher import joint_state_qos
     from sensor_msgs.msg import JointState
 
-    view = procs(module_command("tutorial.runner", "project/step3.yaml", "--json",
-                                "--ros-args", "-r", "__node:=rtt_viewer"))
+    from tutorial.interfaces.joint_state import joint_state_qos
+
+    view = procs(
+        module_command(
+            "tutorial.tools.rtt_run", "project/step3.yaml", "--json", "--ros-args", "-r", "__node:=rtt_viewer"
+        )
+    )
     url = json.loads(view.wait_for_line(lambda line: '"event": "meshcat"' in line, timeout=60))["url"]
     assert url.startswith("http://127.0.0.1:")
     pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
@@ -39,8 +46,8 @@ def test_viewer_page_draws_the_tank_and_follows_the_turret(procs, node, tmp_path
 
 
 def test_simulation_page_shows_the_tank_driving(procs, tmp_path):
-    joy = procs(module_command("tutorial.joy_node", "--demo"))
-    sim = procs(module_command("tutorial.runner", "project/step1.yaml", "--json", "--duration", "30"))
+    joy = procs(module_command("tutorial.tools.rtt_joy", "--demo"))
+    sim = procs(module_command("tutorial.tools.rtt_run", "project/step1.yaml", "--json", "--duration", "30"))
     url = json.loads(sim.wait_for_line(lambda line: '"event": "meshcat"' in line, timeout=60))["url"]
     joy.wait_for_line(lambda line: "the demo starts" in line, timeout=30)
     first = screenshot(url, tmp_path / "first.png")

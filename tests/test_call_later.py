@@ -2,8 +2,7 @@
 
 import threading
 
-
-from tutorial.call_later import LazyCaller, MainLoop, WrongThreadError
+from tutorial.core.call_later import LazyCaller, MainLoop, WrongThreadError
 
 
 def test_posted_calls_run_on_the_owner_thread_in_order():
@@ -98,7 +97,7 @@ def test_no_backlog_under_a_flood_from_many_threads():
     loop.process_pending()
     assert errors == []
     assert max_pending <= 4  # one pending call per key, never a queue of states
-    for thread_id, states in seen.items():
+    for states in seen.values():
         assert states == sorted(states)  # never an older state after a newer one
         assert states[-1] == 4999  # the newest state always arrives
     assert loop.posted == 20000 and loop.executed + loop.coalesced == 20000

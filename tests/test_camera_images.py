@@ -1,6 +1,6 @@
 """Reading a received sensor_msgs/Image: every field is checked; a bad message is counted, never drawn.
 
-Also the notebooks' live picture (:class:`tutorial.notebook.images.LiveImage`).
+Also the notebooks' live picture (:class:`tutorial.notebook.live_image.LiveImage`).
 """
 
 from array import array
@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from sensor_msgs.msg import Image
 
+from tutorial.interfaces.image import ImageError, image_to_array
+from tutorial.view.images import ImageReceiver, PngWriter, format_image_status, png_bytes
+
 from conftest import wait_until
-from tutorial.image_node import ImageReceiver, PngWriter, format_status
-from tutorial.images import ImageError, image_to_array, png_bytes
 
 
 def make_image(pixels: np.ndarray, encoding: str = "rgb8", pad: int = 0) -> Image:
@@ -45,12 +46,15 @@ def test_row_padding_is_skipped():
     np.testing.assert_array_equal(image_to_array(make_image(pixels, pad=3)), pixels)
 
 
-@pytest.mark.parametrize("encoding, channels, expected", [
-    ("bgr8", 3, lambda p: p[:, :, ::-1]),
-    ("rgba8", 4, lambda p: p[:, :, :3]),
-    ("bgra8", 4, lambda p: p[:, :, 2::-1]),
-    ("mono8", 1, lambda p: np.repeat(p, 3, axis=2)),
-])
+@pytest.mark.parametrize(
+    "encoding, channels, expected",
+    [
+        ("bgr8", 3, lambda p: p[:, :, ::-1]),
+        ("rgba8", 4, lambda p: p[:, :, :3]),
+        ("bgra8", 4, lambda p: p[:, :, 2::-1]),
+        ("mono8", 1, lambda p: np.repeat(p, 3, axis=2)),
+    ],
+)
 def test_other_encodings_become_rgb(encoding, channels, expected):
     pixels = picture(c=channels)
     np.testing.assert_array_equal(image_to_array(make_image(pixels, encoding)), expected(pixels))
@@ -86,10 +90,20 @@ def test_a_hostile_image_raises_image_error_naming_the_field(name):
     msg = hostile_messages()[name]
     with pytest.raises(ImageError) as info:
         image_to_array(msg)
-    field = {"unknown encoding": "encoding", "16-bit encoding": "encoding", "empty encoding": "encoding",
-             "short data": "data", "long data": "data", "no data": "data", "step shorter than a row": "step",
-             "step longer than the data": "data", "zero height": "height", "zero width": "width",
-             "huge width": "width", "height and width swapped": "data"}[name]
+    field = {
+        "unknown encoding": "encoding",
+        "16-bit encoding": "encoding",
+        "empty encoding": "encoding",
+        "short data": "data",
+        "long data": "data",
+        "no data": "data",
+        "step shorter than a row": "step",
+        "step longer than the data": "data",
+        "zero height": "height",
+        "zero width": "width",
+        "huge width": "width",
+        "height and width swapped": "data",
+    }[name]
     assert str(info.value).startswith(field), str(info.value)
 
 
@@ -109,7 +123,7 @@ def test_the_receiver_counts_rejections_and_keeps_the_newest_good_picture(node):
     newest = receiver.newest()
     assert (newest.stamp, newest.frame_id, newest.encoding, newest.number) == (3.25, "Kinect", "rgb8", 1)
     np.testing.assert_array_equal(newest.pixels, picture())
-    line = format_status(counts, 1.0, newest)
+    line = format_image_status(counts, 1.0, newest)
     assert "5x4 rgb8 frame Kinect" in line and f"rejected: {len(hostile)} (last: data has 60" in line
 
 
@@ -148,7 +162,8 @@ def test_the_window_shows_the_newest_picture_and_its_stamp():
     matplotlib.use("Agg")  # the window's code, drawn off screen
     import matplotlib.pyplot as plt
 
-    from tutorial.image_node import ReceivedImage, _Viewer, build_parser
+    from tutorial.tools.rtt_image import _Viewer, build_parser
+    from tutorial.view.images import ReceivedImage
 
     class Receiver:  # what the subscription would have received
         topic = "/Tank/camera/image"
@@ -175,9 +190,9 @@ def test_the_notebook_live_image_redraws_in_place_and_keeps_the_last_picture_whe
     """LiveImage (notebook 06): subscribes best effort, redraws when a picture arrives, says stopped on reset()."""
     import IPython.display
 
-    from tutorial.controllers.camera_image_publisher import camera_image_qos
+    from tutorial.interfaces.image import camera_image_qos
     from tutorial.notebook import session
-    from tutorial.notebook.images import LiveImage
+    from tutorial.notebook.live_image import LiveImage
 
     class Handle:  # what display(..., display_id=True) returns in a kernel
         def __init__(self):

@@ -18,15 +18,15 @@ import mujoco
 import numpy as np
 import pytest
 
+from tutorial.controllers.camera_image_publisher import RttCameraImagePublisher, body_cameras
+from tutorial.core.body import Body
+from tutorial.core.controller import ControllerConfig, ControllerIO
+from tutorial.core.project import load_project
+from tutorial.core.world import build_world
+from tutorial.interfaces.image import camera_image_topic, fill_image, image_to_array
+from tutorial.interfaces.timing import PeriodAccumulator
+
 from conftest import PROJECT, ROOT, module_command, wait_until
-from tutorial.body import Body
-from tutorial.controller import ControllerConfig, ControllerIO
-from tutorial.controllers.camera_image_publisher import (RttCameraImagePublisher, body_cameras,
-                                                          camera_image_topic, fill_image)
-from tutorial.controllers.joint_state_publisher import PeriodAccumulator
-from tutorial.images import image_to_array
-from tutorial.project import load_project
-from tutorial.world import build_world
 
 CRATE_BEARING = math.atan2(-1.2, 1.8 + 0.04)  # rad, Room/crate_1 seen from the turret axis of a tank at the origin
 
@@ -39,8 +39,9 @@ def egl_problem() -> str | None:
     default in this process cannot make a test skip instead of fail.
     """
     probe = "from mujoco.egl import GLContext; c = GLContext(8, 8); c.make_current(); c.free()"
-    r = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=60,
-                       env=dict(os.environ, MUJOCO_GL="egl"))
+    r = subprocess.run(
+        [sys.executable, "-c", probe], capture_output=True, text=True, timeout=60, env=dict(os.environ, MUJOCO_GL="egl")
+    )
     return None if r.returncode == 0 else (r.stderr.strip().splitlines() or ["no output"])[-1]
 
 
@@ -61,9 +62,17 @@ class Recorder:
         self.messages: list[dict] = []
 
     def publish(self, msg) -> None:
-        record = {"pixels": image_to_array(msg), "stamp": msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9,
-                  "frame_id": msg.header.frame_id, "encoding": msg.encoding, "height": msg.height,
-                  "width": msg.width, "step": msg.step, "is_bigendian": msg.is_bigendian, "size": len(msg.data)}
+        record = {
+            "pixels": image_to_array(msg),
+            "stamp": msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9,
+            "frame_id": msg.header.frame_id,
+            "encoding": msg.encoding,
+            "height": msg.height,
+            "width": msg.width,
+            "step": msg.step,
+            "is_bigendian": msg.is_bigendian,
+            "size": len(msg.data),
+        }
         with self.lock:
             self.messages.append(record)
         self.real.publish(msg)
@@ -87,8 +96,9 @@ class Rig:
         controller.publisher = self.recorder
         self.data = mujoco.MjData(self.model)  # the simulation's
         self.turret_y = self.model.joint("Tank/TURRET_Y").qposadr[0]
-        assert controller.initialize(ControllerIO(body=Body(self.model, self.data, "Tank"), time_step=0.001,
-                                                  node=node, data=self.data))
+        assert controller.initialize(
+            ControllerIO(body=Body(self.model, self.data, "Tank"), time_step=0.001, node=node, data=self.data)
+        )
         assert controller.start()
         self.steps = 0
 
@@ -150,8 +160,15 @@ def test_the_picture_changes_when_the_turret_turns_towards_an_obstacle(node, egl
     assert rig.controller.error is None
     toward, away = rig.recorder.messages[:2]
     for m in (toward, away):
-        assert (m["encoding"], m["height"], m["width"], m["step"], m["is_bigendian"], m["size"], m["frame_id"]) == \
-               ("rgb8", 240, 320, 960, 0, 240 * 960, "Kinect")
+        assert (m["encoding"], m["height"], m["width"], m["step"], m["is_bigendian"], m["size"], m["frame_id"]) == (
+            "rgb8",
+            240,
+            320,
+            960,
+            0,
+            240 * 960,
+            "Kinect",
+        )
         assert m["pixels"].std() > 10, "a blank picture"
     assert toward["stamp"] == 0.0
     assert away["stamp"] == pytest.approx(0.034)  # the next 30 Hz period ends at the 34th step
@@ -234,8 +251,9 @@ def test_configure_refuses_a_bad_rate_and_a_body_without_camera(node):
     data = mujoco.MjData(model)
 
     def configure(body, rate):
-        return RttCameraImagePublisher().configure(ControllerConfig(name="cam", body=Body(model, data, body), node=node,
-                                                                    parameters={"rate": rate}))
+        return RttCameraImagePublisher().configure(
+            ControllerConfig(name="cam", body=Body(model, data, body), node=node, parameters={"rate": rate})
+        )
 
     assert body_cameras(model, "Tank") == [(0, "Kinect")]
     assert camera_image_topic("Tank") == "/Tank/camera/image"
@@ -244,11 +262,18 @@ def test_configure_refuses_a_bad_rate_and_a_body_without_camera(node):
     assert not configure("Room", 30.0)
 
 
+@pytest.mark.cross_process
 def test_without_egl_rtt_run_refuses_with_one_line_saying_why(egl):
     # glvnd finds no EGL vendor library: as on a machine without Mesa's libEGL
     env = dict(os.environ, MUJOCO_GL="egl", __EGL_VENDOR_LIBRARY_FILENAMES="/nonexistent/egl_vendor.json")
-    r = subprocess.run(module_command("tutorial.runner", str(PROJECT / "step6.yaml"), "--headless", "--duration", "1"),
-                       capture_output=True, text=True, timeout=60, cwd=ROOT, env=env)
+    r = subprocess.run(
+        module_command("tutorial.tools.rtt_run", str(PROJECT / "step6.yaml"), "--headless", "--duration", "1"),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=ROOT,
+        env=env,
+    )
     assert r.returncode == 1, r.stdout + r.stderr
     lines = r.stderr.strip().splitlines()
     assert lines[0].startswith("cannot render camera Kinect offscreen (MUJOCO_GL=egl; "), r.stderr

@@ -17,9 +17,15 @@ import pytest
 
 from conftest import ROOT
 
-MODULES = {"01": "tank_controller", "02": "joint_state_publisher", "03": "joint_state_subscriber",
-           "04": "imu_state_publisher", "05": "imu_state_subscriber",
-           "06": "camera_image_publisher", "07": None}
+MODULES = {
+    "01": "tank_controller",
+    "02": "joint_state_publisher",
+    "03": "joint_state_subscriber",
+    "04": "imu_state_publisher",
+    "05": "imu_state_subscriber",
+    "06": "camera_image_publisher",
+    "07": None,
+}
 
 
 def exercise(number: str) -> dict:
@@ -31,8 +37,14 @@ def exercise(number: str) -> dict:
     check, stub, solution = cells[i - 1], cells[i - 2], cells[i]
     call = re.search(r"^(check_\w+)\((\w+)\)\s*$", check, re.M)
     assert call, check
-    return {"stub": stub, "solution": solution, "check": call.group(1), "target": call.group(2),
-            "module": MODULES[step], "step": int(step)}
+    return {
+        "stub": stub,
+        "solution": solution,
+        "check": call.group(1),
+        "target": call.group(2),
+        "module": MODULES[step],
+        "step": int(step),
+    }
 
 
 def grade(ex: dict, *sources: str):
@@ -41,7 +53,9 @@ def grade(ex: dict, *sources: str):
 
     namespace: dict = {}
     if ex["module"] is not None:
-        exec(f"from tutorial.controllers.{ex['module']} import *", namespace)  # the cells notebook N exports
+        # What the notebook's exported cells define and import, as the notebook's own namespace has it.
+        module = importlib.import_module(f"tutorial.controllers.{ex['module']}")
+        namespace.update({k: v for k, v in vars(module).items() if not k.startswith("__")})
     for source in sources:
         # The cell's own check call is left out: the test makes it, to see its Result.
         source = re.sub(rf"^{ex['check']}\({ex['target']}\)\s*$", "", source, flags=re.M)
@@ -71,102 +85,204 @@ def test_the_empty_stub_fails_as_not_done(ros, number):
 
 # (exercise, text of the solution, the mistake put in its place, the case that must catch it)
 MISTAKES = [
-    ("1.1", "return forward - turn_left, forward + turn_left", "return forward + turn_left, forward - turn_left",
-     "(left)"),
-    ("1.1", "forward = DPAD_SPEED * joy.axis(axes, joy.DPAD_V)", "forward = DPAD_SPEED * axes[joy.DPAD_V]",
-     "(a Joy with only 4 axes)"),
-    ("1.1", "turn_left = DPAD_TURN * joy.axis(axes, joy.DPAD_H)", "turn_left = DPAD_TURN * joy.axis(axes, 0)",
-     "(left)"),
+    (
+        "1.1",
+        "return forward - turn_left, forward + turn_left",
+        "return forward + turn_left, forward - turn_left",
+        "(left)",
+    ),
+    (
+        "1.1",
+        "forward = DPAD_SPEED * joy.axis(axes, joy.DPAD_V)",
+        "forward = DPAD_SPEED * axes[joy.DPAD_V]",
+        "(a Joy with only 4 axes)",
+    ),
+    (
+        "1.1",
+        "turn_left = DPAD_TURN * joy.axis(axes, joy.DPAD_H)",
+        "turn_left = DPAD_TURN * joy.axis(axes, 0)",
+        "(left)",
+    ),
     ("1.2", "if down and not self.a_down:", "if down:", "(A held for 10 repeats, then released)"),
-    ("1.2", "down = len(buttons) > joy.BUTTON_A and buttons[joy.BUTTON_A] == 1", "down = buttons[0] == 1",
-     "(a Joy with no buttons between two presses)"),
-    ("1.2", "        super().on_joy(msg)  # store the sticks, as before\n        buttons", "        buttons",
-     "(a Joy with the left stick up)"),
-    ("2.1", "joints = [io.body.joint(name).info for name in self.selected]",
-     "joints = [j for j in io.body.joint_infos if j.name in self.selected]", "joints='TURRET_P,TURRET_Y'"),
+    (
+        "1.2",
+        "down = len(buttons) > joy.BUTTON_A and buttons[joy.BUTTON_A] == 1",
+        "down = buttons[0] == 1",
+        "(a Joy with no buttons between two presses)",
+    ),
+    (
+        "1.2",
+        "        super().on_joy(msg)  # store the sticks, as before\n        buttons",
+        "        buttons",
+        "(a Joy with the left stick up)",
+    ),
+    (
+        "2.1",
+        "joints = [io.body.joint(name).info for name in self.selected]",
+        "joints = [j for j in io.body.joint_infos if j.name in self.selected]",
+        "joints='TURRET_P,TURRET_Y'",
+    ),
     ("2.1", "        if unknown:\n", "        if False:\n", "joints='GUN'"),
-    ("2.1", "self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(joints)]",
-     "self.addresses = self.addresses[:n]", "joints='TURRET_P,TURRET_Y'"),
-    ("2.2", "o.x, o.y, o.z, o.w = float(qx), float(qy), float(qz), float(w)",
-     "o.w, o.x, o.y, o.z = float(qx), float(qy), float(qz), float(w)", "the root's orientation"),
+    (
+        "2.1",
+        "self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(joints)]",
+        "self.addresses = self.addresses[:n]",
+        "joints='TURRET_P,TURRET_Y'",
+    ),
+    (
+        "2.2",
+        "o.x, o.y, o.z, o.w = float(qx), float(qy), float(qz), float(w)",
+        "o.w, o.x, o.y, o.z = float(qx), float(qy), float(qz), float(w)",
+        "the root's orientation",
+    ),
     ("2.2", 'self.msg.header.frame_id = "world"', "pass", "the root's position, frame world"),
     ("2.2", "if self.accumulator.tick():", "if True:", "10 Hz from t = 0"),
-    ("3.1", "if not names or not names <= ours:", "if not names & ours:",
-     "(one of the tank's joints and one unknown)"),
+    ("3.1", "if not names or not names <= ours:", "if not names & ours:", "(one of the tank's joints and one unknown)"),
     ("3.1", "            return None\n", "", "(the crane's message)"),
     ("3.1", "if not names or not names <= ours:", "if names and not names <= ours:", "(an empty message)"),
-    ("3.2", "if joint is None or copies[name] > 1 or not math.isfinite(q):",
-     "if joint is None or not math.isfinite(q):", "(duplicate name)"),
+    (
+        "3.2",
+        "if joint is None or copies[name] > 1 or not math.isfinite(q):",
+        "if joint is None or not math.isfinite(q):",
+        "(duplicate name)",
+    ),
     ("3.2", 'tolerance = 0.01 if joint.kind == "slide" else 0.05', "tolerance = 0.0", "(past the limit a little)"),
-    ("3.2", "        if joint.limited and not low <= q <= high:\n            continue\n",
-     "        if joint.limited:\n            q = min(max(q, joint.lower), joint.upper)\n", "(huge)"),
+    (
+        "3.2",
+        "        if joint.limited and not low <= q <= high:\n            continue\n",
+        "        if joint.limited:\n            q = min(max(q, joint.lower), joint.upper)\n",
+        "(huge)",
+    ),
     ("4.1", "math.hypot(a[0], a[1])", "math.hypot(a[0], a[1], a[2])", "(at rest, t <= 0.5 s)"),
-    ("4.1", "        self.peak_publisher.publish(Float64(data=self.peak))\n        self.peak = 0.0\n",
-     "        self.peak_publisher.publish(Float64(data=self.peak))\n", "(at rest, t <= 0.5 s)"),
-    ("4.1", "self.peak_publisher.publish(Float64(data=self.peak))",
-     "self.peak_publisher.publish(Float64(data=math.hypot(*self.last[0][:2])))", "(at rest, t <= 0.5 s)"),
-    ("4.1", "        a = self.data.sensordata[self.accel]\n        self.peak = max(self.peak, math.hypot(a[0], a[1]))\n"
-            "        return super().control()\n",
-     "        ok = super().control()\n        a = self.data.sensordata[self.accel]\n"
-     "        self.peak = max(self.peak, math.hypot(a[0], a[1]))\n        return ok\n",
-     "(at rest, t <= 0.5 s)"),
+    (
+        "4.1",
+        "        self.peak_publisher.publish(Float64(data=self.peak))\n        self.peak = 0.0\n",
+        "        self.peak_publisher.publish(Float64(data=self.peak))\n",
+        "(at rest, t <= 0.5 s)",
+    ),
+    (
+        "4.1",
+        "self.peak_publisher.publish(Float64(data=self.peak))",
+        "self.peak_publisher.publish(Float64(data=math.hypot(*self.last[0][:2])))",
+        "(at rest, t <= 0.5 s)",
+    ),
+    (
+        "4.1",
+        "        a = self.data.sensordata[self.accel]\n        self.peak = max(self.peak, math.hypot(a[0], a[1]))\n"
+        "        return super().control()\n",
+        "        ok = super().control()\n        a = self.data.sensordata[self.accel]\n"
+        "        self.peak = max(self.peak, math.hypot(a[0], a[1]))\n        return ok\n",
+        "(at rest, t <= 0.5 s)",
+    ),
     ("4.2", " and not recent:", ":", "with threshold=10.0, the wall"),
-    ("4.2", "recent = self.last_report is not None and now - self.last_report < self.holdoff",
-     "recent = self.last_report is not None", "holdoff=0.1"),
+    (
+        "4.2",
+        "recent = self.last_report is not None and now - self.last_report < self.holdoff",
+        "recent = self.last_report is not None",
+        "holdoff=0.1",
+    ),
     ("4.2", "report.vector.x, report.vector.y = a.x, a.y", "report.vector = a", "with default parameters"),
-    ("4.2", "if math.hypot(a.x, a.y) > self.threshold", "if math.hypot(a.x, a.y, a.z) > self.threshold",
-     "with threshold=10.0, the wall"),
-    ("4.2", "report = Vector3Stamped(header=self.msg.header)", "report = Vector3Stamped()",
-     "with default parameters"),
+    (
+        "4.2",
+        "if math.hypot(a.x, a.y) > self.threshold",
+        "if math.hypot(a.x, a.y, a.z) > self.threshold",
+        "with threshold=10.0, the wall",
+    ),
+    ("4.2", "report = Vector3Stamped(header=self.msg.header)", "report = Vector3Stamped()", "with default parameters"),
     ("5.1", "to_world @ horizontal", "horizontal", "(the tank turned 90 degrees left)"),
     ("5.1", "visible = np.linalg.norm(horizontal) >= ACCEL_MIN_LENGTH", "visible = True", "(0.042 m: hidden)"),
-    ("5.1", "ACCEL_SCALE * np.array([self.accel[0], self.accel[1], 0.0])",
-     "ACCEL_SCALE * (self.accel + GRAVITY_OFFSET)", "(driving over a bump)"),
-    ("5.1", "    def draw_arrows(self) -> None:\n        super().draw_arrows()\n        if self.accel is None:\n"
-            "            return\n",
-     "    def update_imu(self, msg, arrival):\n        reason = super().update_imu(msg, arrival)\n"
-     "        if reason is not None or self.accel is None:\n            return reason\n", "a shake tick 20 ms later"),
+    (
+        "5.1",
+        "ACCEL_SCALE * np.array([self.accel[0], self.accel[1], 0.0])",
+        "ACCEL_SCALE * (self.accel + GRAVITY_OFFSET)",
+        "(driving over a bump)",
+    ),
+    (
+        "5.1",
+        "    def draw_arrows(self) -> None:\n        super().draw_arrows()\n        if self.accel is None:\n"
+        "            return\n",
+        "    def update_imu(self, msg, arrival):\n        reason = super().update_imu(msg, arrival)\n"
+        "        if reason is not None or self.accel is None:\n            return reason\n",
+        "a shake tick 20 ms later",
+    ),
     ("5.1", "        super().draw_arrows()\n", "", "(driving over a bump)"),
-    ("5.2", "newest - self.RESTART <= stamp <= newest", "newest - self.RESTART <= stamp < newest",
-     "(the same stamp twice)"),
-    ("5.2", "        reason = super().update_imu(msg, arrival)\n        if reason is None:\n            self.newest = stamp\n"
-            "        return reason\n",
-     "        self.newest = stamp\n        return super().update_imu(msg, arrival)\n", "(a NaN stamped 2.00 s"),
-    ("5.2", "newest is not None and newest - self.RESTART <= stamp <= newest", "newest is not None and stamp <= newest",
-     "(a restarted publisher)"),
-    ("5.2", '            self.rejected["out_of_order"] += 1\n            return "out_of_order"\n',
-     '            self.rejected["out_of_order"] += 1\n', "(one late)"),
+    (
+        "5.2",
+        "newest - self.RESTART <= stamp <= newest",
+        "newest - self.RESTART <= stamp < newest",
+        "(the same stamp twice)",
+    ),
+    (
+        "5.2",
+        "        reason = super().update_imu(msg, arrival)\n"
+        "        if reason is None:\n            self.newest = stamp\n"
+        "        return reason\n",
+        "        self.newest = stamp\n        return super().update_imu(msg, arrival)\n",
+        "(a NaN stamped 2.00 s",
+    ),
+    (
+        "5.2",
+        "newest is not None and newest - self.RESTART <= stamp <= newest",
+        "newest is not None and stamp <= newest",
+        "(a restarted publisher)",
+    ),
+    (
+        "5.2",
+        '            self.rejected["out_of_order"] += 1\n            return "out_of_order"\n',
+        '            self.rejected["out_of_order"] += 1\n',
+        "(one late)",
+    ),
     ("7.1", "if released and pushed:", "if released:", "let go, then repeated at 20 Hz"),
-    ("7.1", "first = log_time if first is None else first", "first = first or 0",
-     "forward for 1 s, then let go"),
+    ("7.1", "first = log_time if first is None else first", "first = first or 0", "forward for 1 s, then let go"),
     ("7.1", 'read_messages(path, topics=["/joy"])', "read_messages(path)", "joint states around the Joys"),
     ("7.2", "speeds = np.abs(dq[moving] / dt[moving])", "speeds = dq[moving] / dt[moving]", "turning back"),
     ("7.2", "usable = ~np.isnan(q)", "usable = np.ones(len(q), dtype=bool)", "a state without the joint"),
-    ("7.2", "return float(speeds[k]), float(t[1:][moving][k])", "return float(speeds[k]), float(t[:-1][moving][k])",
-     "steady at 1 rad/s"),
+    (
+        "7.2",
+        "return float(speeds[k]), float(t[1:][moving][k])",
+        "return float(speeds[k]), float(t[:-1][moving][k])",
+        "steady at 1 rad/s",
+    ),
     ("6.1", "np.round(pixels @ LUMA)", "np.round(pixels.mean(axis=2))", "towards the crate"),
     ("6.1", "np.round(pixels @ LUMA)", "np.round(pixels @ LUMA[::-1])", "towards the crate"),
     ("6.1", "msg.step = width  # one byte a pixel", "msg.step = 3 * width", "towards the crate"),
-    ("6.1", "msg.height, msg.width = height, width", "msg.height, msg.width = width, height",
-     "towards the crate"),
-    ("6.1", "        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(time_s)\n", "",
-     "picture 2 ("),
+    ("6.1", "msg.height, msg.width = height, width", "msg.height, msg.width = width, height", "towards the crate"),
+    ("6.1", "        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(time_s)\n", "", "picture 2 ("),
     ("6.2", "math.tan(fovy / 2)", "math.tan(math.degrees(fovy) / 2)", "k, from the vertical field of view"),
-    ("6.2", "fx = fy  # square pixels", "fx = (self.width / 2) / math.tan(fovy / 2)",
-     "k, from the vertical field of view"),
-    ("6.2", "cx, cy = (self.width - 1) / 2, (self.height - 1) / 2", "cx, cy = self.width / 2, self.height / 2",
-     "k, from the vertical field of view"),
-    ("6.2", "self.info.header = self.msg.header", "self.info.header.stamp = self.msg.header.stamp",
-     "each CameraInfo has its Image's stamp and frame"),
-    ("6.2", "                                                           camera_image_qos())",
-     "                                                           10)", "one CameraInfo on /Tank/camera/camera_info"),
-    ("6.2", "self.info.p = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]",
-     "self.info.p = [fx, 0.0, 0.0, cx, 0.0, fy, 0.0, cy, 0.0, 0.0, 1.0, 0.0]", "p, k with a fourth column"),
+    (
+        "6.2",
+        "fx = fy  # square pixels",
+        "fx = (self.width / 2) / math.tan(fovy / 2)",
+        "k, from the vertical field of view",
+    ),
+    (
+        "6.2",
+        "cx, cy = (self.width - 1) / 2, (self.height - 1) / 2",
+        "cx, cy = self.width / 2, self.height / 2",
+        "k, from the vertical field of view",
+    ),
+    (
+        "6.2",
+        "self.info.header = self.msg.header",
+        "self.info.header.stamp = self.msg.header.stamp",
+        "each CameraInfo has its Image's stamp and frame",
+    ),
+    (
+        "6.2",
+        "            CameraInfo, topic, camera_image_qos()\n",
+        "            CameraInfo, topic, 10\n",
+        "one CameraInfo on /Tank/camera/camera_info",
+    ),
+    (
+        "6.2",
+        "self.info.p = [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]",
+        "self.info.p = [fx, 0.0, 0.0, cx, 0.0, fy, 0.0, cy, 0.0, 0.0, 1.0, 0.0]",
+        "p, k with a fourth column",
+    ),
 ]
 
 
-@pytest.mark.parametrize("number,right,wrong,caught_by", MISTAKES,
-                         ids=[f"{m[0]}-{k}" for k, m in enumerate(MISTAKES)])
+@pytest.mark.parametrize("number,right,wrong,caught_by", MISTAKES, ids=[f"{m[0]}-{k}" for k, m in enumerate(MISTAKES)])
 def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught_by):
     ex = exercise(number)
     assert right in ex["solution"], f"the solution of {number} no longer has {right!r}: update this test"

@@ -23,10 +23,13 @@ import uuid
 from pathlib import Path
 
 import pytest
+from test_launch import processes_with_marker
+
+from tutorial.ros.shm import SHM_DIR, fast_dds_shm_files, remove_unused_fast_dds_shm
 
 from conftest import ROOT, module_command, publishers_seen, wait_until
-from test_launch import processes_with_marker
-from tutorial.shm import SHM_DIR, fast_dds_shm_files, remove_unused_fast_dds_shm
+
+pytestmark = pytest.mark.cross_process
 
 STALE_DEADLINE = 1.5  # s from a SIGKILLed simulation to the viewer's stale line (issue 18)
 MAX_SLIDE = 0.1  # m the tank's root may move after the joy timeout (issue 18)
@@ -34,11 +37,13 @@ MAX_SLIDE = 0.1  # m the tank's root may move after the joy timeout (issue 18)
 
 def event_is(event: str, **fields):
     """A line predicate: a JSON record of ``event`` whose ``fields`` have these values."""
+
     def match(line: str) -> bool:
         if not line.startswith("{"):
             return False
         record = json.loads(line)
         return record.get("event") == event and all(record.get(k) == v for k, v in fields.items())
+
     return match
 
 
@@ -68,13 +73,27 @@ class Nodes:
 
     def simulation(self, name: str = "rtt"):
         """Step 2's simulation (``rtt-run project/step2.yaml``): Joy in, joint state out at 50 Hz."""
-        return self.start("tutorial.runner", "project/step2.yaml", "--headless", "--json",
-                          "--ros-args", "-r", f"__node:={name}")
+        return self.start(
+            "tutorial.tools.rtt_run",
+            "project/step2.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-r",
+            f"__node:={name}",
+        )
 
     def viewer(self, name: str = "rtt_viewer"):
         """Step 3's viewer (``rtt-run project/step3.yaml``), under its own node name."""
-        return self.start("tutorial.runner", "project/step3.yaml", "--headless", "--json",
-                          "--ros-args", "-r", f"__node:={name}")
+        return self.start(
+            "tutorial.tools.rtt_run",
+            "project/step3.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-r",
+            f"__node:={name}",
+        )
 
     def note_shared_memory(self, proc) -> None:
         self.shm_files |= fast_dds_shm_files(proc.p.pid)
@@ -140,8 +159,9 @@ def test_viewer_killed_and_restarted_mirrors_again(nodes):
     nodes.kill(first)
     second = nodes.viewer()
     second.wait_for_line(event_is("first_state"), timeout=30)
-    status = second.wait_for_line(lambda line: event_is("status", stale=False)(line)
-                                  and json.loads(line)["received"] >= 25, timeout=30)
+    status = second.wait_for_line(
+        lambda line: event_is("status", stale=False)(line) and json.loads(line)["received"] >= 25, timeout=30
+    )
     assert json.loads(status)["matched"] == 2, status
     assert sim.p.poll() is None, sim.err  # the simulation went on without its viewer
 
@@ -160,8 +180,11 @@ def test_two_publishers_on_the_topic_are_warned_about(nodes):
     view = nodes.viewer()
     nodes.simulation()
     second = nodes.simulation("rtt_second")
-    warning = json.loads(view.wait_for_line(
-        lambda line: event_is("warning")(line) and "publishers on /Tank/joint_state" in line, timeout=30))
+    warning = json.loads(
+        view.wait_for_line(
+            lambda line: event_is("warning")(line) and "publishers on /Tank/joint_state" in line, timeout=30
+        )
+    )
     assert "cannot tell which robot it is showing" in warning["message"], warning
     assert publishers_seen(view) == 2
     assert nodes.stop(second) == 0, second.err
@@ -174,7 +197,7 @@ def test_joy_killed_mid_drive_the_tank_stops(nodes, node):
     from rclpy.executors import SingleThreadedExecutor
     from sensor_msgs.msg import JointState
 
-    from tutorial.controllers.joint_state_publisher import joint_state_qos
+    from tutorial.interfaces.joint_state import joint_state_qos
 
     # The demo drives forward (0.8 m/s) exactly while the turret turns (0.8 or 0.5 rad/s):
     # the joint states say when.  newest: the newest state's stamp (s of simulated time),
@@ -200,16 +223,18 @@ def test_joy_killed_mid_drive_the_tank_stops(nodes, node):
         def check():
             executor.spin_once(timeout_sec=0.02)
             return newest["stamp"] is not None and predicate(newest)
+
         return check
 
     try:
         sim = nodes.simulation()
         # The joy node only once this test receives the states: it sees the demo's first drive.
         assert wait_until(spun_and(lambda s: True), timeout=30), sim.out
-        joy = nodes.start("tutorial.joy_node", "--demo")
+        joy = nodes.start("tutorial.tools.rtt_joy", "--demo")
         # Killed 0.4 s into a drive (2.5 s long): at full speed, 2 s before the drive ends.
-        assert wait_until(spun_and(lambda s: s["turning_since"] is not None
-                                   and s["stamp"] - s["turning_since"] >= 0.4), timeout=30), (sim.out, joy.out)
+        assert wait_until(
+            spun_and(lambda s: s["turning_since"] is not None and s["stamp"] - s["turning_since"] >= 0.4), timeout=30
+        ), (sim.out, joy.out)
         nodes.kill(joy)
         stopped = next_record(sim, "joy_timeout", timeout=10)
         assert "tracks stopped" in stopped["line"]
@@ -268,8 +293,10 @@ def step3_launch(procs):
 
     def start():
         marker = uuid.uuid4().hex
-        launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo", "--headless"],
-                       env=dict(os.environ, RTT_TEST_MARKER=marker))
+        launch = procs(
+            [sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo", "--headless"],
+            env=dict(os.environ, RTT_TEST_MARKER=marker),
+        )
         started.append((launch, marker))
         return launch, marker
 
@@ -309,8 +336,11 @@ def test_launch_leaves_no_process_and_no_shared_memory(step3_launch, fault):
         assert launch.wait(15) == 1, launch.out
         assert "[launch] failed: rtt_joy (killed by SIGKILL)" in launch.out
         assert "(rtt_joy killed)" in launch.out  # the launcher says it removed what the killed node left
-        assert not any(os.path.exists(os.path.join(SHM_DIR, name)) for lock in joy_segment
-                       for name in (lock, lock.removesuffix("_el")))
+        assert not any(
+            os.path.exists(os.path.join(SHM_DIR, name))
+            for lock in joy_segment
+            for name in (lock, lock.removesuffix("_el"))
+        )
     assert wait_until(lambda: processes_with_marker(marker) == [], timeout=2.0), processes_with_marker(marker)
     assert left_behind(ours) == [], f"the launch left these in {SHM_DIR}"
 

@@ -1,22 +1,26 @@
-"""When a viewer draws: once a burst is complete or has settled, at most FRAME_RATE times a second, never for nothing."""
+"""When a viewer draws: once a burst is complete or has settled, at most FRAME_RATE times a second, never for
+nothing."""
 
 import math
 import time
 
 import pytest
 
-import tutorial.app as app_module
+import tutorial.core.app as app_module
+from tutorial.core.app import FRAME_RATE, App
+from tutorial.core.project import load_project
+
 from conftest import MODEL
-from tutorial.app import App, FRAME_RATE
-from tutorial.project import load_project
 
 
 @pytest.fixture
 def viewer(tmp_path, node):
     """A project without a simulator (a viewer's) of three tanks, headless, its frames' times in a list."""
     path = tmp_path / "viewer.yaml"
-    path.write_text("name: frames\nmodels:\n" + "".join(
-        f"  - name: Tank{i}\n    file: {MODEL / 'tank.xml'}\n    position: [{i}, 0, 0]\n" for i in (1, 2, 3)))
+    path.write_text(
+        "name: frames\nmodels:\n"
+        + "".join(f"  - name: Tank{i}\n    file: {MODEL / 'tank.xml'}\n    position: [{i}, 0, 0]\n" for i in (1, 2, 3))
+    )
     app = App(load_project(path), node=node, headless=True, output=lambda r: None)
     app.open()
     frames = []

@@ -7,11 +7,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from tutorial.body import Body
-from tutorial.controller import ControllerConfig, ControllerIO
 from tutorial.controllers import imu_state_publisher as pub
 from tutorial.controllers import imu_state_subscriber as sub
-from tutorial.world import ModelEntry, build_world
+from tutorial.core.body import Body
+from tutorial.core.controller import ControllerConfig, ControllerIO
+from tutorial.core.world import ModelEntry, build_world
+from tutorial.interfaces.imu import check_imu, find_imu, imu_qos
+
 from conftest import MODEL, PROJECT
 
 
@@ -22,14 +24,17 @@ class RecordingPublisher:
         self.sent = []
 
     def publish(self, msg):
-        self.sent.append(SimpleNamespace(
-            stamp_ns=msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec,
-            frame_id=msg.header.frame_id,
-            accel=np.array([msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z]),
-            gyro=np.array([msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z]),
-            orientation=[msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w],
-            orientation_covariance=list(msg.orientation_covariance),
-            other_covariances=list(msg.angular_velocity_covariance) + list(msg.linear_acceleration_covariance)))
+        self.sent.append(
+            SimpleNamespace(
+                stamp_ns=msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec,
+                frame_id=msg.header.frame_id,
+                accel=np.array([msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z]),
+                gyro=np.array([msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z]),
+                orientation=[msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w],
+                orientation_covariance=list(msg.orientation_covariance),
+                other_covariances=list(msg.angular_velocity_covariance) + list(msg.linear_acceleration_covariance),
+            )
+        )
 
 
 class FakeNode:
@@ -57,8 +62,9 @@ def run_publisher(seconds, rate=20.0):
     body = Body(model, data, "Tank")
     node = FakeNode()
     controller = pub.RttImuStatePublisher()
-    assert controller.configure(ControllerConfig(name="RttImuStatePublisher", body=body, node=node,
-                                                 parameters={"rate": rate}))
+    assert controller.configure(
+        ControllerConfig(name="RttImuStatePublisher", body=body, node=node, parameters={"rate": rate})
+    )
     assert controller.initialize(ControllerIO(body=body, time_step=model.opt.timestep, node=node, data=data))
     readings = []
     for _ in range(round(seconds / model.opt.timestep)):
@@ -70,7 +76,7 @@ def run_publisher(seconds, rate=20.0):
 
 def test_the_tanks_imu_is_found_by_type_on_its_chassis():
     model, _ = tank_world()
-    accel, gyro, site, frame = pub.find_imu(model, Body(model, mujoco.MjData(model), "Tank").body_ids)
+    accel, gyro, site, frame = find_imu(model, Body(model, mujoco.MjData(model), "Tank").body_ids)
     assert (accel, gyro) == (slice(0, 3), slice(3, 6))
     assert mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, site) == "Tank/IMU"
     assert frame == "CHASSIS"  # the site has the CHASSIS's origin and axes
@@ -79,9 +85,10 @@ def test_the_tanks_imu_is_found_by_type_on_its_chassis():
 def test_a_body_without_imu_is_refused_with_its_name(caplog):
     model, data = tank_world(ModelEntry("Crane", MODEL / "crane.xml", position=(5, 5, 0)))
     with pytest.raises(LookupError, match="no accelerometer"):
-        pub.find_imu(model, Body(model, data, "Crane").body_ids)
-    config = ControllerConfig(name="RttImuStatePublisher", body=Body(model, data, "Crane"), node=FakeNode(),
-                              parameters={"rate": 20.0})
+        find_imu(model, Body(model, data, "Crane").body_ids)
+    config = ControllerConfig(
+        name="RttImuStatePublisher", body=Body(model, data, "Crane"), node=FakeNode(), parameters={"rate": 20.0}
+    )
     assert not pub.RttImuStatePublisher().configure(config)
     assert "body Crane: the body has no accelerometer on a site" in caplog.text
 
@@ -90,7 +97,7 @@ def test_an_imu_site_off_the_link_origin_names_its_own_frame(tmp_path):
     xml = (MODEL / "tank.xml").read_text().replace('<site name="IMU" pos="0 0 0"', '<site name="IMU" pos="0.1 0 0"')
     (tmp_path / "tank.xml").write_text(xml)
     model = build_world([ModelEntry("Tank", tmp_path / "tank.xml")])
-    assert pub.find_imu(model, Body(model, mujoco.MjData(model), "Tank").body_ids)[3] == "IMU"
+    assert find_imu(model, Body(model, mujoco.MjData(model), "Tank").body_ids)[3] == "IMU"
 
 
 def test_each_message_is_the_mean_of_every_step_of_its_period():
@@ -99,7 +106,7 @@ def test_each_message_is_the_mean_of_every_step_of_its_period():
     assert node.topic == "/Tank/imu"
     assert len(sent) == controller.published == 20  # steps 0, 50, ..., 950
     assert [m.stamp_ns for m in sent] == [k * 50_000_000 for k in range(20)]  # simulation time, exact
-    windows = [readings[0:1]] + [readings[50 * k - 49:50 * k + 1] for k in range(1, 20)]
+    windows = [readings[0:1]] + [readings[50 * k - 49 : 50 * k + 1] for k in range(1, 20)]
     for m, window in zip(sent, windows):
         np.testing.assert_allclose(m.accel, window[:, :3].mean(axis=0), rtol=0, atol=1e-12)
         np.testing.assert_allclose(m.gyro, window[:, 3:].mean(axis=0), rtol=0, atol=1e-12)
@@ -120,7 +127,7 @@ def test_at_rest_the_accelerometer_reads_gravity_up_and_orientation_is_unknown()
 def test_the_qos_is_reliable_keep_last_1():
     from rclpy.qos import HistoryPolicy, ReliabilityPolicy
 
-    qos = pub.imu_qos()
+    qos = imu_qos()
     assert (qos.reliability, qos.history, qos.depth) == (ReliabilityPolicy.RELIABLE, HistoryPolicy.KEEP_LAST, 1)
 
 
@@ -147,20 +154,23 @@ def imu(accel=(0.0, 0.0, 9.8), gyro=(0.0, 0.0, 0.0), frame_id="CHASSIS"):
     return msg
 
 
-@pytest.mark.parametrize("msg, reason", [
-    (imu(accel=(math.nan, 0, 9.8)), "not_finite"),
-    (imu(gyro=(0, -math.inf, 0)), "not_finite"),
-    (imu(accel=(0, 0, 9806.65)), "absurd"),  # mm/s^2
-    (imu(gyro=(0, 0, 114.6)), "absurd"),  # deg/s
-    (imu(frame_id="imu_link"), "wrong_frame"),
-])
+@pytest.mark.parametrize(
+    "msg, reason",
+    [
+        (imu(accel=(math.nan, 0, 9.8)), "not_finite"),
+        (imu(gyro=(0, -math.inf, 0)), "not_finite"),
+        (imu(accel=(0, 0, 9806.65)), "absurd"),  # mm/s^2
+        (imu(gyro=(0, 0, 114.6)), "absurd"),  # deg/s
+        (imu(frame_id="imu_link"), "wrong_frame"),
+    ],
+)
 def test_bad_imu_messages_are_rejected_with_a_reason(msg, reason):
-    assert sub.check_imu(msg, "CHASSIS") == (None, None, reason)
+    assert check_imu(msg, "CHASSIS") == (None, None, reason)
 
 
 def test_good_imu_messages_pass_and_an_empty_frame_means_the_viewers():
     for msg in (imu(accel=(999.0, 0, 0), gyro=(0, 0, 99.0)), imu(frame_id="")):
-        accel, gyro, reason = sub.check_imu(msg, "CHASSIS")
+        accel, gyro, reason = check_imu(msg, "CHASSIS")
         assert reason is None and accel.shape == gyro.shape == (3,)
 
 
@@ -198,8 +208,8 @@ def test_a_free_root_has_its_position_at_the_start_of_its_qpos():
 @pytest.fixture
 def viewer(node):
     """The Step 5 project opened in this process, headless: the App and its IMU subscriber."""
-    from tutorial.app import App
-    from tutorial.project import load_project
+    from tutorial.core.app import App
+    from tutorial.core.project import load_project
 
     records = []
     app = App(load_project(PROJECT / "step5.yaml"), node=node, headless=True, output=records.append)
@@ -229,7 +239,7 @@ def test_arrows_follow_the_reading_take_gravity_off_and_hide_when_short(viewer):
 def test_arrows_turn_with_the_body(viewer):
     app, controller = viewer
     root = sub.root_position_address(app.model, controller.body.root_id)
-    app.data.qpos[root + 3:root + 7] = [math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4)]  # yaw +90 deg
+    app.data.qpos[root + 3 : root + 7] = [math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4)]  # yaw +90 deg
     controller.body.notify_kinematic_state_change()
     controller.update_imu(imu(accel=(5.0, 0.0, 9.8), gyro=(0.0, 1.0, 0.0)), 0.0)
     np.testing.assert_allclose(controller.accel_arrow.vector, [0.0, 0.5, 0.0], atol=1e-12)  # forward is +y now
@@ -250,20 +260,20 @@ def test_rejected_messages_are_counted_and_leave_the_arrows_alone(viewer):
 def test_a_collision_shakes_the_model_on_the_timer_and_puts_it_back_exactly(viewer):
     app, controller = viewer
     root = sub.root_position_address(app.model, controller.body.root_id)
-    home = app.data.qpos[root:root + 3].copy()
+    home = app.data.qpos[root : root + 3].copy()
     controller.update_imu(imu(accel=(-30.0, 0.0, 9.8)), 0.0)
     assert controller.shake.shaking
-    assert app.data.qpos[root:root + 3].tolist() == home.tolist()  # not moved by the message itself
+    assert app.data.qpos[root : root + 3].tolist() == home.tolist()  # not moved by the message itself
     seen = []
 
     def moved():
-        seen.append(app.data.qpos[root:root + 3] - home)
+        seen.append(app.data.qpos[root : root + 3] - home)
         return not controller.shake.shaking
 
     assert app.loop.run_until(moved, timeout=5.0)
     offsets = np.array(seen)
     assert np.abs(offsets).max() <= sub.SHAKE_AMPLITUDE and np.abs(offsets).max() > 0
-    assert app.data.qpos[root:root + 3].tolist() == home.tolist()
+    assert app.data.qpos[root : root + 3].tolist() == home.tolist()
     np.testing.assert_array_equal(app.data.site_xpos[controller.site], controller.accel_arrow.origin)
     events = [r["event"] for r in app.records if r["event"] in ("shake", "shake_end")]
     assert events == ["shake", "shake_end"]
@@ -271,7 +281,7 @@ def test_a_collision_shakes_the_model_on_the_timer_and_puts_it_back_exactly(view
 
 
 def test_the_viewers_imu_records_read_as_lines(viewer):
-    from tutorial.runner import format_record
+    from tutorial.tools.rtt_run import format_record
 
     app, controller = viewer
     controller.update_imu(imu(accel=(3.0, 4.0, 9.8), gyro=(0.0, 0.0, 0.005)), 0.0)
@@ -280,13 +290,22 @@ def test_the_viewers_imu_records_read_as_lines(viewer):
     record = dict(app.records[-1], age_ms=12.0, rate_hz=20.0, node="/rtt_viewer")
     assert format_record(record) == (
         "[/rtt_viewer] /Tank/imu: 20.0 msg/s, newest 12 ms old, arrows: acceleration 0.500 m, "
-        "angular velocity 0.002 m (hidden), shakes 0, rejected: not_finite 1")
+        "angular velocity 0.002 m (hidden), shakes 0, rejected: not_finite 1"
+    )
     shake = {"event": "shake", "node": "/rtt_viewer", "body": "Tank", "horizontal_acceleration": 56.77}
     assert format_record(shake) == "[/rtt_viewer] Tank: collision, 56.8 m/s^2 horizontal: shaking the view"
-    summary = format_record({"event": "summary", "project": "step5", "node": "/rtt_viewer",
-                             "controllers": {"RttImuStateSubscriber": controller.summary()}})
-    assert ("RttImuStateSubscriber: arrows: acceleration=(length=0.5, visible=True), "
-            "angular_velocity=(length=0.002, visible=False)") in summary
+    summary = format_record(
+        {
+            "event": "summary",
+            "project": "step5",
+            "node": "/rtt_viewer",
+            "controllers": {"RttImuStateSubscriber": controller.summary()},
+        }
+    )
+    assert (
+        "RttImuStateSubscriber: arrows: acceleration=(length=0.5, visible=True), "
+        "angular_velocity=(length=0.002, visible=False)"
+    ) in summary
 
 
 def test_the_first_message_is_the_first_steps_reading_a_free_fall():
@@ -309,7 +328,7 @@ def test_period_mean_is_the_mean_of_what_was_added_and_starts_over():
 
 
 def test_the_stamp_is_the_simulation_time_split_by_step_2s_stamp_parts():
-    from tutorial.controllers.joint_state_publisher import PeriodAccumulator, stamp_parts
+    from tutorial.interfaces.timing import PeriodAccumulator, stamp_parts
 
     controller, node, _ = run_publisher(2.0, rate=3.0)  # a period that is no whole number of steps
     accumulator = PeriodAccumulator(0.001, 3.0)
@@ -333,7 +352,7 @@ def test_on_a_simulated_clock_the_shake_ends_half_a_second_after_the_hit(viewer)
     now = [50.0]
     controller.clock = lambda: now[0]
     root = sub.root_position_address(app.model, controller.body.root_id)
-    home = app.data.qpos[root:root + 3].copy()
+    home = app.data.qpos[root : root + 3].copy()
     controller.update_imu(imu(accel=(0.0, 25.0, 9.8)), now[0])  # 25 m/s^2 sideways: a hit
     ticks = 0
     while controller.shake.shaking:
@@ -342,7 +361,7 @@ def test_on_a_simulated_clock_the_shake_ends_half_a_second_after_the_hit(viewer)
         ticks += 1
         assert ticks <= 30
     assert ticks == 25  # 0.5 s of 20 ms ticks; the 25th puts the root back
-    assert app.data.qpos[root:root + 3].tolist() == home.tolist()
+    assert app.data.qpos[root : root + 3].tolist() == home.tolist()
     assert [r["event"] for r in app.records if r["event"].startswith("shake")] == ["shake", "shake_end"]
 
 
@@ -354,7 +373,7 @@ def recorded_arrows(visible_per_frame, fps=15.0):
     import umsgpack
 
     from tutorial.notebook import replay
-    from tutorial.overlays import Overlays
+    from tutorial.view.overlays import Overlays
 
     model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
     data = mujoco.MjData(model)
@@ -367,13 +386,19 @@ def recorded_arrows(visible_per_frame, fps=15.0):
     for k, visible in enumerate(visible_per_frame):
         red.set((0.0, 0.0, 0.2), (0.5, 0.1 * k, 0.0), visible=visible)
         snapshots.append(overlays.snapshot())
-    recorder = replay.record_replay(model, [data.qpos.copy()] * len(snapshots), fps, overlays=overlays,
-                                    overlay_frames=snapshots, camera=([-0.6, -0.75, 0.55], [0.0, 0.0, 0.0]))
-    return recorder, [umsgpack.unpackb(c) for c in recorder.commands()]
+    recording = replay.record_replay(
+        model,
+        [data.qpos.copy()] * len(snapshots),
+        fps,
+        overlays=overlays,
+        overlay_frames=snapshots,
+        camera=([-0.6, -0.75, 0.55], [0.0, 0.0, 0.0]),
+    )
+    return recording, [umsgpack.unpackb(c) for c in recording.commands()]
 
 
 def test_a_recording_draws_the_arrows_and_animates_them_with_the_bodies():
-    from tutorial.overlays import arrow_poses
+    from tutorial.view.overlays import arrow_poses
 
     _, commands = recorded_arrows([False, True, True, True])
     path = "/meshcat/rtt_overlays/Tank/acceleration"
@@ -394,7 +419,7 @@ def test_a_recording_draws_the_arrows_and_animates_them_with_the_bodies():
 
 def test_a_recording_is_the_same_bytes_twice_and_refuses_a_wrong_number_of_snapshots():
     from tutorial.notebook import replay
-    from tutorial.overlays import Overlays
+    from tutorial.view.overlays import Overlays
 
     first, _ = recorded_arrows([True, False, True])
     second, _ = recorded_arrows([True, False, True])
@@ -406,26 +431,39 @@ def test_a_recording_is_the_same_bytes_twice_and_refuses_a_wrong_number_of_snaps
         replay.record_replay(model, [qpos, qpos], 15, overlays=overlays, overlay_frames=[overlays.snapshot()])
 
 
+@pytest.mark.browser
 def test_recorded_arrows_appear_and_hide_in_a_browser(tmp_path):
     """The page of a recording shows the arrow only in the frames it was visible (headless Chromium)."""
     import subprocess
 
     import matplotlib.image
 
-    from browser import FLAGS, chromium
     from tutorial.notebook import replay
+
+    from browser import FLAGS, chromium
 
     if chromium() is None:
         pytest.skip("chromium is not installed (make test installs it)")
     red_pixels = {}
     for label, frames in {"hidden": [False, True, True], "shown": [True, False, False]}.items():
-        recorder, _ = recorded_arrows(frames, fps=0.1)  # 10 s a frame: the page stays in frame 0
+        recording, _ = recorded_arrows(frames, fps=0.1)  # 10 s a frame: the page stays in frame 0
         page = tmp_path / f"{label}.html"
-        page.write_text(replay.page_html([recorder]))
+        page.write_text(replay.page_html([recording]))
         png = tmp_path / f"{label}.png"
-        subprocess.run([chromium(), *FLAGS, f"--user-data-dir={tmp_path / label}", "--virtual-time-budget=3000",
-                        f"--screenshot={png}", page.as_uri()], check=True, timeout=120,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        subprocess.run(
+            [
+                chromium(),
+                *FLAGS,
+                f"--user-data-dir={tmp_path / label}",
+                "--virtual-time-budget=3000",
+                f"--screenshot={png}",
+                page.as_uri(),
+            ],
+            check=True,
+            timeout=120,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
         image = matplotlib.image.imread(str(png))[..., :3]
         r, g, b = image[..., 0], image[..., 1], image[..., 2]
         red_pixels[label] = int(((r > g + 0.3) & (r > b + 0.3)).sum())

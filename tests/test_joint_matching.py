@@ -5,9 +5,10 @@ import math
 import mujoco
 import pytest
 
-from tutorial.body import Body
-from tutorial.joint_matching import REASONS, match_joint_state, match_like_the_original
-from tutorial.world import ModelEntry, build_world
+from tutorial.core.body import Body
+from tutorial.core.world import ModelEntry, build_world
+from tutorial.interfaces.joint_state import REASONS, match_joint_state, match_like_the_original
+
 from conftest import MODEL
 
 

@@ -26,14 +26,21 @@ def read_available(fd, timeout=0.1) -> bytes:
 def test_keys_become_stick_values_on_joy(node):
     from sensor_msgs.msg import Joy
 
-    from tutorial.ros_env import SpinThread
+    from tutorial.ros.env import SpinThread
 
     received = []
     node.create_subscription(Joy, "/joy", lambda msg: received.append(list(msg.axes)), 10)
     spin = SpinThread(node).start()
     master, slave = pty.openpty()
-    proc = subprocess.Popen([sys.executable, "-u", "-m", "tutorial.joy_node"], stdin=slave, stdout=slave,
-                            stderr=slave, cwd=ROOT, env=dict(os.environ), start_new_session=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-u", "-m", "tutorial.tools.rtt_joy"],
+        stdin=slave,
+        stdout=slave,
+        stderr=slave,
+        cwd=ROOT,
+        env=dict(os.environ),
+        start_new_session=True,
+    )
     os.close(slave)
     try:
         screen = b""

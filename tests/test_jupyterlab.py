@@ -59,12 +59,16 @@ from conftest import ROOT
 pytest.importorskip("playwright.sync_api", reason="playwright is not installed (pip install -e .[test])")
 pytest.importorskip("psutil", reason="psutil is not installed (pip install -e .[test])")
 
-from jupyterlab import CHROMIUM, JupyterLab, browser  # noqa: E402 - after the skips
-from playwright.sync_api import Error as PlaywrightError, expect  # noqa: E402
+from playwright.sync_api import Error as PlaywrightError  # noqa: E402
+from playwright.sync_api import expect
 
-pytestmark = [pytest.mark.skipif(not Path(CHROMIUM).exists(),
-                                 reason="chromium is not installed (make test installs it)"),
-              pytest.mark.timeout(180)]
+from jupyterlab import CHROMIUM, JupyterLab, browser  # noqa: E402 - after the skips
+
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="chromium is not installed (make test installs it)"),
+    pytest.mark.timeout(180),
+]
 
 BUDGET = 175.0  # s, for the whole module: servers, browsers and every notebook (the timeout below: 180)
 TEARDOWN = 15.0  # s of the budget kept for stopping the servers and browsers
@@ -121,8 +125,7 @@ IN_SIGHT_JS = """e => {
 class Lane:
     """One JupyterLab server and one page, on its thread; where screenshots go; the module's deadline."""
 
-    def __init__(self, number: int, lab: JupyterLab, page, shots: Path, start: float, log: list,
-                 stop: threading.Event):
+    def __init__(self, number: int, lab: JupyterLab, page, shots: Path, start: float, log: list, stop: threading.Event):
         self.number, self.lab, self.page, self.shots = number, lab, page, shots
         self.start, self.deadline, self.stop = start, start + BUDGET - TEARDOWN, stop
         self._log = log
@@ -178,6 +181,7 @@ class Lane:
         page may shift under a screenshot, which would then show the wrong
         thing (code, a plot) where the element was.
         """
+
         def steady():
             locator.evaluate("e => e.scrollIntoView({block: 'center'})")
             box = locator.bounding_box(timeout=self.ms(30))
@@ -287,7 +291,8 @@ def prompts(lane: Lane) -> list:
     """Each code cell's execution count: an int, "*" (queued or running), None (never run), or "?"
     (its input is collapsed, as a worked solution's is: no prompt shows)."""
     shown = lane.page.locator(f"{CELLS}.jp-CodeCell").evaluate_all(
-        "cells => cells.map(c => { const p = c.querySelector('.jp-InputArea-prompt'); return p && p.textContent; })")
+        "cells => cells.map(c => { const p = c.querySelector('.jp-InputArea-prompt'); return p && p.textContent; })"
+    )
     values = []
     for text in shown:
         inside = "?" if text is None else text.strip().removesuffix(":").strip("[]").strip()
@@ -314,8 +319,7 @@ def run(lane: Lane, command: str, code_cells: list[int], what: str, most: float)
     quiet = {"polls": 0}
 
     def shown(p):  # what the cells show, and what they should, leaving out those with no prompt shown
-        return ([p[k] for k in code_cells if p[k] != "?"],
-                [e for k, e in zip(code_cells, expected) if p[k] != "?"])
+        return ([p[k] for k in code_cells if p[k] != "?"], [e for k, e in zip(code_cells, expected) if p[k] != "?"])
 
     def finished():
         p = prompts(lane)
@@ -331,8 +335,10 @@ def run(lane: Lane, command: str, code_cells: list[int], what: str, most: float)
     if got != want:
         stderr = "application/vnd.jupyter.stderr"  # how JupyterLab shows stderr and errors
         errors = texts(lane.page.locator(f"{CELLS} .jp-OutputArea-output[data-mime-type='{stderr}']"))
-        raise AssertionError(f"{what}: the code cells show {got}, not {want}; the last stderr output or error:\n"
-                             + (errors[-1][-1500:] if errors else "none"))
+        raise AssertionError(
+            f"{what}: the code cells show {got}, not {want}; the last stderr output or error:\n"
+            + (errors[-1][-1500:] if errors else "none")
+        )
     lane.count += len(code_cells)
     lane.log(f"{what}: done")
 
@@ -340,15 +346,13 @@ def run(lane: Lane, command: str, code_cells: list[int], what: str, most: float)
 def save(lane: Lane, name: str) -> dict:
     """Save the notebook (the lane's copy) and return it as JSON: the outputs the page shows."""
     menu(lane, "File", "docmanager:save")
-    lane.poll(f"{name} saved", lambda: lane.page.locator(".lm-TabBar-tab.jp-mod-current.jp-mod-dirty").count() == 0,
-              30)
+    lane.poll(f"{name} saved", lambda: lane.page.locator(".lm-TabBar-tab.jp-mod-current.jp-mod-dirty").count() == 0, 30)
     return json.loads((lane.lab.root / name).read_text())
 
 
 def code_cell_index(cells: list[dict], test, after: int = -1) -> int:
     """Index (among all cells) of the first code cell after ``after`` whose source passes ``test``."""
-    return next(i for i, c in enumerate(cells) if i > after and c["cell_type"] == "code"
-                and test("".join(c["source"])))
+    return next(i for i, c in enumerate(cells) if i > after and c["cell_type"] == "code" and test("".join(c["source"])))
 
 
 def run_up_to(lane: Lane, cells: list[dict], index: int) -> None:
@@ -397,31 +401,40 @@ def check_views(lane: Lane, stem: str) -> list[str]:
             assert "(live)" not in caption, f"{what}: its caption says live: {caption!r}"
 
             def drawing():  # meshcat's viewer has made its canvas in every pane
-                now = frames.evaluate_all(FRAMES_JS)[k]
+                now = frames.evaluate_all(FRAMES_JS)[k]  # noqa: B023 - called in this iteration
                 return now if now["canvases"] and now["canvases"] >= max(len(now["panes"]), 1) else None
 
             panes = lane.poll(f"{what}: its page drawing", drawing, 30)["panes"] or [None]
         name = f"{stem}_view{k}"
 
         def every_pane_has_the_tank():
-            image = lane.shot(frame, name)
-            return all(tank_at(image if p is None else image[:, int(p[0]) + 1:int(p[1]) - 1]) for p in panes)
+            image = lane.shot(frame, name)  # noqa: B023 - called in this iteration
+            return all(tank_at(image if p is None else image[:, int(p[0]) + 1 : int(p[1]) - 1]) for p in panes)  # noqa: B023 - called in this iteration
 
-        lane.poll(f"{what}: the tank drawn in each of its {len(panes)} pane(s) ({name}.png)",
-                  every_pane_has_the_tank, 30, every=0.1)
+        lane.poll(
+            f"{what}: the tank drawn in each of its {len(panes)} pane(s) ({name}.png)",
+            every_pane_has_the_tank,
+            30,
+            every=0.1,
+        )
         seen.append(f"view {k}: {'live' if src else 'recording'}, {len(panes)} pane(s)")
     return seen
 
 
 def views_in(notebook: dict) -> int:
     """How many 3D views (``<iframe>`` elements, live or recordings) a saved notebook's outputs hold."""
-    return sum("".join(output.get("data", {}).get("text/html", "")).count("<iframe")
-               for cell in notebook["cells"] if cell["cell_type"] == "code" for output in cell.get("outputs", []))
+    return sum(
+        "".join(output.get("data", {}).get("text/html", "")).count("<iframe")
+        for cell in notebook["cells"]
+        if cell["cell_type"] == "code"
+        for output in cell.get("outputs", [])
+    )
 
 
 def stderr_of(cell: dict) -> str:
-    return "".join("".join(o["text"]) for o in cell.get("outputs", [])
-                   if o["output_type"] == "stream" and o["name"] == "stderr")
+    return "".join(
+        "".join(o["text"]) for o in cell.get("outputs", []) if o["output_type"] == "stream" and o["name"] == "stderr"
+    )
 
 
 def check_outputs(saved: dict, committed: dict, stem: str, first: int) -> None:
@@ -442,8 +455,10 @@ def check_outputs(saved: dict, committed: dict, stem: str, first: int) -> None:
 def check_panels_closed(lane: Lane, stem: str) -> None:
     """After the final reset(): no control can be used, and each panel (an output with controls) says why."""
     outputs = lane.page.locator(f"{CELLS} .jp-OutputArea-output")
-    enabled = (outputs.locator("button.widget-button:enabled").count()
-               + outputs.locator(".widget-slider .noUi-target:not([disabled])").count())
+    enabled = (
+        outputs.locator("button.widget-button:enabled").count()
+        + outputs.locator(".widget-slider .noUi-target:not([disabled])").count()
+    )
     assert enabled == 0, f"{stem}: {enabled} controls still enabled after the final reset()"
     panels = outputs.filter(has=lane.page.locator("button.widget-button, .widget-slider"))
     for text in texts(panels):
@@ -472,8 +487,11 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
     for _ in range(10):  # ten steps of 0.05: half forward, 1 m/s
         handle.press("ArrowRight")
     expect(forward.locator(".widget-readout")).to_have_text("0.50", timeout=lane.ms(10))
-    lane.poll("the tank driving off in the live view (01_live_2_driving.png)",
-              lambda: distance(lane.tank_in(view, "01_live_2_driving")[1], at_start) > 40, 20)
+    lane.poll(
+        "the tank driving off in the live view (01_live_2_driving.png)",
+        lambda: distance(lane.tank_in(view, "01_live_2_driving")[1], at_start) > 40,
+        20,
+    )
     panel.get_by_role("button", name="release sticks").click()  # the kernel sets the sliders back
     expect(forward.locator(".widget-readout")).to_have_text("0.00", timeout=lane.ms(10))
 
@@ -486,8 +504,11 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
 
     start.click()
     line.filter(has_text="running").wait_for(timeout=lane.ms(30))
-    lane.poll("the same view showing the restarted run: the tank back at its start (01_live_4_restarted.png)",
-              lambda: distance(lane.tank_in(view, "01_live_4_restarted")[1], at_start) < 3, 30)
+    lane.poll(
+        "the same view showing the restarted run: the tank back at its start (01_live_4_restarted.png)",
+        lambda: distance(lane.tank_in(view, "01_live_4_restarted")[1], at_start) < 3,
+        30,
+    )
     assert "(live): running" in output_text(view_cell), output_text(view_cell)
 
     # the section's reset(): the view becomes its recording, the panel closes and says so
@@ -506,8 +527,9 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
 def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
     """Notebook 03: the simulation's and the viewer's live views, side by side; the viewer follows the turret."""
     teleop = code_cell_index(cells, lambda src: "TeleopPanel()" in src)
-    shown = max(i for i in range(teleop)
-                if cells[i]["cell_type"] == "code" and "views.show(" in "".join(cells[i]["source"]))
+    shown = max(
+        i for i in range(teleop) if cells[i]["cell_type"] == "code" and "views.show(" in "".join(cells[i]["source"])
+    )
     run_up_to(lane, cells, teleop)
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
     live = view_cell.locator("iframe[src^='http://127.0.0.1:']")
@@ -520,8 +542,7 @@ def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
     lane.tank_in(live.nth(0), "03_live_simulation")
     before, _ = lane.tank_in(live.nth(1), "03_live_viewer_before")
     for label in ("/rtt:", "/rtt_viewer:"):
-        panel.locator(".widget-html-content", has_text=label).filter(has_text="running").wait_for(
-            timeout=lane.ms(30))
+        panel.locator(".widget-html-content", has_text=label).filter(has_text="running").wait_for(timeout=lane.ms(30))
 
     turret = panel.locator(".widget-hslider", has_text="right H")
     turret.locator(".noUi-handle").focus()
@@ -548,10 +569,14 @@ def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
     panel.screenshot(path=str(lane.shots / "03_panel_after_kernel_restart.png"))
 
 
-INTERACTIVE = {"01_step1_tank_controller": ("teleop", drive_the_tank),
-               "03_step3_viewer": ("side by side", two_views_side_by_side)}
-CHECKS = {"01_step1_tank_controller": "test_teleop_panel_drives_the_tank",  # the tests that report them
-          "03_step3_viewer": "test_step3_views_side_by_side"}
+INTERACTIVE = {
+    "01_step1_tank_controller": ("teleop", drive_the_tank),
+    "03_step3_viewer": ("side by side", two_views_side_by_side),
+}
+CHECKS = {
+    "01_step1_tank_controller": "test_teleop_panel_drives_the_tank",  # the tests that report them
+    "03_step3_viewer": "test_step3_views_side_by_side",
+}
 
 
 def failure(exc: BaseException) -> str:
@@ -581,8 +606,13 @@ def run_notebook(lane: Lane, notebook: Path, outcome: dict) -> None:
             lane.log(f"{stem}: {check}: {'passed' if outcome[f'{stem}: {check}'] is None else 'FAILED'}")
         first = lane.count + 1
         out_of_sight(lane)
-        run(lane, "runmenu:run-all", code_positions(committed["cells"], 0, len(committed["cells"])),
-            f"{stem}: Run All", 120)
+        run(
+            lane,
+            "runmenu:run-all",
+            code_positions(committed["cells"], 0, len(committed["cells"])),
+            f"{stem}: Run All",
+            120,
+        )
         saved = save(lane, name)
         check_outputs(saved, committed, stem, first)
         seen = check_views(lane, stem)
@@ -613,8 +643,10 @@ def estimate(notebook: Path) -> float:
     for cell in json.loads(notebook.read_text())["cells"]:
         times = cell.get("metadata", {}).get("execution", {})
         if "iopub.execute_input" in times and "shell.execute_reply" in times:
-            total += (datetime.fromisoformat(times["shell.execute_reply"].replace("Z", "+00:00"))
-                      - datetime.fromisoformat(times["iopub.execute_input"].replace("Z", "+00:00"))).total_seconds()
+            total += (
+                datetime.fromisoformat(times["shell.execute_reply"].replace("Z", "+00:00"))
+                - datetime.fromisoformat(times["iopub.execute_input"].replace("Z", "+00:00"))
+            ).total_seconds()
     return total
 
 
@@ -681,8 +713,9 @@ def outcome(request, tmp_path_factory):
         for t in threads:
             t.join(TEARDOWN)
     over = [t.name for t in threads if t.is_alive()]
-    results["the browsers stayed on this machine"] = (f"they asked for pages off this machine: {refused}"
-                                                      if refused else None)
+    results["the browsers stayed on this machine"] = (
+        f"they asked for pages off this machine: {refused}" if refused else None
+    )
     results["every lane ended"] = f"still running after {BUDGET:.0f} s: {over}" if over else None
     text = "\n".join(log)
     outcome = {name: (None if error is None else f"{error}\n--- log:\n{text}") for name, error in results.items()}

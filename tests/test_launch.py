@@ -9,8 +9,11 @@ from pathlib import Path
 
 import pytest
 
+from tutorial.ros.launch import Launch, LaunchDescription, Node
+
 from conftest import ROOT, wait_until
-from tutorial.launch import Launch, LaunchDescription, Node
+
+pytestmark = pytest.mark.launch
 
 
 def processes_with_marker(marker: str) -> list[int]:
@@ -30,18 +33,28 @@ def processes_with_marker(marker: str) -> list[int]:
     return found
 
 
-@pytest.mark.parametrize("sig, group", [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False)],
-                         ids=["ctrl-c", "ctrl-c-in-a-terminal", "sigterm"])
+@pytest.mark.parametrize(
+    "sig, group",
+    [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False)],
+    ids=["ctrl-c", "ctrl-c-in-a-terminal", "sigterm"],
+)
 def test_step3_launch_stops_every_node_within_5_s(procs, sig, group):
     """``group``: the signal goes to the launcher's whole process group, as a terminal's Ctrl-C
     does, so every node gets SIGINT twice: from the terminal and from the launcher."""
     marker = uuid.uuid4().hex
     env = dict(os.environ, RTT_TEST_MARKER=marker)
-    launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"], env=env,
-                   start_new_session=group)
+    launch = procs(
+        [sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo"], env=env, start_new_session=group
+    )
     launch.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "meshcat: open" in line, timeout=60)
-    launch.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "2/2 joints matched" in line
-                         and not line.split("] ", 2)[-1].startswith("0.0 msg/s"), timeout=60)
+    launch.wait_for_line(
+        lambda line: (
+            line.startswith("[rtt_viewer]")
+            and "2/2 joints matched" in line
+            and not line.split("] ", 2)[-1].startswith("0.0 msg/s")
+        ),
+        timeout=60,
+    )
     assert len(processes_with_marker(marker)) >= 6  # launcher, 3 nodes, 2 meshcat servers
     started = time.monotonic()
     if group:
@@ -64,10 +77,15 @@ def test_a_failing_node_fails_the_launch_and_stops_the_others():
     import io
 
     out = io.StringIO()
-    launch = Launch(LaunchDescription([
-        Node("rtt_joy", "tutorial.joy_node", ["--demo"]),
-        Node("broken", "tutorial.runner", ["/nonexistent/project.yaml", "--headless"], required=True),
-    ]), out=out)
+    launch = Launch(
+        LaunchDescription(
+            [
+                Node("rtt_joy", "tutorial.tools.rtt_joy", ["--demo"]),
+                Node("broken", "tutorial.tools.rtt_run", ["/nonexistent/project.yaml", "--headless"], required=True),
+            ]
+        ),
+        out=out,
+    )
     launch.start()
     code = launch.wait()
     text = out.getvalue()
@@ -83,13 +101,26 @@ def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
     from tutorial.bag.info import bag_info
 
     bag = tmp_path / "launch.mcap"
-    launch = procs([sys.executable, "-u", str(ROOT / "launch_py" / "step3_launch.py"), "--demo", "--headless",
-                    "--duration", "5", "--record", str(bag)])
+    launch = procs(
+        [
+            sys.executable,
+            "-u",
+            str(ROOT / "launch_py" / "step3_launch.py"),
+            "--demo",
+            "--headless",
+            "--duration",
+            "5",
+            "--record",
+            str(bag),
+        ]
+    )
     assert launch.wait(60) == 0, launch.out
     assert "[launch] all nodes stopped cleanly" in launch.out
     assert "Traceback" not in launch.out + launch.err
     assert "[rtt_bag] [/rtt_bag] recording /joy /Tank/joint_state to" in launch.out
     info = bag_info(bag)  # raises unless the file is a whole MCAP file
-    assert [(t.topic, t.type) for t in info.topics] == [("/Tank/joint_state", "sensor_msgs/msg/JointState"),
-                                                         ("/joy", "sensor_msgs/msg/Joy")]
+    assert [(t.topic, t.type) for t in info.topics] == [
+        ("/Tank/joint_state", "sensor_msgs/msg/JointState"),
+        ("/joy", "sensor_msgs/msg/Joy"),
+    ]
     assert all(t.count > 0 for t in info.topics), launch.out

@@ -2,7 +2,11 @@
 
 import sys
 
+import pytest
+
 from conftest import ROOT
+
+pytestmark = pytest.mark.launch
 
 
 def launch(procs, step, *args):
@@ -21,8 +25,12 @@ def test_step5_launch_shows_the_imu_in_the_viewer_and_stops_on_ctrl_c(procs):
 
     run = launch(procs, 5, "--demo", "--headless")
     # A status line of the viewer's IMU subscriber with messages arriving: "... /Tank/imu: 20.0 msg/s, ..."
-    run.wait_for_line(lambda line: line.startswith("[rtt_viewer]") and "/Tank/imu: " in line
-                      and "msg/s" in line and " 0.0 msg/s" not in line, timeout=60)
+    run.wait_for_line(
+        lambda line: (
+            line.startswith("[rtt_viewer]") and "/Tank/imu: " in line and "msg/s" in line and " 0.0 msg/s" not in line
+        ),
+        timeout=60,
+    )
     run.p.send_signal(signal.SIGINT)
     assert run.wait(15) == 0, run.out
     assert "[launch] all nodes stopped cleanly" in run.out

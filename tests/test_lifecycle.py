@@ -2,10 +2,10 @@
 
 import threading
 
-
 from tests.fixtures import recording_controller as rec
-from tutorial.app import App
-from tutorial.project import load_project
+from tutorial.core.app import App
+from tutorial.core.project import load_project
+
 from conftest import MODEL
 
 
@@ -14,7 +14,7 @@ def write_project(tmp_path, controller_class, simulate=True, parameters=""):
 name: lifecycle
 models:
   - name: Tank
-    file: {MODEL / 'tank.xml'}
+    file: {MODEL / "tank.xml"}
     controllers:
       - name: Rec
         class: {controller_class}
@@ -59,8 +59,12 @@ def test_project_without_simulator_only_configures(tmp_path, node):
 
 def test_parameters_reach_configure(tmp_path, node):
     rec.CALLS.clear()
-    project = write_project(tmp_path, "tests.fixtures.recording_controller:RecordingController", simulate=False,
-                            parameters="        parameters: {gain: 3}")
+    project = write_project(
+        tmp_path,
+        "tests.fixtures.recording_controller:RecordingController",
+        simulate=False,
+        parameters="        parameters: {gain: 3}",
+    )
     app = App(project, node=node, headless=True, duration=0.01, output=lambda r: None)
     app.open()
     try:
@@ -83,8 +87,7 @@ def test_a_callback_that_raises_ends_the_run_and_is_reported(tmp_path, node):
 
     from conftest import wait_until
 
-    project = write_project(tmp_path, "tests.fixtures.recording_controller:BrokenCallbackController",
-                            simulate=False)
+    project = write_project(tmp_path, "tests.fixtures.recording_controller:BrokenCallbackController", simulate=False)
     app = App(project, node_name="broken_callback_app", headless=True, duration=60.0, output=lambda r: None)
     pub = node.create_publisher(String, "/broken_callback", 10)
     try:

@@ -12,8 +12,13 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
 
 
 def test_controller_modules_are_what_the_notebooks_export():
-    result = subprocess.run([sys.executable, "scripts/export_notebooks.py", "--check"], cwd=ROOT,
-                            capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [sys.executable, "scripts/export_notebooks.py", "--check"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stderr
     assert "are in step" in result.stdout
 
@@ -25,8 +30,13 @@ def test_the_check_fails_when_a_module_is_edited_by_hand(tmp_path):
     shutil.copytree(ROOT / "tutorial" / "controllers", library / "controllers")
     module = library / "controllers" / "tank_controller.py"
     module.write_text(module.read_text().replace("TRACK_DEAD_ZONE = 0.2", "TRACK_DEAD_ZONE = 0.3"))
-    result = subprocess.run([sys.executable, "scripts/export_notebooks.py", "--check", "--library", str(library)],
-                            cwd=ROOT, capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [sys.executable, "scripts/export_notebooks.py", "--check", "--library", str(library)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 1
     assert "tutorial/controllers/tank_controller.py: differs from what its notebook exports" in result.stderr
 
@@ -34,8 +44,13 @@ def test_the_check_fails_when_a_module_is_edited_by_hand(tmp_path):
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
 def test_code_lines_fit_the_book(path):
     """Code cells stay within 88 characters, so the book never scrolls them sideways."""
-    long = [(i, line) for i, cell in enumerate(json.loads(path.read_text())["cells"]) if cell["cell_type"] == "code"
-            for line in "".join(cell["source"]).splitlines() if len(line) > 88]
+    long = [
+        (i, line)
+        for i, cell in enumerate(json.loads(path.read_text())["cells"])
+        if cell["cell_type"] == "code"
+        for line in "".join(cell["source"]).splitlines()
+        if len(line) > 88
+    ]
     assert long == [], f"{path.name}: cells with lines over 88 characters: {long}"
 
 

@@ -2,14 +2,15 @@
 
 import pytest
 
-from tutorial.project import ProjectError, load_project
+from tutorial.core.project import ProjectError, load_project
+
 from conftest import MODEL, PROJECT
 
 GOOD = f"""
 name: p
 models:
   - name: Tank
-    file: {MODEL / 'tank.xml'}
+    file: {MODEL / "tank.xml"}
     controllers:
       - name: C
         class: tutorial.controllers.joint_state_publisher:RttJointStatePublisher
@@ -44,8 +45,12 @@ def test_good_project(tmp_path):
         ("rate: 50", "rate: fifty", "models[0].controllers[0].parameters.rate", "finite number"),
         ("rate: 50", "speed: 50", "models[0].controllers[0].parameters.speed", "unknown parameter"),
         (":RttJointStatePublisher", ":Nope", "models[0].controllers[0].class", "no SimpleController"),
-        ("tutorial.controllers.joint_state_publisher:", "no.such.module:", "models[0].controllers[0].class",
-         "cannot import"),
+        (
+            "tutorial.controllers.joint_state_publisher:",
+            "no.such.module:",
+            "models[0].controllers[0].class",
+            "cannot import",
+        ),
         ("- name: Tank", "- name: 9Tank", "models[0].name", "expected a name"),
         ("- name: C", "- nam: C", "models[0].controllers[0].nam", "unknown key"),
     ],
@@ -85,6 +90,6 @@ def test_rtt_run_reports_a_bad_project_with_exit_status_2(tmp_path, procs):
 
     path = tmp_path / "p.yaml"
     path.write_text(GOOD.replace("simulator:", "simulatr:"))
-    p = procs(module_command("tutorial.runner", str(path), "--headless"))
+    p = procs(module_command("tutorial.tools.rtt_run", str(path), "--headless"))
     assert p.wait(60) == 2
     assert f"{path}: simulatr: unknown key" in p.err

@@ -2,7 +2,7 @@
 
 import pytest
 
-from tutorial.controllers.joint_state_publisher import PeriodAccumulator
+from tutorial.interfaces.timing import PeriodAccumulator
 
 
 def due_steps(time_step, rate, steps):

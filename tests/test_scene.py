@@ -3,9 +3,10 @@
 import mujoco
 import numpy as np
 
-from tutorial.body import Body
-from tutorial.scene import POSE_TOLERANCE, Scene
-from tutorial.world import ModelEntry, build_world
+from tutorial.core.body import Body
+from tutorial.core.world import ModelEntry, build_world
+from tutorial.view.scene import POSE_TOLERANCE, Scene
+
 from conftest import MODEL
 
 
@@ -115,7 +116,10 @@ def test_a_welded_body_rides_in_its_parents_frame_and_is_drawn_where_mujoco_puts
     vis = RecordingVisualizer()
     scene = Scene(vis, model)
     scene.build(data)
-    name = lambda b: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
+
+    def name(b):
+        return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b)
+
     assert [name(b) for b in scene.moving_bodies] == ["base", "arm", "target"]  # plate, bracket ride with the base
     assert scene.frame_body(model.body("plate").id) == model.body("base").id
     assert scene.frame_body(model.body("bracket").id) == model.body("base").id  # two welds up
@@ -146,7 +150,7 @@ def test_the_pipeline_packs_what_meshcat_python_packs():
     import umsgpack
     from meshcat.commands import SetTransform
 
-    from tutorial.scene import pack_command
+    from tutorial.view.scene import pack_command
 
     class Path:
         def lower(self):
@@ -159,6 +163,7 @@ def test_the_pipeline_packs_what_meshcat_python_packs():
 
 
 # ---- overlays: arrows a controller draws over the view ----------------------------------
+
 
 class CommandVisualizer(RecordingVisualizer):
     """A RecordingVisualizer that also keeps every command, in order: (kind, path, value)."""
@@ -186,7 +191,7 @@ class CommandVisualizer(RecordingVisualizer):
 
 def tip_of(shaft, head):
     """Where an arrow drawn with these transforms ends: the cone's apex, and where its shaft starts."""
-    from tutorial.overlays import HEAD_LENGTH
+    from tutorial.view.overlays import HEAD_LENGTH
 
     apex = head @ np.array([0.0, HEAD_LENGTH / 2, 0.0, 1.0])
     tail = shaft @ np.array([0.0, -0.5, 0.0, 1.0])  # the shaft is a unit cylinder along meshcat's Y
@@ -194,10 +199,14 @@ def tip_of(shaft, head):
 
 
 def test_an_arrow_is_drawn_from_its_origin_to_origin_plus_vector():
-    from tutorial.overlays import arrow_transforms
+    from tutorial.view.overlays import arrow_transforms
 
-    for origin, vector in [((0, 0, 0.1), (0.3, 0.4, 0.0)), ((1, 2, 3), (0, 0, -0.5)), ((0, 0, 0), (0.01, 0, 0.02)),
-                           ((0.5, 0, 0), (1e-3, 0, 0))]:
+    for origin, vector in [
+        ((0, 0, 0.1), (0.3, 0.4, 0.0)),
+        ((1, 2, 3), (0, 0, -0.5)),
+        ((0, 0, 0), (0.01, 0, 0.02)),
+        ((0.5, 0, 0), (1e-3, 0, 0)),
+    ]:
         shaft, head = arrow_transforms(origin, vector)
         tail, tip = tip_of(shaft, head)
         np.testing.assert_allclose(tail, origin, atol=1e-6)
@@ -206,7 +215,7 @@ def test_an_arrow_is_drawn_from_its_origin_to_origin_plus_vector():
 
 
 def test_overlays_send_only_changed_arrows_and_hide_without_moving():
-    from tutorial.overlays import MeshcatOverlays, Overlays
+    from tutorial.view.overlays import MeshcatOverlays, Overlays
 
     overlays = Overlays()
     red = overlays.arrow("Tank/acceleration", (1.0, 0.2, 0.2))
@@ -223,8 +232,10 @@ def test_overlays_send_only_changed_arrows_and_hide_without_moving():
     red.set((0, 0, 0.1), (0.5, 0, 0))
     assert drawer.update() == 1
     assert [(c[0], c[1].rsplit("/", 2)[-2:]) for c in vis.log] == [
-        ("transform", ["acceleration", "shaft"]), ("transform", ["acceleration", "head"]),
-        ("visible", ["Tank", "acceleration"])]
+        ("transform", ["acceleration", "shaft"]),
+        ("transform", ["acceleration", "head"]),
+        ("visible", ["Tank", "acceleration"]),
+    ]
     vis.log.clear()
     red.set((0, 0, 0.1), (0.5, 0, 0))  # the same: nothing to send
     blue.set((0, 0, 0.1), (0, 0, 0.001), visible=False)  # hidden was hidden: no command either
@@ -238,7 +249,7 @@ def test_overlays_send_only_changed_arrows_and_hide_without_moving():
 def test_an_arrow_refuses_non_finite_numbers_and_a_second_arrow_of_the_same_name():
     import pytest
 
-    from tutorial.overlays import Overlays
+    from tutorial.view.overlays import Overlays
 
     overlays = Overlays()
     arrow = overlays.arrow("a", (1, 0, 0))

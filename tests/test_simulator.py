@@ -2,9 +2,10 @@
 
 import mujoco
 
-from tutorial.controller import SimpleController
-from tutorial.simulator import Attachment, Simulator
-from tutorial.world import ModelEntry, build_world
+from tutorial.core.controller import SimpleController
+from tutorial.core.simulator import Attachment, Simulator
+from tutorial.core.world import ModelEntry, build_world
+
 from conftest import MODEL
 
 

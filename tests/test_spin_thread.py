@@ -5,8 +5,9 @@ import threading
 import pytest
 from std_msgs.msg import String
 
+from tutorial.ros.env import SPIN_POLL, SpinThread, make_executor
+
 from conftest import wait_until
-from tutorial.ros_env import SPIN_POLL, SpinThread, make_executor
 
 
 def test_the_executor_is_the_single_threaded_executor_unless_switched(node, monkeypatch):
@@ -46,6 +47,7 @@ def test_callbacks_run_on_the_spin_thread_and_stop_ends_it(node):
         SpinThread(node)
 
 
+@pytest.mark.ros
 def test_a_ros_shutdown_ends_the_spin_thread():
     import rclpy
 
@@ -77,19 +79,20 @@ def test_an_exception_in_a_callback_is_kept_for_the_owner(node):
 
 
 def test_after_a_callback_the_spin_thread_steps_aside_for_the_owner(node):
-    from tutorial.call_later import MainLoop
+    from tutorial.core.call_later import MainLoop
 
     loop = MainLoop()  # owned by this thread, which runs it below
     ran = []
-    node.create_subscription(String, "/spin_thread_hand_over",
-                             lambda msg: loop.call_later(ran.append, msg.data, key=msg.data), 10)
+    node.create_subscription(
+        String, "/spin_thread_hand_over", lambda msg: loop.call_later(ran.append, msg.data, key=msg.data), 10
+    )
     pub = node.create_publisher(String, "/spin_thread_hand_over", 10)
     spin = SpinThread(node, hand_over_to=loop).start()
     try:
         assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
         for i in range(5):
             pub.publish(String(data=str(i)))
-            assert loop.run_until(lambda: len(ran) == i + 1, timeout=10), ran
+            assert loop.run_until(lambda: len(ran) == i + 1, timeout=10), ran  # noqa: B023 - called in this iteration
     finally:
         assert spin.stop(timeout=10 * SPIN_POLL + 2.0)
     assert spin.error is None

@@ -4,9 +4,11 @@ from conftest import module_command
 
 
 def test_demo_joy_drives_the_simulated_tank(procs):
-    joy = procs(module_command("tutorial.joy_node", "--demo", "--duration", "15"))
+    joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "15"))
     joy.wait_for_line(lambda line: "publishing /joy" in line, timeout=30)
-    sim = procs(module_command("tutorial.runner", "project/step1.yaml", "--headless", "--duration", "8", "--json"))
+    sim = procs(
+        module_command("tutorial.tools.rtt_run", "project/step1.yaml", "--headless", "--duration", "8", "--json")
+    )
     assert sim.wait(60) == 0, sim.err
     summary = sim.summary()
     tank = summary["bodies"]["Tank"]

@@ -9,8 +9,11 @@ from conftest import module_command, publish_and_wait_applied, publishers_seen, 
 
 
 def viewer(procs, project="project/step3.yaml", name="rtt_viewer", *extra):
-    return procs(module_command("tutorial.runner", project, "--headless", "--json", *extra,
-                                "--ros-args", "-r", f"__node:={name}"))
+    return procs(
+        module_command(
+            "tutorial.tools.rtt_run", project, "--headless", "--json", *extra, "--ros-args", "-r", f"__node:={name}"
+        )
+    )
 
 
 def is_stale(line: str) -> bool:
@@ -32,8 +35,10 @@ def stop_when_stale(proc, stale_before: int, timeout=30):
 
 def test_viewer_ends_on_the_simulations_final_state(procs):
     view = viewer(procs)
-    joy = procs(module_command("tutorial.joy_node", "--demo", "--duration", "4"))
-    sim = procs(module_command("tutorial.runner", "project/step2.yaml", "--headless", "--duration", "6", "--json"))
+    joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "4"))
+    sim = procs(
+        module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--duration", "6", "--json")
+    )
     stale_before = view.count(is_stale)  # the simulation is still starting or running
     assert sim.wait(60) == 0, sim.err
     assert joy.wait(30) == 0
@@ -49,28 +54,30 @@ def test_viewer_ends_on_the_simulations_final_state(procs):
     counts = view_summary["controllers"]["RttJointStateMonitor"]
     assert counts["rejected"] == {}
     assert counts["received"] > 100  # 50 Hz for most of 6 s
-    assert sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 300 + 1  # 50 Hz over 6 s (steps 0, 20, ..., 5980), and the final state
+    assert (
+        sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 300 + 1
+    )  # 50 Hz over 6 s (steps 0, 20, ..., 5980), and the final state
 
 
 HOSTILE = [
     # (names, positions, expected rejections)
-    (["TURRET_P", "TURRET_Y"], [0.2, 0.3], {}),                                      # reordered
-    (["TURRET_Y", "GUN", "TURRET_P"], [0.1, 9.0, 0.2], {"unknown_name": 1}),        # unknown name
+    (["TURRET_P", "TURRET_Y"], [0.2, 0.3], {}),  # reordered
+    (["TURRET_Y", "GUN", "TURRET_P"], [0.1, 9.0, 0.2], {"unknown_name": 1}),  # unknown name
     (["TURRET_Y", "TURRET_Y", "TURRET_P"], [0.1, 0.2, 0.3], {"duplicate_name": 2}),  # duplicate
-    (["TURRET_Y", "TURRET_P"], [0.4], {"no_position": 1}),                           # short positions
-    (["TURRET_Y"], [0.4, 0.5], {"no_name": 1}),                                      # short names
-    (["TURRET_Y", "TURRET_P"], [math.nan, 0.1], {"not_finite": 1}),                  # NaN
-    (["TURRET_Y", "TURRET_P"], [0.1, -math.inf], {"not_finite": 1}),                 # inf
-    (["TURRET_Y", "TURRET_P"], [1e300, 0.1], {"out_of_range": 1}),                   # huge
-    ([], [], {}),                                                                    # empty
-    (["TURRET_Y", "TURRET_P"], [0.5, 0.25], {}),                                     # a good one, last
+    (["TURRET_Y", "TURRET_P"], [0.4], {"no_position": 1}),  # short positions
+    (["TURRET_Y"], [0.4, 0.5], {"no_name": 1}),  # short names
+    (["TURRET_Y", "TURRET_P"], [math.nan, 0.1], {"not_finite": 1}),  # NaN
+    (["TURRET_Y", "TURRET_P"], [0.1, -math.inf], {"not_finite": 1}),  # inf
+    (["TURRET_Y", "TURRET_P"], [1e300, 0.1], {"out_of_range": 1}),  # huge
+    ([], [], {}),  # empty
+    (["TURRET_Y", "TURRET_P"], [0.5, 0.25], {}),  # a good one, last
 ]
 
 
 def test_hostile_publisher_is_counted_exactly(procs, node):
     from sensor_msgs.msg import JointState
 
-    from tutorial.controllers.joint_state_publisher import joint_state_qos
+    from tutorial.interfaces.joint_state import joint_state_qos
 
     view = viewer(procs)
     pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
@@ -99,7 +106,7 @@ def test_hostile_publisher_is_counted_exactly(procs, node):
 def test_viewer_reports_publishers_that_come_and_go(procs, node):
     from sensor_msgs.msg import JointState
 
-    from tutorial.controllers.joint_state_publisher import joint_state_qos
+    from tutorial.interfaces.joint_state import joint_state_qos
 
     view = viewer(procs)
     pub = node.create_publisher(JointState, "/Tank/joint_state", joint_state_qos())
@@ -131,8 +138,11 @@ def test_any_model_publishes_and_shows_its_own_joints(procs):
     view = viewer(procs, "tests/fixtures/crane_view.yaml")
     # 5 s: long enough that the two nodes have found each other well before the final
     # state is sent, even when discovery takes one of Fast DDS's ~3 s announcement periods.
-    sim = procs(module_command("tutorial.runner", "tests/fixtures/crane_sim.yaml", "--headless",
-                               "--duration", "5", "--json"))
+    sim = procs(
+        module_command(
+            "tutorial.tools.rtt_run", "tests/fixtures/crane_sim.yaml", "--headless", "--duration", "5", "--json"
+        )
+    )
     stale_before = view.count(is_stale)
     assert sim.wait(60) == 0, sim.err
     final = sim.summary()["bodies"]["Crane"]["joint_positions"]
@@ -146,8 +156,10 @@ def test_any_model_publishes_and_shows_its_own_joints(procs):
 
 
 def test_publishers_record_reads_as_a_line():
-    from tutorial.runner import format_record
+    from tutorial.tools.rtt_run import format_record
 
     line = format_record({"event": "publishers", "node": "/rtt_viewer", "topic": "/Tank/joint_state", "count": 1})
     assert line == "[/rtt_viewer] /Tank/joint_state: matched with 1 publisher"
-    assert format_record({"event": "publishers", "topic": "/Tank/joint_state", "count": 0}).endswith("with 0 publishers")
+    assert format_record({"event": "publishers", "topic": "/Tank/joint_state", "count": 0}).endswith(
+        "with 0 publishers"
+    )

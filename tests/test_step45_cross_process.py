@@ -6,16 +6,26 @@ import signal
 
 import pytest
 
+from tutorial.ros.env import SpinThread
+
 from conftest import module_command, wait_until
-from tutorial.ros_env import SpinThread
 
 GRAVITY = 9.80665  # m/s^2
 PERIOD_NS = 50_000_000  # 20 Hz
 
 
 def viewer(procs):
-    return procs(module_command("tutorial.runner", "project/step5.yaml", "--headless", "--json",
-                                "--ros-args", "-r", "__node:=rtt_viewer"))
+    return procs(
+        module_command(
+            "tutorial.tools.rtt_run",
+            "project/step5.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-r",
+            "__node:=rtt_viewer",
+        )
+    )
 
 
 def imu_publishers_seen(view) -> int:
@@ -35,9 +45,8 @@ def stop(proc) -> dict:
 
 
 def test_step4_publishes_the_imu_at_20_hz_of_simulated_time(procs, node):
-    from sensor_msgs.msg import Imu
-
     from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import Imu
 
     received = []
     # Reliable like the publisher, and a deep queue: this test wants every message.
@@ -48,7 +57,7 @@ def test_step4_publishes_the_imu_at_20_hz_of_simulated_time(procs, node):
         # No --duration: discovery takes a varying time (one of Fast DDS's ~3 s announcement periods on a
         # loaded machine), so the test does not count on a number of messages within a fixed run. It waits
         # until 41 have arrived from whenever the subscription matched, then stops the simulation.
-        sim = procs(module_command("tutorial.runner", "project/step4.yaml", "--headless", "--json"))
+        sim = procs(module_command("tutorial.tools.rtt_run", "project/step4.yaml", "--headless", "--json"))
         assert wait_until(lambda: len(received) >= 41, timeout=60), (len(received), sim.err)
         summary = stop(sim)
     finally:
@@ -73,8 +82,9 @@ def test_driving_into_a_wall_shakes_the_viewer_and_it_ends_where_it_was(procs, n
     from sensor_msgs.msg import Joy
 
     view = viewer(procs)
-    sim = procs(module_command("tutorial.runner", "project/step4.yaml", "--headless", "--duration", "30",
-                               "--json"))
+    sim = procs(
+        module_command("tutorial.tools.rtt_run", "project/step4.yaml", "--headless", "--duration", "30", "--json")
+    )
     stick = [0.0] * 8
     joy = node.create_publisher(Joy, "/joy", 10)
 
@@ -124,7 +134,7 @@ ARROWS = [
 def test_the_arrows_follow_the_numbers_sent_and_bad_ones_are_counted(procs, node):
     from sensor_msgs.msg import Imu
 
-    from tutorial.controllers.imu_state_publisher import imu_qos
+    from tutorial.interfaces.imu import imu_qos
 
     view = viewer(procs)
     pub = node.create_publisher(Imu, "/Tank/imu", imu_qos())
@@ -139,7 +149,7 @@ def test_the_arrows_follow_the_numbers_sent_and_bad_ones_are_counted(procs, node
         msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = gyro
         pub.publish(msg)
         # The next one goes out only when the viewer has handled this one: keep-last-1 cannot drop it.
-        line = view.wait_for_line(lambda line: '"event": "imu_status"' in line and handled(line) >= sent, timeout=30)
+        line = view.wait_for_line(lambda line: '"event": "imu_status"' in line and handled(line) >= sent, timeout=30)  # noqa: B023
         status = json.loads(line)
         if isinstance(accel_arrow, str):
             rejected[accel_arrow] = rejected.get(accel_arrow, 0) + 1
@@ -170,27 +180,36 @@ def arrow_pixels(image):
 
 
 def test_the_viewers_page_draws_the_arrows_and_hides_them(procs, node, tmp_path):
-    from browser import chromium, screenshot
     from sensor_msgs.msg import Imu
 
-    from tutorial.controllers.imu_state_publisher import imu_qos
+    from tutorial.interfaces.imu import imu_qos
+
+    from browser import chromium, screenshot
 
     if chromium() is None:
         pytest.skip("chromium is not installed (make test installs it)")
-    view = procs(module_command("tutorial.runner", "project/step5.yaml", "--json",
-                                "--ros-args", "-r", "__node:=rtt_viewer"))
+    view = procs(
+        module_command(
+            "tutorial.tools.rtt_run", "project/step5.yaml", "--json", "--ros-args", "-r", "__node:=rtt_viewer"
+        )
+    )
     url = json.loads(view.wait_for_line(lambda line: '"event": "meshcat"' in line, timeout=60))["url"]
     pub = node.create_publisher(Imu, "/Tank/imu", imu_qos())
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
     assert wait_until(lambda: imu_publishers_seen(view) >= 1, timeout=30), view.out
     pictures = []
-    for sent, (accel, gyro) in enumerate([((3.0, 0.0, 12.8), (0.0, 0.0, 1.0)),  # 0.42 m red, 0.4 m blue
-                                          ((0.0, 0.0, 9.8), (0.0, 0.0, 0.0))], start=1):  # at rest: none
+    for sent, (accel, gyro) in enumerate(
+        [
+            ((3.0, 0.0, 12.8), (0.0, 0.0, 1.0)),  # 0.42 m red, 0.4 m blue
+            ((0.0, 0.0, 9.8), (0.0, 0.0, 0.0)),
+        ],
+        start=1,
+    ):  # at rest: none
         msg = Imu()
         msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = accel
         msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = gyro
         pub.publish(msg)
-        view.wait_for_line(lambda line: '"event": "imu_status"' in line and handled(line) >= sent, timeout=30)
+        view.wait_for_line(lambda line: '"event": "imu_status"' in line and handled(line) >= sent, timeout=30)  # noqa: B023
         pictures.append(arrow_pixels(screenshot(url, tmp_path / f"arrows{sent}.png")))
     (red, blue), (red_after, blue_after) = pictures
     assert red > 100 and blue > 100, pictures

@@ -5,11 +5,11 @@ import threading
 import numpy as np
 import pytest
 
+from tutorial.interfaces.image import camera_image_qos, image_to_array
+from tutorial.ros import env as ros_env
+
 from conftest import module_command, wait_until
 from test_camera_publisher import egl  # noqa: F401 - the fixture that skips where EGL is missing
-from tutorial import ros_env
-from tutorial.controllers.camera_image_publisher import camera_image_qos
-from tutorial.images import image_to_array
 
 RATE = 10.0  # Hz of simulated time, set with -p: the parameter reaches the controller
 DURATION = 8.0  # s of simulated time
@@ -22,21 +22,35 @@ def test_pictures_arrive_stamped_with_simulation_time_at_the_rate_asked(procs, n
     received: list[dict] = []
 
     def on_image(msg):
-        record = {"stamp": msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9, "frame_id": msg.header.frame_id,
-                  "fields": (msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian, len(msg.data)),
-                  "pixels": image_to_array(msg)}
+        record = {
+            "stamp": msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9,
+            "frame_id": msg.header.frame_id,
+            "fields": (msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian, len(msg.data)),
+            "pixels": image_to_array(msg),
+        }
         with lock:
             received.append(record)
 
     node.create_subscription(Image, "/Tank/camera/image", on_image, camera_image_qos())
     spin = ros_env.SpinThread(node).start()
     try:
-        sim = procs(module_command("tutorial.runner", "project/step6.yaml", "--headless", "--json",
-                                   "--duration", str(DURATION),
-                                   "--ros-args", "-p", f"RttCameraImagePublisher.rate:={RATE}"))
+        sim = procs(
+            module_command(
+                "tutorial.tools.rtt_run",
+                "project/step6.yaml",
+                "--headless",
+                "--json",
+                "--duration",
+                str(DURATION),
+                "--ros-args",
+                "-p",
+                f"RttCameraImagePublisher.rate:={RATE}",
+            )
+        )
         assert sim.wait(60) == 0, sim.out + sim.err
-        assert wait_until(lambda: len(received) > 0 and received[-1]["stamp"] == pytest.approx(DURATION), timeout=5), \
+        assert wait_until(lambda: len(received) > 0 and received[-1]["stamp"] == pytest.approx(DURATION), timeout=5), (
             "the final picture did not arrive"
+        )
     finally:
         spin.stop()
     summary = sim.summary()

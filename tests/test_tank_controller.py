@@ -6,10 +6,11 @@ from types import SimpleNamespace
 import mujoco
 import pytest
 
-from tutorial.body import Body
-from tutorial.controller import ControllerIO
 from tutorial.controllers import tank_controller as tc
-from tutorial.world import ModelEntry, build_world
+from tutorial.core.body import Body
+from tutorial.core.controller import ControllerIO
+from tutorial.core.world import ModelEntry, build_world
+
 from conftest import MODEL
 
 
@@ -35,7 +36,7 @@ def test_dead_zones_are_the_originals():
 
 def test_turret_rate_is_0_002_rad_per_ms_at_full_stick():
     yaw, pitch = tc.turret_rates(axes(rh=-1.0, rv=1.0))
-    assert yaw * 0.001 == pytest.approx(0.002)   # stick right: TURRET_Y reference grows (clockwise from above)
+    assert yaw * 0.001 == pytest.approx(0.002)  # stick right: TURRET_Y reference grows (clockwise from above)
     assert pitch * 0.001 == pytest.approx(-0.002)  # stick pushed forward: barrel goes down, as in the original
 
 
@@ -53,7 +54,8 @@ def test_bad_axes_never_raise_and_never_give_non_finite_commands(bad):
 
 
 def make_controller(joy_timeout: float = 0.0):
-    """The Step 1 controller on the tank in its room, unconfigured (no ROS), initialized; the safe stop off by default."""
+    """The Step 1 controller on the tank in its room, unconfigured (no ROS), initialized; the safe stop off by
+    default."""
     model = build_world([ModelEntry("Room", MODEL / "room.xml"), ModelEntry("Tank", MODEL / "tank.xml")])
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)

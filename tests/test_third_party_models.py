@@ -19,8 +19,9 @@ from pathlib import Path
 import mujoco
 import pytest
 
-from tutorial.body import MECHANISM_JOINT_GROUP, Body
-from tutorial.world import ModelEntry, build_world
+from tutorial.core.body import MECHANISM_JOINT_GROUP, Body
+from tutorial.core.world import ModelEntry, build_world
+
 from conftest import MODEL
 
 HINGE_SLIDE = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
@@ -49,27 +50,80 @@ class Case:
 
 
 CASES = [
-    Case("Ant", "gymnasium", "envs/mujoco/assets/ant.xml", 8, 8,
-         "four unnamed links (the feet) under named ones; a free root"),
-    Case("Pusher", "gymnasium", "envs/mujoco/assets/pusher.xml", 11, 11,
-         "three top-level bodies: an arm, and an object and a goal on slides"),
-    Case("Hopper", "gymnasium", "envs/mujoco/assets/hopper.xml", 6, 6,
-         "a planar robot: two slides and a hinge as its root"),
-    Case("Humanoid", "gymnasium", "envs/mujoco/assets/humanoid.xml", 17, 17,
-         "17 motorised hinges, a free root"),
-    Case("MujocoTest", "mujoco", "testdata/model.xml", 10, 10,
-         "unnamed links and joints, a ball, a slide, five free bodies, six top-level bodies, "
-         "an unnamed world geom, actuators on tendons and a site"),
-    Case("Quadruped", "dm_control", "suite/quadruped.xml", 16, 16,
-         "relative includes, two top-level bodies with free joints"),
-    Case("Manipulator", "dm_control", "suite/manipulator.xml", 14, 14,
-         "seven top-level bodies, slides and hinges, includes"),
-    Case("Dog", "dm_control", "suite/dog.xml", 73, 30,
-         "meshes from an asset directory; 43 spine and tail hinges in joint group 3"),
-    Case("BallJoints", "dm_control", "mujoco/testing/assets/model_with_ball_joints.xml", 0, 0,
-         "unnamed links, ball joints only"),
-    Case("ThirdOrder", "dm_control", "mujoco/testing/assets/model_with_third_order_actuators.xml", 1, 1,
-         "an unnamed link on a slide with four kinds of actuator"),
+    Case(
+        "Ant",
+        "gymnasium",
+        "envs/mujoco/assets/ant.xml",
+        8,
+        8,
+        "four unnamed links (the feet) under named ones; a free root",
+    ),
+    Case(
+        "Pusher",
+        "gymnasium",
+        "envs/mujoco/assets/pusher.xml",
+        11,
+        11,
+        "three top-level bodies: an arm, and an object and a goal on slides",
+    ),
+    Case(
+        "Hopper",
+        "gymnasium",
+        "envs/mujoco/assets/hopper.xml",
+        6,
+        6,
+        "a planar robot: two slides and a hinge as its root",
+    ),
+    Case("Humanoid", "gymnasium", "envs/mujoco/assets/humanoid.xml", 17, 17, "17 motorised hinges, a free root"),
+    Case(
+        "MujocoTest",
+        "mujoco",
+        "testdata/model.xml",
+        10,
+        10,
+        "unnamed links and joints, a ball, a slide, five free bodies, six top-level bodies, "
+        "an unnamed world geom, actuators on tendons and a site",
+    ),
+    Case(
+        "Quadruped",
+        "dm_control",
+        "suite/quadruped.xml",
+        16,
+        16,
+        "relative includes, two top-level bodies with free joints",
+    ),
+    Case(
+        "Manipulator",
+        "dm_control",
+        "suite/manipulator.xml",
+        14,
+        14,
+        "seven top-level bodies, slides and hinges, includes",
+    ),
+    Case(
+        "Dog",
+        "dm_control",
+        "suite/dog.xml",
+        73,
+        30,
+        "meshes from an asset directory; 43 spine and tail hinges in joint group 3",
+    ),
+    Case(
+        "BallJoints",
+        "dm_control",
+        "mujoco/testing/assets/model_with_ball_joints.xml",
+        0,
+        0,
+        "unnamed links, ball joints only",
+    ),
+    Case(
+        "ThirdOrder",
+        "dm_control",
+        "mujoco/testing/assets/model_with_third_order_actuators.xml",
+        1,
+        1,
+        "an unnamed link on a slide with four kinds of actuator",
+    ),
 ]
 IDS = [c.name for c in CASES]
 
@@ -154,8 +208,13 @@ def test_models_in_one_world_own_disjoint_parts_that_cover_it():
     world = build_world(entries)
     data = mujoco.MjData(world)
     bodies = [Body(world, data, e.name) for e in entries]
-    for attribute, count in (("body_ids", world.nbody - 1), ("joint_ids", world.njnt), ("geom_ids", world.ngeom),
-                             ("site_ids", world.nsite), ("actuator_ids", world.nu)):
+    for attribute, count in (
+        ("body_ids", world.nbody - 1),
+        ("joint_ids", world.njnt),
+        ("geom_ids", world.ngeom),
+        ("site_ids", world.nsite),
+        ("actuator_ids", world.nu),
+    ):
         owned = [getattr(b, attribute) for b in bodies]
         assert sum(len(o) for o in owned) == count, attribute  # disjoint ...
         assert len(frozenset().union(*owned)) == count, attribute  # ... and covering
@@ -165,15 +224,16 @@ def test_models_in_one_world_own_disjoint_parts_that_cover_it():
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
 def test_the_publisher_sends_every_numbered_joint_by_name(case, loaded, node):
-    from tutorial.controller import ControllerConfig, ControllerIO
     from tutorial.controllers.joint_state_publisher import RttJointStatePublisher
+    from tutorial.core.controller import ControllerConfig, ControllerIO
 
     _, world, _ = loaded(case)
     data = mujoco.MjData(world)
     body = Body(world, data, case.name)
     publisher = RttJointStatePublisher()
-    assert publisher.configure(ControllerConfig(name="RttJointStatePublisher", body=body, node=node,
-                                                parameters={"rate": 50.0}))
+    assert publisher.configure(
+        ControllerConfig(name="RttJointStatePublisher", body=body, node=node, parameters={"rate": 50.0})
+    )
     try:
         assert publisher.initialize(ControllerIO(body=body, time_step=world.opt.timestep, node=node, data=data))
         assert publisher.topic == f"/{case.name}/joint_state"
@@ -192,7 +252,7 @@ models:
     file: {file}
     controllers:
       - name: Swing
-        class: tutorial.controllers.swing_controller:SwingController
+        class: tests.fixtures.swing_controller:SwingController
       - name: RttJointStatePublisher
         class: tutorial.controllers.joint_state_publisher:RttJointStatePublisher
         parameters: {{rate: 100}}
@@ -232,8 +292,8 @@ def test_a_viewer_mirrors_a_simulation(case, ros, tmp_path):
     messages, then is stopped; the publisher sends the final state in ``stop()``.  The
     viewer must end on exactly that state (the same float64s), no entry rejected for its name.
     """
-    from tutorial.app import App
-    from tutorial.project import load_project
+    from tutorial.core.app import App
+    from tutorial.core.project import load_project
 
     path = case.file()
     tag = case.name.lower()
@@ -248,8 +308,11 @@ def test_a_viewer_mirrors_a_simulation(case, ros, tmp_path):
         sim.open()
         subscriber = view.controller("RttJointStateMonitor")
         status = subscriber.status
-        assert step_until(open_apps, lambda: status.applied >= MIN_APPLIED and sim.sim.sim_time >= MIN_SIM_TIME
-                          or sim.sim.finished.is_set(), timeout=60), (status.applied, sim.sim.sim_time)
+        assert step_until(
+            open_apps,
+            lambda: status.applied >= MIN_APPLIED and sim.sim.sim_time >= MIN_SIM_TIME or sim.sim.finished.is_set(),
+            timeout=60,
+        ), (status.applied, sim.sim.sim_time)
         assert not sim.sim.finished.is_set(), sim.sim.error  # it was still running: nothing failed
         sim.request_stop()
         open_apps.remove(sim)
@@ -258,8 +321,9 @@ def test_a_viewer_mirrors_a_simulation(case, ros, tmp_path):
         body = sim.bodies[case.name]
         final = body.joint_positions()  # the simulation's final state
         mirrored = step_until([view], lambda: status.last_positions == final, timeout=10)
-        assert mirrored, {k: (final[k], status.last_positions.get(k)) for k in final
-                          if status.last_positions.get(k) != final[k]}
+        assert mirrored, {
+            k: (final[k], status.last_positions.get(k)) for k in final if status.last_positions.get(k) != final[k]
+        }
         assert view.bodies[case.name].joint_positions() == final  # and the viewer's model is in it
         # No entry is rejected for its name.  Out-of-range rejections on the way are the
         # viewer's policy working: MuJoCo's joint limits are soft, and a model may start
@@ -286,18 +350,29 @@ def test_ant_mirrors_across_processes(procs, tmp_path):
 
     case = CASES[0]
     path = case.file()
-    (tmp_path / "sim.yaml").write_text(SIM_YAML.format(tag="ant", name=case.name, file=path)
-                                       .replace("realtime_sync: false", "realtime_sync: true"))
+    (tmp_path / "sim.yaml").write_text(
+        SIM_YAML.format(tag="ant", name=case.name, file=path).replace("realtime_sync: false", "realtime_sync: true")
+    )
     (tmp_path / "view.yaml").write_text(VIEW_YAML.format(tag="ant", name=case.name, file=path))
 
     def stale(line: str) -> bool:
         return line.startswith("{") and json.loads(line).get("event") == "stale"
 
-    view = procs(module_command("tutorial.runner", str(tmp_path / "view.yaml"), "--headless", "--json",
-                                "--ros-args", "-r", "__node:=ant_viewer"))
+    view = procs(
+        module_command(
+            "tutorial.tools.rtt_run",
+            str(tmp_path / "view.yaml"),
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-r",
+            "__node:=ant_viewer",
+        )
+    )
     # 4 s of real time: the two processes find each other well before the final state goes out.
-    sim = procs(module_command("tutorial.runner", str(tmp_path / "sim.yaml"), "--headless", "--json",
-                               "--duration", "4"))
+    sim = procs(
+        module_command("tutorial.tools.rtt_run", str(tmp_path / "sim.yaml"), "--headless", "--json", "--duration", "4")
+    )
     stale_before = view.count(stale)
     assert sim.wait(60) == 0, sim.err
     final = sim.summary()["bodies"][case.name]["joint_positions"]
@@ -307,7 +382,10 @@ def test_ant_mirrors_across_processes(procs, tmp_path):
     shown = view.summary()["controllers"]["RttJointStateMonitor"]
     assert shown["topic"] == "/Ant/joint_state"
     assert set(shown["rejected"]) <= {"out_of_range"}  # the ant starts outside its ankle limits
-    assert sorted(final) == sorted(shown["last_positions"]) == sorted(f"{leg}_{i}" for leg in ("hip", "ankle")
-                                                                        for i in range(1, 5))
+    assert (
+        sorted(final)
+        == sorted(shown["last_positions"])
+        == sorted(f"{leg}_{i}" for leg in ("hip", "ankle") for i in range(1, 5))
+    )
     for name, q in final.items():
         assert abs(shown["last_positions"][name] - q) <= 1e-6, (name, q, shown["last_positions"][name])

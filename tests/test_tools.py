@@ -8,12 +8,15 @@ from conftest import module_command
 def test_plot_and_graph_of_a_running_step2(procs, tmp_path):
     png = tmp_path / "plot.png"
     graph_png = tmp_path / "graph.png"
-    plot = procs(module_command("tutorial.plot_node", "--body", "Tank", "--duration", "9", "--output", str(png),
-                                "--no-window"))
-    joy = procs(module_command("tutorial.joy_node", "--demo", "--duration", "10"))
-    sim = procs(module_command("tutorial.runner", "project/step2.yaml", "--headless", "--duration", "10"))
+    plot = procs(
+        module_command(
+            "tutorial.tools.rtt_plot", "--body", "Tank", "--duration", "9", "--output", str(png), "--no-window"
+        )
+    )
+    joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "10"))
+    sim = procs(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--duration", "10"))
     joy.wait_for_line(lambda line: "the demo starts" in line, timeout=30)
-    graph = procs(module_command("tutorial.graph_node", "--wait", "4", "--json", "--output", str(graph_png)))
+    graph = procs(module_command("tutorial.tools.rtt_graph", "--wait", "4", "--json", "--output", str(graph_png)))
     assert graph.wait(60) == 0, graph.err
     g = json.loads(graph.out.splitlines()[0])
     assert {"/rtt", "/rtt_joy", "/rtt_plot"} <= set(g["nodes"])

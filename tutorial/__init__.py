@@ -1,7 +1,7 @@
 """ros-tank-tutorial: the library behind the notebooks and the ``rtt-*`` programs.
 
 Importing the package makes localhost-only ROS 2 discovery the default for this
-process (see :mod:`tutorial.ros_env`), so a learner's first run never talks to
+process (see :mod:`tutorial.ros.env`), so a learner's first run never talks to
 other machines.  Set ``ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`` before starting
 a program to reach a real robot on your network.
 
@@ -14,7 +14,7 @@ renders on the CPU where there is no GPU).  MuJoCo picks its backend when
 import os as _os
 import sys as _sys
 
-from tutorial import ros_env as _ros_env
+from tutorial.ros import env as _ros_env
 
 _ros_env.use_localhost_by_default()
 if _sys.platform.startswith("linux"):  # elsewhere MUJOCO_GL=egl makes `import mujoco` fail

@@ -28,7 +28,7 @@ import signal
 import sys
 import time
 
-from tutorial import ros_env
+from tutorial.ros import env as ros_env
 
 PROG = "rtt-bag"
 _say = functools.partial(print, flush=True)
@@ -36,19 +36,32 @@ _say = functools.partial(print, flush=True)
 
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``rtt-bag`` (ROS arguments are removed before it parses)."""
-    p = argparse.ArgumentParser(prog=PROG, description="Record, list and replay ROS 2 bags in MCAP files.",
-                                epilog="ROS arguments go after --ros-args, e.g. --ros-args -r __node:=my_bag")
+    p = argparse.ArgumentParser(
+        prog=PROG,
+        description="Record, list and replay ROS 2 bags in MCAP files.",
+        epilog="ROS arguments go after --ros-args, e.g. --ros-args -r __node:=my_bag",
+    )
     sub = p.add_subparsers(dest="command", required=True, metavar="{record,info,play}")
 
     r = sub.add_parser("record", help="record topics to an MCAP file until Ctrl-C, SIGTERM or --duration")
     r.add_argument("topics", nargs="*", metavar="TOPIC", help="topics to record, e.g. /joy /Tank/joint_state")
     r.add_argument("-a", "--all", action="store_true", help="record every topic with a publisher (hidden ones aside)")
-    r.add_argument("-o", "--output", metavar="FILE.mcap",
-                   help="the file to write (default rtt_bag_<date>-<time>.mcap); it must not exist")
-    r.add_argument("--duration", type=float, default=None, metavar="SECONDS",
-                   help="stop after this long (wall time from the start)")
-    r.add_argument("--compression", choices=["zstd", "lz4", "none"], default="zstd",
-                   help="chunk compression (default zstd)")
+    r.add_argument(
+        "-o",
+        "--output",
+        metavar="FILE.mcap",
+        help="the file to write (default rtt_bag_<date>-<time>.mcap); it must not exist",
+    )
+    r.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="stop after this long (wall time from the start)",
+    )
+    r.add_argument(
+        "--compression", choices=["zstd", "lz4", "none"], default="zstd", help="chunk compression (default zstd)"
+    )
     r.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
 
     i = sub.add_parser("info", help="per topic: type, message count, time span, rate, QoS")
@@ -60,10 +73,16 @@ def build_parser() -> argparse.ArgumentParser:
     y.add_argument("-r", "--rate", type=float, default=1.0, help="speed factor (default 1.0)")
     y.add_argument("-l", "--loop", action="store_true", help="play again from the start offset, until stopped")
     y.add_argument("--topics", nargs="+", metavar="TOPIC", help="play only these topics")
-    y.add_argument("--start-offset", type=float, default=0.0, metavar="SECONDS",
-                   help="skip this many seconds from the bag's start")
-    y.add_argument("--delay", type=float, default=0.0, metavar="SECONDS",
-                   help="wait this long before playing (each loop), e.g. for discovery")
+    y.add_argument(
+        "--start-offset", type=float, default=0.0, metavar="SECONDS", help="skip this many seconds from the bag's start"
+    )
+    y.add_argument(
+        "--delay",
+        type=float,
+        default=0.0,
+        metavar="SECONDS",
+        help="wait this long before playing (each loop), e.g. for discovery",
+    )
     return p
 
 
@@ -84,7 +103,7 @@ class _StopRequest:
         if self._on_stop is not None:
             self._on_stop()
 
-    def install(self) -> "_StopRequest":
+    def install(self) -> _StopRequest:
         signal.signal(signal.SIGINT, self)
         signal.signal(signal.SIGTERM, self)
         return self
@@ -116,8 +135,9 @@ def record(args, argv: list[str]) -> int:
         return _fail("record: --duration must be > 0")
     path = args.output or datetime.datetime.now().strftime("rtt_bag_%Y_%m_%d-%H_%M_%S.mcap")
     try:  # the file first: a name that exists fails before ROS starts
-        recorder = BagRecorder(path, args.topics, all_topics=args.all, compression=args.compression,
-                               overwrite=args.overwrite, output=_say)
+        recorder = BagRecorder(
+            path, args.topics, all_topics=args.all, compression=args.compression, overwrite=args.overwrite, output=_say
+        )
     except (BagWriteError, ValueError) as exc:
         return _fail(f"record: {exc}")
     stop = _StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
@@ -161,8 +181,15 @@ def play(args, argv: list[str]) -> int:
     from tutorial.bag.reader import BagError
 
     try:
-        player = BagPlayer(args.file, rate=args.rate, loop=args.loop, topics=args.topics,
-                           start_offset=args.start_offset, delay=args.delay, output=_say)
+        player = BagPlayer(
+            args.file,
+            rate=args.rate,
+            loop=args.loop,
+            topics=args.topics,
+            start_offset=args.start_offset,
+            delay=args.delay,
+            output=_say,
+        )
     except (BagError, ValueError) as exc:
         return _fail(f"play: {exc}")
     _StopRequest(player.request_stop).install()

@@ -35,8 +35,24 @@ MAX_DEPTH = 50  # rosbag2's ROSBAG2_CPP_LOCAL_MESSAGE_DEFINITION_SOURCE_MAX_RECU
 _PACKAGE_TYPENAME = re.compile(r"^([a-zA-Z0-9_]+)/(?:msg/|srv/)?([a-zA-Z0-9_]+)$")
 _MSG_FIELD_TYPE = re.compile(r"(?:^|\n)\s*([a-zA-Z0-9_/]+)(?:\[[^\]]*\])?\s+")
 _IDL_FIELD_TYPE = re.compile(r"(?:^|\n)#include\s+(?:\"|<)([a-zA-Z0-9_/]+)\.idl(?:\"|>)")
-PRIMITIVE_TYPES = frozenset({"bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16",
-                             "uint16", "int32", "uint32", "int64", "uint64", "string"})
+PRIMITIVE_TYPES = frozenset(
+    {
+        "bool",
+        "byte",
+        "char",
+        "float32",
+        "float64",
+        "int8",
+        "uint8",
+        "int16",
+        "uint16",
+        "int32",
+        "uint32",
+        "int64",
+        "uint64",
+        "string",
+    }
+)
 
 
 class UnknownMessageType(LookupError):
@@ -69,8 +85,9 @@ def _definition_file(type_name: str, extension: str) -> str:
         path = share / package / "msg" / f"{name}.{extension}"
         if path.is_file():
             return path.read_text(encoding="utf-8")
-    raise UnknownMessageType(f"no {name}.{extension} of package {package} in "
-                             + ", ".join(str(s) for s in share_directories()))
+    raise UnknownMessageType(
+        f"no {name}.{extension} of package {package} in " + ", ".join(str(s) for s in share_directories())
+    )
 
 
 def _dependencies(text: str, package: str, extension: str) -> list[str]:
@@ -150,10 +167,10 @@ def message_class(type_name: str):
     try:
         module = importlib.import_module(f"{package}.msg")
     except ImportError:
-        raise UnknownMessageType(f"message type {type_name} is not installed here "
-                                 f"(no Python module {package}.msg)") from None
+        raise UnknownMessageType(
+            f"message type {type_name} is not installed here (no Python module {package}.msg)"
+        ) from None
     cls = getattr(module, name, None)
     if cls is None:
-        raise UnknownMessageType(f"message type {type_name} is not installed here "
-                                 f"({package}.msg has no {name})")
+        raise UnknownMessageType(f"message type {type_name} is not installed here ({package}.msg has no {name})")
     return cls

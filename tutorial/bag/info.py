@@ -110,9 +110,16 @@ def bag_info(path) -> BagInfo:
             t.last_ns = message.log_time if t.last_ns is None else max(t.last_ns, message.log_time)
     firsts = [t.first_ns for t in topics.values() if t.count]
     lasts = [t.last_ns for t in topics.values() if t.count]
-    return BagInfo(p, p.stat().st_size, header.profile, header.library, sum(t.count for t in topics.values()),
-                   min(firsts) if firsts else None, max(lasts) if lasts else None,
-                   sorted(topics.values(), key=lambda t: t.topic))
+    return BagInfo(
+        p,
+        p.stat().st_size,
+        header.profile,
+        header.library,
+        sum(t.count for t in topics.values()),
+        min(firsts) if firsts else None,
+        max(lasts) if lasts else None,
+        sorted(topics.values(), key=lambda t: t.topic),
+    )
 
 
 def _topic_info(path: Path, channel, schema) -> TopicInfo:
@@ -120,9 +127,13 @@ def _topic_info(path: Path, channel, schema) -> TopicInfo:
         profiles = parse_profiles(channel.metadata.get("offered_qos_profiles", ""))
     except QosFormatError as exc:
         raise BagError(f"{path}: topic {channel.topic}: {exc}") from None
-    return TopicInfo(channel.topic, schema.name if schema else "", offered_qos_profiles=profiles,
-                     schema_encoding=schema.encoding if schema else "",
-                     type_hash=channel.metadata.get("topic_type_hash", ""))
+    return TopicInfo(
+        channel.topic,
+        schema.name if schema else "",
+        offered_qos_profiles=profiles,
+        schema_encoding=schema.encoding if schema else "",
+        type_hash=channel.metadata.get("topic_type_hash", ""),
+    )
 
 
 def _time(ns: int | None) -> str:
@@ -156,11 +167,17 @@ def format_info(info: BagInfo) -> str:
     twidth = max((len(t.type) for t in info.topics), default=0)
     for t in info.topics:
         # The span as offsets from the bag's first message, and its length.
-        span = (f"{(t.first_ns - info.first_ns) * 1e-9:7.3f} s to {(t.last_ns - info.first_ns) * 1e-9:7.3f} s "
-                f"({t.span_s:.3f} s)" if t.count else "no messages")
+        span = (
+            f"{(t.first_ns - info.first_ns) * 1e-9:7.3f} s to {(t.last_ns - info.first_ns) * 1e-9:7.3f} s "
+            f"({t.span_s:.3f} s)"
+            if t.count
+            else "no messages"
+        )
         rate = f"{t.rate_hz:.2f} Hz" if t.rate_hz is not None else "- Hz"
-        lines.append(f"  {t.topic:<{width}}  {t.type or '?':<{twidth}}  {t.count:7d} msgs  {span}  {rate:>11}  "
-                     f"QoS {describe(t.offered_qos_profiles)}")
+        lines.append(
+            f"  {t.topic:<{width}}  {t.type or '?':<{twidth}}  {t.count:7d} msgs  {span}  {rate:>11}  "
+            f"QoS {describe(t.offered_qos_profiles)}"
+        )
     if not info.topics:
         lines.append("  (none)")
     return "\n".join(lines)

@@ -74,8 +74,19 @@ class BagPlayer:
     it on a background thread, stopped by :meth:`close` from the owner.
     """
 
-    def __init__(self, path, *, rate: float = 1.0, loop: bool = False, topics=None, start_offset: float = 0.0,
-                 delay: float = 0.0, node=None, node_name: str = NODE_NAME, output=print):
+    def __init__(
+        self,
+        path,
+        *,
+        rate: float = 1.0,
+        loop: bool = False,
+        topics=None,
+        start_offset: float = 0.0,
+        delay: float = 0.0,
+        node=None,
+        node_name: str = NODE_NAME,
+        output=print,
+    ):
         if not rate > 0:
             raise ValueError("rate must be > 0")
         if start_offset < 0 or delay < 0:
@@ -88,8 +99,9 @@ class BagPlayer:
             wanted = [t if t.startswith("/") else "/" + t for t in topics]
             missing = [t for t in wanted if t not in names]
             if missing:
-                raise BagError(f"{self.path}: no messages on {', '.join(missing)} "
-                               f"(it has: {', '.join(names) or 'none'})")
+                raise BagError(
+                    f"{self.path}: no messages on {', '.join(missing)} (it has: {', '.join(names) or 'none'})"
+                )
             names = [n for n in names if n in wanted]
         self.selected = [self.info.topic(n) for n in names]
         self.classes = {}
@@ -104,7 +116,7 @@ class BagPlayer:
         self.output = output
         self.publishers: dict[str, object] = {}
         self.stats = PlayStats({n: 0 for n in names})
-        self._stop = False  # a plain flag: also set from a signal handler (see tutorial/launch.py)
+        self._stop = False  # a plain flag: also set from a signal handler (see tutorial/ros/launch.py)
         self._thread: threading.Thread | None = None
         self.error: BaseException | None = None
 
@@ -117,8 +129,9 @@ class BagPlayer:
             profile, warning = offer_for_recorded(t.offered_qos_profiles)
             if warning:
                 self._say(f"WARNING: {t.topic}: {warning}")
-            self.publishers[t.topic] = self.node.create_publisher(self.classes[t.topic], t.topic,
-                                                                  to_qos_profile(profile))
+            self.publishers[t.topic] = self.node.create_publisher(
+                self.classes[t.topic], t.topic, to_qos_profile(profile)
+            )
             self._say(f"publishing {t.topic} ({t.type}; {profile['reliability']}, {profile['durability']})")
 
     def request_stop(self) -> None:
@@ -163,9 +176,11 @@ class BagPlayer:
         finally:
             self.stats.stopped = self._stop
             self._wait_for_acks()
-        self._say(f"published {self.stats.messages} messages ("
-                  + ", ".join(f"{t} {n}" for t, n in self.stats.published.items())
-                  + f"){', stopped' if self.stats.stopped else ''}")
+        self._say(
+            f"published {self.stats.messages} messages ("
+            + ", ".join(f"{t} {n}" for t, n in self.stats.published.items())
+            + f"){', stopped' if self.stats.stopped else ''}"
+        )
         return self.stats
 
     def _wait_for_acks(self) -> None:
@@ -174,7 +189,7 @@ class BagPlayer:
         for pub in self.publishers.values():
             pub.wait_for_all_acked(Duration(seconds=ACK_TIMEOUT))
 
-    def start(self) -> "BagPlayer":
+    def start(self) -> BagPlayer:
         """Play on a background thread (its error, if any, is kept in :attr:`error`); returns self."""
         self._create_publishers()
 

@@ -53,12 +53,20 @@ _POLICY_VALUES = {
     "history": ["system_default", "keep_last", "keep_all", "unknown"],
     "reliability": ["system_default", "reliable", "best_effort", "unknown", "best_available"],
     "durability": ["system_default", "transient_local", "volatile", "unknown", "best_available"],
-    "liveliness": ["system_default", "automatic", "manual_by_node", "manual_by_topic", "unknown",
-                   "best_available"],
+    "liveliness": ["system_default", "automatic", "manual_by_node", "manual_by_topic", "unknown", "best_available"],
 }
 _DURATIONS = ("deadline", "lifespan", "liveliness_lease_duration")
-_KEYS = ("history", "depth", "reliability", "durability", "deadline", "lifespan", "liveliness",
-         "liveliness_lease_duration", "avoid_ros_namespace_conventions")
+_KEYS = (
+    "history",
+    "depth",
+    "reliability",
+    "durability",
+    "deadline",
+    "lifespan",
+    "liveliness",
+    "liveliness_lease_duration",
+    "avoid_ros_namespace_conventions",
+)
 _COMPATIBILITY_KEYS = ("reliability", "durability", "deadline", "liveliness", "liveliness_lease_duration")
 
 
@@ -72,9 +80,15 @@ def _duration(ns: int) -> dict:
 
 
 DEFAULT_PROFILE = {  # rosbag2's Rosbag2QoS{}: rmw_qos_profile_default
-    "history": "keep_last", "depth": DEFAULT_DEPTH, "reliability": "reliable", "durability": "volatile",
-    "deadline": _duration(0), "lifespan": _duration(0), "liveliness": "system_default",
-    "liveliness_lease_duration": _duration(0), "avoid_ros_namespace_conventions": False,
+    "history": "keep_last",
+    "depth": DEFAULT_DEPTH,
+    "reliability": "reliable",
+    "durability": "volatile",
+    "deadline": _duration(0),
+    "lifespan": _duration(0),
+    "liveliness": "system_default",
+    "liveliness_lease_duration": _duration(0),
+    "avoid_ros_namespace_conventions": False,
 }
 
 
@@ -159,8 +173,10 @@ def offer_for_recorded(profiles: list[dict]) -> tuple[dict, str | None]:
     first = profiles[0]
     if all(all(p[k] == first[k] for k in _COMPATIBILITY_KEYS) for p in profiles[1:]):
         return {**first, "history": "keep_last", "depth": DEFAULT_DEPTH}, None
-    return dict(DEFAULT_PROFILE), ("the recorded publishers offered different QoS profiles; "
-                                   "offering the default (reliable, volatile, keep last 10)")
+    return dict(DEFAULT_PROFILE), (
+        "the recorded publishers offered different QoS profiles; "
+        "offering the default (reliable, volatile, keep last 10)"
+    )
 
 
 def request_for_offers(profiles: list[dict], depth: int) -> dict:
@@ -173,10 +189,10 @@ def request_for_offers(profiles: list[dict], depth: int) -> dict:
     """
     request = dict(DEFAULT_PROFILE, depth=depth)
     if profiles:
-        request["reliability"] = ("reliable" if all(p["reliability"] == "reliable" for p in profiles)
-                                  else "best_effort")
-        request["durability"] = ("transient_local" if all(p["durability"] == "transient_local" for p in profiles)
-                                 else "volatile")
+        request["reliability"] = "reliable" if all(p["reliability"] == "reliable" for p in profiles) else "best_effort"
+        request["durability"] = (
+            "transient_local" if all(p["durability"] == "transient_local" for p in profiles) else "volatile"
+        )
     return request
 
 
@@ -199,9 +215,12 @@ def to_qos_profile(profile: dict):
     if history == HistoryPolicy.UNKNOWN:
         history = HistoryPolicy.KEEP_LAST
     return QoSProfile(
-        history=history, depth=max(1, profile["depth"]),
-        reliability=policy(ReliabilityPolicy, "reliability"), durability=policy(DurabilityPolicy, "durability"),
-        deadline=duration("deadline"), lifespan=duration("lifespan"),
+        history=history,
+        depth=max(1, profile["depth"]),
+        reliability=policy(ReliabilityPolicy, "reliability"),
+        durability=policy(DurabilityPolicy, "durability"),
+        deadline=duration("deadline"),
+        lifespan=duration("lifespan"),
         liveliness=policy(LivelinessPolicy, "liveliness"),
         liveliness_lease_duration=duration("liveliness_lease_duration"),
         avoid_ros_namespace_conventions=profile["avoid_ros_namespace_conventions"],

@@ -19,9 +19,9 @@ or a chunk CRC's complaint).
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
@@ -64,8 +64,10 @@ def check_file(path) -> Path:
         f.seek(max(0, size - len(MAGIC)))
         tail = f.read(len(MAGIC))
     if size < 2 * len(MAGIC) or tail != MAGIC:
-        raise BagError(f"{p}: truncated MCAP file (no closing magic at its end): "
-                       "the recording was not closed, or the copy is incomplete")
+        raise BagError(
+            f"{p}: truncated MCAP file (no closing magic at its end): "
+            "the recording was not closed, or the copy is incomplete"
+        )
     return p
 
 
@@ -122,10 +124,16 @@ def iter_raw(path, topics=None, start_time: int | None = None) -> Iterator[RawMe
         BagError: the file is not a whole, readable MCAP file.
     """
     with open_reader(path) as reader:
-        for schema, channel, message in reader.iter_messages(topics=topics, starting_at=start_time,
-                                                             log_time_order=True):
-            yield RawMessage(channel.topic, schema.name if schema else "", message.log_time,
-                             message.publish_time, bytes(message.data))
+        for schema, channel, message in reader.iter_messages(
+            topics=topics, starting_at=start_time, log_time_order=True
+        ):
+            yield RawMessage(
+                channel.topic,
+                schema.name if schema else "",
+                message.log_time,
+                message.publish_time,
+                bytes(message.data),
+            )
 
 
 def read_messages(path, topics=None) -> Iterator[tuple[str, int, object]]:
@@ -187,5 +195,9 @@ def joint_series(path, topic: str = "/Tank/joint_state") -> JointSeries:
         if topic not in topics:
             raise BagError(f"{path}: no topic {topic} (it has: {', '.join(topics) or 'none'})")
     t0 = logs[0] if logs else 0
-    return JointSeries(topic, np.array(stamps), (np.array(logs, dtype=np.int64) - t0) * 1e-9,
-                       {n: np.array([r.get(n, np.nan) for r in rows]) for n in names})
+    return JointSeries(
+        topic,
+        np.array(stamps),
+        (np.array(logs, dtype=np.int64) - t0) * 1e-9,
+        {n: np.array([r.get(n, np.nan) for r in rows]) for n in names},
+    )

@@ -62,7 +62,7 @@ class BagRecorder:
         all_topics: record every (non-hidden) topic that has a publisher, now or later.
         node: an ``rclpy`` node to use, spun by its owner; None (default):
             the recorder creates node ``node_name`` and spins it on its own
-            :class:`tutorial.ros_env.SpinThread`.
+            :class:`tutorial.ros.env.SpinThread`.
         node_name: the name of the node it creates.
         compression: chunk compression, ``zstd`` (default), ``lz4`` or ``none``.
         overwrite: replace an existing file (default: refuse).
@@ -73,7 +73,7 @@ class BagRecorder:
         tutorial.bag.writer.BagWriteError: the file cannot be created.
 
     The file is created by the constructor; :meth:`start` subscribes.
-    ``rclpy`` must be initialised first (``tutorial.ros_env.init`` or, in a
+    ``rclpy`` must be initialised first (``tutorial.ros.env.init`` or, in a
     notebook, ``init_ros()``).
 
     Threads: construct, :meth:`start` and :meth:`close` on one owner thread
@@ -83,8 +83,18 @@ class BagRecorder:
     keeps :meth:`close` from finishing the file in the middle of a write.
     """
 
-    def __init__(self, path, topics=(), *, all_topics: bool = False, node=None, node_name: str = NODE_NAME,
-                 compression: str = "zstd", overwrite: bool = False, output=print):
+    def __init__(
+        self,
+        path,
+        topics=(),
+        *,
+        all_topics: bool = False,
+        node=None,
+        node_name: str = NODE_NAME,
+        compression: str = "zstd",
+        overwrite: bool = False,
+        output=print,
+    ):
         self.topics_wanted = [normalize_topic(t) for t in topics]
         if not self.topics_wanted and not all_topics:
             raise ValueError("name the topics to record, or record all topics")
@@ -108,11 +118,11 @@ class BagRecorder:
         self.started_at: float | None = None
 
     # ------------------------------------------------------------ owner thread
-    def start(self) -> "BagRecorder":
+    def start(self) -> BagRecorder:
         """Create the node if needed, subscribe to what exists now, keep polling for the rest; returns self."""
         import rclpy
 
-        from tutorial import ros_env
+        from tutorial.ros import env as ros_env
 
         if self.node is None:
             self.node = rclpy.create_node(self.node_name)
@@ -159,11 +169,13 @@ class BagRecorder:
             return self.writer.stats()
         stats = self.writer.close()
         per_topic = ", ".join(f"{t} {n}" for t, n in stats.per_topic.items()) or "no topics"
-        self._say(f"wrote {stats.messages} of {sum(self.received.values())} messages received ({per_topic}) "
-                  f"to {self.path}, {stats.size_bytes} bytes")
+        self._say(
+            f"wrote {stats.messages} of {sum(self.received.values())} messages received ({per_topic}) "
+            f"to {self.path}, {stats.size_bytes} bytes"
+        )
         return stats
 
-    def __enter__(self) -> "BagRecorder":
+    def __enter__(self) -> BagRecorder:
         return self.start()
 
     def __exit__(self, *exc) -> None:
@@ -219,9 +231,12 @@ class BagRecorder:
             self.writer.write(topic, received, info.get("source_timestamp") or received, data)
 
         self._subscriptions[topic] = self.node.create_subscription(
-            msg_type, topic, on_message, to_qos_profile(request), raw=True)
-        self._say(f"subscribed to {topic} ({type_name}; {request['reliability']}, {request['durability']}, "
-                  f"{len(endpoints)} publisher{'s' if len(endpoints) != 1 else ''})")
+            msg_type, topic, on_message, to_qos_profile(request), raw=True
+        )
+        self._say(
+            f"subscribed to {topic} ({type_name}; {request['reliability']}, {request['durability']}, "
+            f"{len(endpoints)} publisher{'s' if len(endpoints) != 1 else ''})"
+        )
 
     def _skip(self, topic: str, why: str) -> None:
         self._skipped.add(topic)

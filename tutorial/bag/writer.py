@@ -97,8 +97,9 @@ class BagWriter:
         self._stats = WriteStats(self.path)
         self.closed = False
 
-    def add_topic(self, topic: str, type_name: str, definition: tuple[str, str],
-                  offered_qos_profiles: str, type_hash: str = "") -> int:
+    def add_topic(
+        self, topic: str, type_name: str, definition: tuple[str, str], offered_qos_profiles: str, type_hash: str = ""
+    ) -> int:
         """Register a topic (once); its channel id.
 
         Args:
@@ -123,8 +124,8 @@ class BagWriter:
                 schema_id = self._writer.register_schema(type_name, encoding, text.encode())
                 self._schemas[type_name] = schema_id
             channel_id = self._writer.register_channel(
-                topic, "cdr", schema_id,
-                {"offered_qos_profiles": offered_qos_profiles, "topic_type_hash": type_hash})
+                topic, "cdr", schema_id, {"offered_qos_profiles": offered_qos_profiles, "topic_type_hash": type_hash}
+            )
             self._topics[topic] = _Topic(topic, type_name, channel_id, offered_qos_profiles, type_hash)
             self._stats.per_topic[topic] = 0
             return channel_id
@@ -182,14 +183,19 @@ class BagWriter:
         s = self._stats
         start = s.first_ns or 0
         duration = (s.last_ns - s.first_ns) if s.messages else 0
-        topics = [{
-            "topic_metadata": {
-                "name": t.name, "type": t.type, "serialization_format": "cdr",
-                "offered_qos_profiles": parse_profiles(t.offered_qos_profiles),
-                "type_description_hash": t.type_hash,
-            },
-            "message_count": t.count,
-        } for t in self._topics.values()]
+        topics = [
+            {
+                "topic_metadata": {
+                    "name": t.name,
+                    "type": t.type,
+                    "serialization_format": "cdr",
+                    "offered_qos_profiles": parse_profiles(t.offered_qos_profiles),
+                    "type_description_hash": t.type_hash,
+                },
+                "message_count": t.count,
+            }
+            for t in self._topics.values()
+        ]
         metadata = {
             "version": BAG_FORMAT_VERSION,
             "storage_identifier": "mcap",
@@ -200,8 +206,14 @@ class BagWriter:
             "compression_format": "",
             "compression_mode": "",
             "relative_file_paths": [self.path.name],
-            "files": [{"path": self.path.name, "starting_time": {"nanoseconds_since_epoch": start},
-                       "duration": {"nanoseconds": duration}, "message_count": s.messages}],
+            "files": [
+                {
+                    "path": self.path.name,
+                    "starting_time": {"nanoseconds_since_epoch": start},
+                    "duration": {"nanoseconds": duration},
+                    "message_count": s.messages,
+                }
+            ],
             "custom_data": {},
             "ros_distro": os.environ.get("ROS_DISTRO", "jazzy"),
         }

@@ -23,7 +23,8 @@ render thread: while one snapshot waits, a newer one replaces it and the
 older is counted as skipped.  Nothing queues up: the simulation never waits
 for the renderer, and each picture published is the newest that could be made.
 
-Topic ``/<body>/camera/image``, ``rgb8``, QoS :func:`camera_image_qos`.  The
+Topic ``/<body>/camera/image``, ``rgb8``, QoS
+:func:`tutorial.interfaces.image.camera_image_qos`.  The
 ``frame_id`` is the camera's name (``Kinect``): MuJoCo's camera frame, which
 looks along its -z with +y up (a ROS optical frame looks along +z, +y down).
 Rendering without a window needs an OpenGL backend: MuJoCo reads
@@ -38,15 +39,15 @@ from __future__ import annotations
 import os
 import threading
 import time
-from array import array
 
 import mujoco
 import numpy as np
 
-from ..call_later import MainLoop
-from ..controller import ControllerConfig, ControllerIO, SimpleController
-from .joint_state_publisher import PeriodAccumulator, stamp_parts
-from ..simulator import Snapshot
+from ..core.call_later import MainLoop
+from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.simulator import Snapshot
+from ..interfaces.image import camera_image_qos, camera_image_topic, fill_image
+from ..interfaces.timing import PeriodAccumulator
 
 DEFAULT_RATE = 30.0  # pictures per second of simulated time
 START_TIMEOUT = 20.0  # s for the render thread to make its OpenGL context
@@ -60,11 +61,12 @@ def body_cameras(model: mujoco.MjModel, body_name: str) -> list[tuple[int, str]]
     """
     prefix = f"{body_name}/"
     names = [(i, model.camera(i).name) for i in range(model.ncam)]
-    return [(i, name[len(prefix):]) for i, name in names if name.startswith(prefix)]
+    return [(i, name[len(prefix) :]) for i, name in names if name.startswith(prefix)]
 
 
-def render_snapshot(renderer: mujoco.Renderer, data: mujoco.MjData,
-                    snapshot: Snapshot, camera_id: int) -> np.ndarray:
+def render_snapshot(
+    renderer: mujoco.Renderer, data: mujoco.MjData, snapshot: Snapshot, camera_id: int
+) -> np.ndarray:
     """Pose ``data`` as in ``snapshot`` and render one camera.
 
     Returns:
@@ -83,56 +85,7 @@ def render_snapshot(renderer: mujoco.Renderer, data: mujoco.MjData,
     return renderer.render()
 
 # %% auto #0
-__all__ = ['DEFAULT_RATE', 'START_TIMEOUT', 'STOP_TIMEOUT', 'body_cameras', 'render_snapshot', 'camera_image_topic',
-           'camera_image_qos', 'fill_image', 'RttCameraImagePublisher']
-
-# %% ../../notebooks/06_step6_camera.ipynb #b240e969
-def camera_image_topic(body_name: str) -> str:
-    """``/<body name>/camera/image``, e.g. ``/Tank/camera/image``."""
-    return f"/{body_name}/camera/image"
-
-
-def camera_image_qos():
-    """The camera's QoS: best effort, keep last 1, volatile.
-
-    * best effort: a picture that arrives late is worth nothing (the next
-      one is 33 ms behind it), so none is resent;
-    * keep last 1: only the newest picture matters; a slow subscriber skips
-      to it instead of working through a queue of old ones;
-    * volatile: a subscriber that joins later waits for the next picture.
-
-    It is ROS's sensor-data convention with depth 1 (rclpy's
-    ``qos_profile_sensor_data`` keeps 5).  A subscriber must ask for best
-    effort too: a reliable subscription does not match a best-effort publisher.
-    """
-    from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile,
-                           ReliabilityPolicy)
-
-    return QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                      reliability=ReliabilityPolicy.BEST_EFFORT,
-                      durability=DurabilityPolicy.VOLATILE)
-
-
-def fill_image(msg, pixels: np.ndarray, time_s: float) -> None:
-    """Write a picture and its stamp into a ``sensor_msgs/Image``.
-
-    Args:
-        msg: the Image to fill (its ``header.frame_id`` is left as it is).
-        pixels: ``(height, width, 3)`` uint8 RGB, rows top to bottom.
-        time_s: the stamp, s of simulation time.
-
-    ``rgb8`` is 3 bytes a pixel, so a row is ``step`` = 3 x width bytes;
-    ``is_bigendian`` does not matter for single bytes but is set (0).
-    Any thread may call it, on a message no other thread is using.
-    """
-    height, width, _ = pixels.shape
-    msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(time_s)
-    msg.height, msg.width = height, width
-    msg.encoding = "rgb8"
-    msg.is_bigendian = 0
-    msg.step = 3 * width  # bytes per row
-    # An array('B') is taken as it is; a list or bytes would be checked byte by byte.
-    msg.data = array("B", pixels.tobytes())
+__all__ = ['DEFAULT_RATE', 'START_TIMEOUT', 'STOP_TIMEOUT', 'body_cameras', 'render_snapshot', 'RttCameraImagePublisher']
 
 # %% ../../notebooks/06_step6_camera.ipynb #299ffdac
 class RttCameraImagePublisher(SimpleController):
@@ -167,14 +120,16 @@ class RttCameraImagePublisher(SimpleController):
         width, height = self.model.cam_resolution[self.camera_id]
         self.width, self.height = int(width), int(height)
         if self.width * self.height <= 1:
-            config.log.error('camera %s: give it resolution="W H" in its model',
-                             self.camera_name)
+            config.log.error(
+                'camera %s: give it resolution="W H" in its model', self.camera_name
+            )
             return False
         self.topic = camera_image_topic(config.body_name)
         self.msg = Image()  # the render thread's alone once it runs
         self.msg.header.frame_id = self.camera_name
-        self.publisher = config.node.create_publisher(Image, self.topic,
-                                                      camera_image_qos())
+        self.publisher = config.node.create_publisher(
+            Image, self.topic, camera_image_qos()
+        )
         # Written by the render thread, read after it has ended (summary):
         self.rendered = self.published = 0
         self.render_seconds = 0.0
@@ -185,8 +140,9 @@ class RttCameraImagePublisher(SimpleController):
         self.finishing = False  # set by stop() or unconfigure(); ends the thread
         self.sim_span = self.wall_span = None
         self.ready = threading.Event()
-        self.thread = threading.Thread(target=self.render_loop, name="camera-render",
-                                       daemon=True)
+        self.thread = threading.Thread(
+            target=self.render_loop, name="camera-render", daemon=True
+        )
         self.thread.start()
         if not self.ready.wait(START_TIMEOUT):
             self.error = f"the render thread did not start in {START_TIMEOUT} s"
@@ -261,9 +217,11 @@ class RttCameraImagePublisher(SimpleController):
             self.loop = MainLoop()  # owned by this thread: runs what is handed over
         except Exception as exc:  # noqa: BLE001 - configure() reports it
             gl = os.environ.get("MUJOCO_GL", "unset")
-            self.error = (f"cannot render camera {self.camera_name} offscreen "
-                          f"(MUJOCO_GL={gl}; without a display, use egl): "
-                          f"{type(exc).__name__}: {exc}")
+            self.error = (
+                f"cannot render camera {self.camera_name} offscreen "
+                f"(MUJOCO_GL={gl}; without a display, use egl): "
+                f"{type(exc).__name__}: {exc}"
+            )
         self.ready.set()
         try:
             while self.error is None and not self.finishing:
@@ -280,8 +238,7 @@ class RttCameraImagePublisher(SimpleController):
             return
         try:
             started = time.perf_counter()
-            pixels = render_snapshot(self.renderer, self.data, snapshot,
-                                     self.camera_id)
+            pixels = render_snapshot(self.renderer, self.data, snapshot, self.camera_id)
             self.render_seconds += time.perf_counter() - started
             self.rendered += 1
             self.publish_image(pixels, snapshot.time)
@@ -304,10 +261,14 @@ class RttCameraImagePublisher(SimpleController):
     def summary(self) -> dict:
         """Counts and rates (main thread, after ``unconfigure``)."""
         loop = self.loop
-        record = {"topic": self.topic, "rate": self.rate,
-                  "handed_over": loop.posted if loop else 0,
-                  "skipped": loop.coalesced if loop else 0,
-                  "rendered": self.rendered, "published": self.published}
+        record = {
+            "topic": self.topic,
+            "rate": self.rate,
+            "handed_over": loop.posted if loop else 0,
+            "skipped": loop.coalesced if loop else 0,
+            "rendered": self.rendered,
+            "published": self.published,
+        }
         if self.rendered:
             mean = self.render_seconds / self.rendered
             record["render_ms"] = round(1000 * mean, 1)

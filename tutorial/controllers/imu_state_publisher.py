@@ -22,81 +22,26 @@ Topic ``/<body name>/imu`` (``/Tank/imu``), type ``sensor_msgs/Imu``:
   ``orientation_covariance[0] = -1`` says so (ROS's convention); the other
   covariances are 0, "unknown";
 * ``header.stamp``: the simulation time of the step that publishes, the end
-  of the period averaged; ``header.frame_id``: see :func:`imu_frame_id`.
+  of the period averaged; ``header.frame_id``: see
+  :func:`tutorial.interfaces.imu.imu_frame_id`.
 
 The first message, at t = 0, is that step's reading alone.  The tank starts
 1 mm above the floor, falling, and an accelerometer in free fall reads 0:
-the first message says so.  QoS: :func:`imu_qos`.
+the first message says so.  QoS: :func:`tutorial.interfaces.imu.imu_qos`.
 """
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
-from ..controller import ControllerConfig, ControllerIO, SimpleController
-from .joint_state_publisher import PeriodAccumulator, stamp_parts
+from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..interfaces.imu import find_imu, imu_qos, imu_topic
+from ..interfaces.timing import PeriodAccumulator, stamp_parts
 
-
-def find_imu(model: mujoco.MjModel, body_ids) -> tuple[slice, slice, int, str]:
-    """The body's accelerometer and gyro, found by type, as Choreonoid does.
-
-    Args:
-        model: the world's model.
-        body_ids: ids of the body's links (``Body.body_ids``).
-
-    Returns:
-        ``(accel, gyro, site, frame_id)``: the slices of ``sensordata``
-        holding the accelerometer (m/s^2) and the gyro (rad/s), 3 numbers
-        each; the id of the site they sit on; the frame they measure in.
-
-    Raises:
-        LookupError: the body has no accelerometer or no gyro on a site, or
-            the two sit on different sites (then they measure in different
-            frames, and one message cannot carry both).
-
-    Any thread may call it: it only reads the model.
-    """
-    kinds = mujoco.mjtSensor
-    accel, site = _sensor_on_site(model, body_ids, kinds.mjSENS_ACCELEROMETER)
-    gyro, gyro_site = _sensor_on_site(model, body_ids, kinds.mjSENS_GYRO)
-    if site != gyro_site:
-        raise LookupError("the accelerometer and the gyro sit on different sites")
-    return accel, gyro, site, imu_frame_id(model, site)
-
-
-def _sensor_on_site(model, body_ids, kind) -> tuple[slice, int]:
-    """The first sensor of type ``kind`` on a site of the body: its slice, its site."""
-    for s in range(model.nsensor):
-        site = int(model.sensor_objid[s])
-        if (model.sensor_type[s] == kind
-                and model.sensor_objtype[s] == mujoco.mjtObj.mjOBJ_SITE
-                and int(model.site_bodyid[site]) in body_ids):
-            adr = int(model.sensor_adr[s])
-            return slice(adr, adr + 3), site
-    kind_name = kind.name.removeprefix("mjSENS_").lower()  # "accelerometer", "gyro"
-    raise LookupError(f"the body has no {kind_name} on a site")
-
-
-def imu_frame_id(model: mujoco.MjModel, site: int) -> str:
-    """The frame the IMU measures in, as a message's ``header.frame_id``.
-
-    The link's name (``CHASSIS``) when the site has the link's origin and
-    axes (it has, in the tank), else the site's own name.  Named as in the
-    model, without the world's ``Tank/`` prefix: the topic ``/Tank/imu``
-    already says whose it is.
-    """
-    on_link_frame = (np.allclose(model.site_pos[site], 0)
-                     and np.allclose(model.site_quat[site], [1, 0, 0, 0]))
-    if on_link_frame:
-        link = int(model.site_bodyid[site])
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, link)
-    else:
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_SITE, site)
-    return name.split("/", 1)[-1]  # the world's name is "Tank/CHASSIS"
+DEFAULT_RATE = 20.0  # Hz of simulated time
 
 # %% auto #0
-__all__ = ['DEFAULT_RATE', 'find_imu', 'imu_frame_id', 'PeriodMean', 'imu_topic', 'imu_qos', 'RttImuStatePublisher']
+__all__ = ['DEFAULT_RATE', 'PeriodMean', 'RttImuStatePublisher']
 
 # %% ../../notebooks/04_step4_imu_publisher.ipynb #c0dd9010
 class PeriodMean:
@@ -130,43 +75,22 @@ class PeriodMean:
         self.count = 0
         return mean
 
-# %% ../../notebooks/04_step4_imu_publisher.ipynb #03d25da9
-DEFAULT_RATE = 20.0  # Hz of simulated time
-
-
-def imu_topic(body_name: str) -> str:
-    """``/<body name>/imu``, e.g. ``/Tank/imu``."""
-    return f"/{body_name}/imu"
-
-
-def imu_qos():
-    """The IMU's QoS: reliable, keep last 1, volatile.
-
-    * keep last 1: a display needs only the newest reading; no queue builds
-      up behind a slow subscriber;
-    * reliable: a collision shows in only one or two messages, and a viewer
-      that lost them would miss it.  A reliable publisher also serves
-      subscribers that ask for best effort (ROS's "sensor data" profile),
-      while a best-effort publisher would not serve reliable ones (what a
-      subscription created with a plain queue depth asks for);
-    * volatile: an old reading is no use to a subscriber that joins later.
-    """
-    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-
-    return QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                      reliability=ReliabilityPolicy.RELIABLE,
-                      durability=DurabilityPolicy.VOLATILE)
-
 # %% ../../notebooks/04_step4_imu_publisher.ipynb #7e6cf417
 class RttImuStatePublisher(SimpleController):
     """Step 4 controller: publishes ``/<body>/imu``, the mean of each ``1/rate`` s.
 
-    QoS: :func:`imu_qos`.  Refuses to configure on a body without an
-    accelerometer and a gyro on one site (:func:`find_imu`).
+    QoS: :func:`tutorial.interfaces.imu.imu_qos`.  Refuses to configure on a body
+    without an accelerometer and a gyro on one site
+    (:func:`tutorial.interfaces.imu.find_imu`).
     """
 
-    PARAMETERS = {"rate": (float, DEFAULT_RATE,
-                           "Imu publish rate, Hz of simulated time (0: every step)")}
+    PARAMETERS = {
+        "rate": (
+            float,
+            DEFAULT_RATE,
+            "Imu publish rate, Hz of simulated time (0: every step)",
+        )
+    }
 
     # ---- main thread ------------------------------------------------------
     def configure(self, config: ControllerConfig) -> bool:
@@ -231,8 +155,12 @@ class RttImuStatePublisher(SimpleController):
 
     # ---- main thread, after the run -----------------------------------------
     def summary(self) -> dict:
-        record = {"topic": self.topic, "rate": self.rate, "frame_id": self.frame_id,
-                  "published": self.published}
+        record = {
+            "topic": self.topic,
+            "rate": self.rate,
+            "frame_id": self.frame_id,
+            "published": self.published,
+        }
         if self.last is not None:
             a, w = self.last
             record["last_linear_acceleration"] = [round(float(v), 6) for v in a]

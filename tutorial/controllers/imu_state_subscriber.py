@@ -13,7 +13,8 @@ the main thread got to it is counted as ``superseded``.  (A hit in such a
 message would be missed; a real collision shows in a few messages in a
 row, each one a new hit.)
 
-On the main thread each message is checked first (:func:`check_imu`: NaN,
+On the main thread each message is checked first
+(:func:`tutorial.interfaces.imu.check_imu`: NaN,
 infinite and absurd values and another frame are rejected and counted),
 then drawn as two arrows from the IMU's origin, turned with the body
 (:func:`arrow_vectors`): the acceleration with gravity taken off, red, and
@@ -33,42 +34,10 @@ from collections import Counter
 import mujoco
 import numpy as np
 
-from ..controller import ControllerConfig, SimpleController
-from .imu_state_publisher import find_imu, imu_qos, imu_topic
+from ..core.controller import ControllerConfig, SimpleController
+from ..interfaces.imu import check_imu, find_imu, imu_qos, imu_topic
 
-# Beyond these a reading is absurd, not a collision: a mean of 1000 m/s^2 over
-# 50 ms is a change of speed of 50 m/s; 100 rad/s is 16 turns a second, three
-# times what common MEMS gyros measure.  They also catch a wrong unit: a tank
-# at rest in mm/s^2 reads 9807, a turn of 2 rad/s in deg/s reads 115.
-ACCEL_LIMIT = 1000.0  # m/s^2, norm
-GYRO_LIMIT = 100.0  # rad/s, norm
 HIT_ACCELERATION = 20.0  # m/s^2, horizontal (x, y) norm that counts as a collision
-
-
-def check_imu(msg, frame_id: str):
-    """Decide whether a received ``sensor_msgs/Imu`` may be shown (any thread).
-
-    Args:
-        msg: the message.
-        frame_id: the frame the viewer draws in; an empty ``frame_id`` is
-            taken to mean it too (the original tutorial left it empty).
-
-    Returns:
-        ``(acceleration (3,) m/s^2, angular_velocity (3,) rad/s, None)``, or
-        ``(None, None, reason)`` with reason ``not_finite``, ``absurd`` or
-        ``wrong_frame`` (vectors in another frame would be drawn wrongly).
-    """
-    a = msg.linear_acceleration
-    w = msg.angular_velocity
-    accel = np.array([a.x, a.y, a.z], dtype=float)
-    gyro = np.array([w.x, w.y, w.z], dtype=float)
-    if not (np.isfinite(accel).all() and np.isfinite(gyro).all()):
-        return None, None, "not_finite"
-    if np.linalg.norm(accel) > ACCEL_LIMIT or np.linalg.norm(gyro) > GYRO_LIMIT:
-        return None, None, "absurd"
-    if msg.header.frame_id not in ("", frame_id):
-        return None, None, "wrong_frame"
-    return accel, gyro, None
 
 
 def is_hit(accel) -> bool:
@@ -76,10 +45,10 @@ def is_hit(accel) -> bool:
     return math.hypot(accel[0], accel[1]) > HIT_ACCELERATION
 
 # %% auto #0
-__all__ = ['ACCEL_LIMIT', 'GYRO_LIMIT', 'HIT_ACCELERATION', 'GRAVITY_OFFSET', 'ACCEL_SCALE', 'GYRO_SCALE', 'ACCEL_MIN_LENGTH',
-           'GYRO_MIN_LENGTH', 'ACCEL_COLOR', 'GYRO_COLOR', 'SHAKE_AMPLITUDE', 'SHAKE_PERIOD', 'SHAKE_DURATION',
-           'SHAKE_SEED', 'STATUS_PERIOD', 'check_imu', 'is_hit', 'arrow_vectors', 'CollisionShake',
-           'root_position_address', 'RttImuStateSubscriber']
+__all__ = ['HIT_ACCELERATION', 'GRAVITY_OFFSET', 'ACCEL_SCALE', 'GYRO_SCALE', 'ACCEL_MIN_LENGTH', 'GYRO_MIN_LENGTH',
+           'ACCEL_COLOR', 'GYRO_COLOR', 'SHAKE_AMPLITUDE', 'SHAKE_PERIOD', 'SHAKE_DURATION', 'SHAKE_SEED',
+           'STATUS_PERIOD', 'is_hit', 'arrow_vectors', 'CollisionShake', 'root_position_address',
+           'RttImuStateSubscriber']
 
 # %% ../../notebooks/05_step5_imu_viewer.ipynb #e7921257
 GRAVITY_OFFSET = np.array([0.0, 0.0, -9.8])  # m/s^2, added to the acceleration shown
@@ -216,8 +185,12 @@ class RttImuStateSubscriber(SimpleController):
         self.rejected: Counter = Counter()
         self.last_report = (self.clock(), 0)
         self.subscription = config.node.create_subscription(
-            Imu, self.topic, self.on_imu, imu_qos(),
-            event_callbacks=SubscriptionEventCallbacks(matched=self.on_matched))
+            Imu,
+            self.topic,
+            self.on_imu,
+            imu_qos(),
+            event_callbacks=SubscriptionEventCallbacks(matched=self.on_matched),
+        )
         config.call_every(SHAKE_PERIOD, self.shake_tick)
         config.call_every(STATUS_PERIOD, self.report_status)
         return True
@@ -235,8 +208,14 @@ class RttImuStateSubscriber(SimpleController):
 
     # ---- main thread --------------------------------------------------------
     def report_publishers(self, count: int) -> None:
-        self.config.output({"event": "publishers", "node": self.node_name,
-                            "topic": self.topic, "count": count})
+        self.config.output(
+            {
+                "event": "publishers",
+                "node": self.node_name,
+                "topic": self.topic,
+                "count": count,
+            }
+        )
 
     def update_imu(self, msg, arrival: float) -> str | None:
         """Check one message and show it (via ``call_later``).
@@ -262,18 +241,25 @@ class RttImuStateSubscriber(SimpleController):
         origin = self.data.site_xpos[self.site]  # m, world frame
         to_world = self.data.site_xmat[self.site].reshape(3, 3)  # IMU axes -> world
         accel, gyro = arrow_vectors(self.accel, self.gyro)  # m, IMU axes
-        self.accel_arrow.set(origin, to_world @ accel,
-                             visible=np.linalg.norm(accel) >= ACCEL_MIN_LENGTH)
-        self.gyro_arrow.set(origin, to_world @ gyro,
-                            visible=np.linalg.norm(gyro) >= GYRO_MIN_LENGTH)
+        self.accel_arrow.set(
+            origin, to_world @ accel, visible=np.linalg.norm(accel) >= ACCEL_MIN_LENGTH
+        )
+        self.gyro_arrow.set(
+            origin, to_world @ gyro, visible=np.linalg.norm(gyro) >= GYRO_MIN_LENGTH
+        )
 
     def start_shake(self, accel) -> None:
         """A collision: start a shake, or restart its 0.5 s."""
         if not self.shake.shaking:
-            self.config.output({
-                "event": "shake", "node": self.node_name, "body": self.body.name,
-                "horizontal_acceleration": round(math.hypot(accel[0], accel[1]), 3)})
-        position = self.data.qpos[self.root:self.root + 3]  # m, the root link's
+            self.config.output(
+                {
+                    "event": "shake",
+                    "node": self.node_name,
+                    "body": self.body.name,
+                    "horizontal_acceleration": round(math.hypot(accel[0], accel[1]), 3),
+                }
+            )
+        position = self.data.qpos[self.root : self.root + 3]  # m, the root link's
         self.shake.hit(self.clock(), position)
 
     def shake_tick(self) -> None:
@@ -281,12 +267,18 @@ class RttImuStateSubscriber(SimpleController):
         position = self.shake.tick(self.clock())
         if position is None:
             return
-        self.data.qpos[self.root:self.root + 3] = position
+        self.data.qpos[self.root : self.root + 3] = position
         self.body.notify_kinematic_state_change()
         self.draw_arrows()  # they start at the IMU, which moved
         if not self.shake.shaking:
-            self.config.output({"event": "shake_end", "node": self.node_name,
-                                "body": self.body.name, "position": position.tolist()})
+            self.config.output(
+                {
+                    "event": "shake_end",
+                    "node": self.node_name,
+                    "body": self.body.name,
+                    "position": position.tolist(),
+                }
+            )
 
     def report_status(self) -> None:
         """Once a second: an ``imu_status`` record."""
@@ -296,14 +288,19 @@ class RttImuStateSubscriber(SimpleController):
         then, received_then = self.last_report
         self.last_report = (now, received)
         age = None if self.arrival is None else round((now - self.arrival) * 1e3, 1)
-        self.config.output({
-            "event": "imu_status", "node": self.node_name,
-            "rate_hz": round((received - received_then) / max(now - then, 1e-9), 1),
-            "age_ms": age, **self.summary()})
+        self.config.output(
+            {
+                "event": "imu_status",
+                "node": self.node_name,
+                "rate_hz": round((received - received_then) / max(now - then, 1e-9), 1),
+                "age_ms": age,
+                **self.summary(),
+            }
+        )
 
     def unconfigure(self) -> None:
         if self.shake.shaking:  # leave the model where it was, not mid-shake
-            self.data.qpos[self.root:self.root + 3] = self.shake.home
+            self.data.qpos[self.root : self.root + 3] = self.shake.home
             self.body.notify_kinematic_state_change()
         self.node.destroy_subscription(self.subscription)
 
@@ -312,14 +309,19 @@ class RttImuStateSubscriber(SimpleController):
             received = self.received
         handled = self.accepted + sum(self.rejected.values())
         return {
-            "topic": self.topic, "received": received, "accepted": self.accepted,
+            "topic": self.topic,
+            "received": received,
+            "accepted": self.accepted,
             # replaced by a newer message before the main thread got to them
             # (call_later coalesces); in a status line, one may still be pending
             "superseded": received - handled,
             "rejected": dict(sorted(self.rejected.items())),
-            "arrows": {"acceleration": self.accel_arrow.record(),
-                       "angular_velocity": self.gyro_arrow.record()},
-            "shakes": self.shake.episodes, "hits": self.shake.hits,
+            "arrows": {
+                "acceleration": self.accel_arrow.record(),
+                "angular_velocity": self.gyro_arrow.record(),
+            },
+            "shakes": self.shake.episodes,
+            "hits": self.shake.hits,
             "shaking": self.shake.shaking,
             "max_shake_offset": round(self.shake.max_offset, 6),
         }

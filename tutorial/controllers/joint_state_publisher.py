@@ -14,85 +14,31 @@ from __future__ import annotations
 
 from array import array
 
-from ..controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..interfaces.joint_state import joint_state_qos, joint_state_topic
+from ..interfaces.timing import PeriodAccumulator, stamp_parts
 
 DEFAULT_RATE = 50.0  # Hz of simulated time
 
-
-def joint_state_topic(body_name: str) -> str:
-    """``/<body name>/joint_state``: named after the body, so any model works."""
-    return f"/{body_name}/joint_state"
-
-
-def joint_state_qos():
-    """The joint state's QoS: reliable, keep last 1, transient local.
-
-    * keep last 1: a viewer needs only the newest state; an older one is
-      already out of date, so no queue builds up behind a slow subscriber;
-    * reliable: a state that is sent should arrive, the last one before
-      the simulation stops above all;
-    * transient local: the publisher keeps its newest state for subscribers
-      that join later, so a viewer started while the simulation is paused
-      (or publishing slowly) still gets it.  A volatile subscriber matches
-      it too, so every ordinary subscriber works unchanged.
-    """
-    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-
-    return QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                      reliability=ReliabilityPolicy.RELIABLE,
-                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-
-def stamp_parts(t: float) -> tuple[int, int]:
-    """Simulation time ``t`` (s, >= 0) as a ROS time ``(sec, nanosec)``.
-
-    Rounded to the nanosecond first, so 0.9999999999 s is (1, 0), never
-    (0, 1_000_000_000).  Any thread may call it.
-    """
-    return divmod(round(t * 1e9), 1_000_000_000)
-
 # %% auto #0
-__all__ = ['DEFAULT_RATE', 'joint_state_topic', 'joint_state_qos', 'stamp_parts', 'PeriodAccumulator', 'RttJointStatePublisher']
-
-# %% ../../notebooks/02_step2_joint_state_publisher.ipynb #a0662551
-class PeriodAccumulator:
-    """Decides, step by step, when a periodic output is due.
-
-    Args:
-        time_step: the simulation step, s.
-        rate: outputs per simulated second, Hz; a rate of one per step or
-            more (or 0) means every step.
-
-    ``tick()`` is called once per step and returns True when an output is
-    due; the first step is always due.  It counts integer nanoseconds, so
-    it is exact for any step and rate that are whole numbers of
-    nanoseconds: 0.001 s added twenty times is not exactly 0.02 s in
-    floating point, but 1_000_000 ns is.  Used by one thread only.
-    """
-
-    def __init__(self, time_step: float, rate: float):
-        self.step_ns = max(1, round(time_step * 1e9))
-        rate_ns = self.step_ns if rate <= 0 else round(1e9 / rate)
-        self.period_ns = max(self.step_ns, rate_ns)
-        self.elapsed_ns = self.period_ns  # due at once
-
-    def tick(self) -> bool:
-        due = self.elapsed_ns >= self.period_ns
-        if due:
-            self.elapsed_ns -= self.period_ns  # carry the remainder over
-        self.elapsed_ns += self.step_ns
-        return due
+__all__ = ['DEFAULT_RATE', 'RttJointStatePublisher']
 
 # %% ../../notebooks/02_step2_joint_state_publisher.ipynb #821d11a1
 class RttJointStatePublisher(SimpleController):
     """Step 2 controller: publishes ``/<body>/joint_state`` at ``rate`` Hz (simulated).
 
-    QoS: :func:`joint_state_qos`.  When the simulation stops it publishes
-    the final state once more, so subscribers see where the body stopped.
+    QoS: :func:`tutorial.interfaces.joint_state.joint_state_qos`.  When the
+    simulation stops it publishes the final state once more, so subscribers
+    see where the body stopped.
     """
 
-    PARAMETERS = {"rate": (float, DEFAULT_RATE,
-                           "publish rate, Hz of simulated time (0: every step)")}
+    PARAMETERS = {
+        "rate": (
+            float,
+            DEFAULT_RATE,
+            "publish rate, Hz of simulated time (0: every step)",
+        )
+    }
 
     # ---- main thread ------------------------------------------------------
     def configure(self, config: ControllerConfig) -> bool:
@@ -105,8 +51,9 @@ class RttJointStatePublisher(SimpleController):
             return False
         self.topic = joint_state_topic(config.body_name)
         self.msg_type = JointState
-        self.publisher = config.node.create_publisher(JointState, self.topic,
-                                                      joint_state_qos())
+        self.publisher = config.node.create_publisher(
+            JointState, self.topic, joint_state_qos()
+        )
         self.published = 0
         return True
 
@@ -132,8 +79,11 @@ class RttJointStatePublisher(SimpleController):
         self.msg.effort = array("d", bytes(8 * n))
         # Where each joint's numbers are in MjData, read through memoryviews
         # (plain floats, cheaper than indexing NumPy arrays every time).
-        self.sources = (memoryview(io.data.qpos), memoryview(io.data.qvel),
-                        memoryview(io.data.qfrc_actuator))
+        self.sources = (
+            memoryview(io.data.qpos),
+            memoryview(io.data.qvel),
+            memoryview(io.data.qfrc_actuator),
+        )
         self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(joints)]
         return True
 

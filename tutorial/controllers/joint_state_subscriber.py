@@ -15,25 +15,14 @@ from __future__ import annotations
 
 from collections import Counter
 
-from ..controller import ControllerConfig, SimpleController
-from .joint_state_publisher import (joint_state_qos,
-                                                        joint_state_topic)
-from ..joint_matching import match_joint_state
-from ..viewer_status import STALE_CHECK_PERIOD, ViewerStatus
-
-
-def viewer_qos():
-    """What the viewer asks of a publisher: reliable, keep last 1, volatile.
-
-    Volatile asks the least, so every publisher matches: ours (transient
-    local) and ordinary volatile ones, as most robots and
-    ``joint_state_publisher`` use.
-    """
-    from rclpy.qos import DurabilityPolicy
-
-    qos = joint_state_qos()
-    qos.durability = DurabilityPolicy.VOLATILE
-    return qos
+from ..core.controller import ControllerConfig, SimpleController
+from tutorial.interfaces.joint_state import (
+    joint_state_qos,
+    joint_state_topic,
+    joint_state_viewer_qos,
+    match_joint_state,
+)
+from ..view.status import STALE_CHECK_PERIOD, ViewerStatus
 
 
 class RttJointStateSubscriber(SimpleController):
@@ -42,7 +31,7 @@ class RttJointStateSubscriber(SimpleController):
     It runs in a project without a simulator, so all its work hangs off
     ``configure``: the subscription's callback (spin thread) posts each
     message to the main thread, whose model the viewer draws.  Received
-    data is never trusted: :func:`tutorial.joint_matching.match_joint_state`
+    data is never trusted: :func:`tutorial.interfaces.joint_state.match_joint_state`
     decides what to apply, and rejections are counted.
     """
 
@@ -56,8 +45,12 @@ class RttJointStateSubscriber(SimpleController):
         self.applied = 0
         self.rejected: Counter = Counter()
         self.subscription = config.node.create_subscription(
-            JointState, self.topic, self.on_joint_state, viewer_qos(),
-            event_callbacks=self.subscription_events())
+            JointState,
+            self.topic,
+            self.on_joint_state,
+            joint_state_viewer_qos(),
+            event_callbacks=self.subscription_events(),
+        )
         return True
 
     def subscription_events(self):
@@ -94,13 +87,17 @@ class RttJointStateSubscriber(SimpleController):
         return report
 
     def summary(self) -> dict:
-        return {"topic": self.topic, "applied": self.applied,
-                "rejected": dict(sorted(self.rejected.items())),
-                "last_positions": {k: round(v, 9)
-                                   for k, v in self.body.joint_positions().items()}}
+        return {
+            "topic": self.topic,
+            "applied": self.applied,
+            "rejected": dict(sorted(self.rejected.items())),
+            "last_positions": {
+                k: round(v, 9) for k, v in self.body.joint_positions().items()
+            },
+        }
 
 # %% auto #0
-__all__ = ['viewer_qos', 'RttJointStateSubscriber', 'RttJointStateMonitor']
+__all__ = ['RttJointStateSubscriber', 'RttJointStateMonitor']
 
 # %% ../../notebooks/03_step3_viewer.ipynb #235619e8
 class RttJointStateMonitor(RttJointStateSubscriber):
@@ -110,7 +107,7 @@ class RttJointStateMonitor(RttJointStateSubscriber):
 
     * a status line once a second (rate, age of the newest state, joints
       matched, rejections), ``stale`` within 1.25 s of silence and
-      ``live`` again when states resume (:class:`tutorial.viewer_status.ViewerStatus`);
+      ``live`` again when states resume (:class:`tutorial.view.status.ViewerStatus`);
     * how many publishers it is matched with (the subscription's "matched"
       event), with a warning at two or more: it cannot tell which robot
       it is showing;
@@ -136,7 +133,8 @@ class RttJointStateMonitor(RttJointStateSubscriber):
         # Transient local: matches transient-local publishers only, which hand it
         # the newest state they kept.  Live states come through the first one.
         self.late_subscription = config.node.create_subscription(
-            JointState, self.topic, self.on_late_state, joint_state_qos())
+            JointState, self.topic, self.on_late_state, joint_state_qos()
+        )
         config.call_every(self.STATUS_PERIOD, self.report_status)
         config.call_every(STALE_CHECK_PERIOD, self.check_stale)
         return True
@@ -167,19 +165,27 @@ class RttJointStateMonitor(RttJointStateSubscriber):
         stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
         if self.last_stamp is not None and stamp < self.last_stamp:
             self.status.stamps_back += 1
-            self.say("stamps_back", f"{self.topic}: stamps went back from "
-                     f"{self.last_stamp:.3f} s to {stamp:.3f} s (a new run?): "
-                     "showing it")
+            self.say(
+                "stamps_back",
+                f"{self.topic}: stamps went back from "
+                f"{self.last_stamp:.3f} s to {stamp:.3f} s (a new run?): "
+                "showing it",
+            )
         self.last_stamp = stamp
         first = self.status.applied == 0
         report = super().update_joint_state(msg)
-        self.status.applied_message(arrival, report.matched, report.counts(),
-                                    report.applied)
+        self.status.applied_message(
+            arrival, report.matched, report.counts(), report.applied
+        )
         if first:
             self.drop_late_subscription()  # live states flow: no more need for it
-            self.say("first_state", f"first joint state on {self.topic}: "
-                     f"{report.matched}/{self.body.num_joints} joints matched",
-                     matched=report.matched, joints=self.body.num_joints)
+            self.say(
+                "first_state",
+                f"first joint state on {self.topic}: "
+                f"{report.matched}/{self.body.num_joints} joints matched",
+                matched=report.matched,
+                joints=self.body.num_joints,
+            )
         return report
 
     def show_late_state(self, msg) -> None:
@@ -188,8 +194,11 @@ class RttJointStateMonitor(RttJointStateSubscriber):
             self.apply(msg)
             self.late_states += 1
             stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-            self.say("late_state", f"{self.topic}: showing the newest state published "
-                     f"before this viewer started (t = {stamp:.3f} s)")
+            self.say(
+                "late_state",
+                f"{self.topic}: showing the newest state published "
+                f"before this viewer started (t = {stamp:.3f} s)",
+            )
         self.drop_late_subscription()
 
     def drop_late_subscription(self) -> None:
@@ -198,11 +207,20 @@ class RttJointStateMonitor(RttJointStateSubscriber):
             self.late_subscription = None
 
     def report_publishers(self, count: int) -> None:
-        self.config.output({"event": "publishers", "node": self.node_name,
-                            "topic": self.topic, "count": count})
+        self.config.output(
+            {
+                "event": "publishers",
+                "node": self.node_name,
+                "topic": self.topic,
+                "count": count,
+            }
+        )
         if count > 1:
-            self.say("warning", f"{count} publishers on {self.topic}: the view mixes "
-                     "their states and cannot tell which robot it is showing")
+            self.say(
+                "warning",
+                f"{count} publishers on {self.topic}: the view mixes "
+                "their states and cannot tell which robot it is showing",
+            )
 
     def report_status(self) -> None:
         for record in self.status.report():
@@ -214,10 +232,21 @@ class RttJointStateMonitor(RttJointStateSubscriber):
 
     def say(self, event: str, text: str, **fields) -> None:
         """Output one status record with its line of text (main thread)."""
-        self.config.output({"event": event, "node": self.node_name, "topic": self.topic,
-                            "message": text, "line": f"[{self.node_name}] {text}",
-                            **fields})
+        self.config.output(
+            {
+                "event": event,
+                "node": self.node_name,
+                "topic": self.topic,
+                "message": text,
+                "line": f"[{self.node_name}] {text}",
+                **fields,
+            }
+        )
 
     def summary(self) -> dict:
-        return {**super().summary(), "received": self.status.received_count(),
-                "late_states": self.late_states, "stamps_back": self.status.stamps_back}
+        return {
+            **super().summary(),
+            "received": self.status.received_count(),
+            "late_states": self.late_states,
+            "stamps_back": self.status.stamps_back,
+        }

@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import threading
 
-from .. import joy
-from ..controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..interfaces import joy
 
-JOY_TOPIC = "/joy"
 TRACK_DEAD_ZONE = 0.2  # stick units
 TURRET_DEAD_ZONE = 0.15  # stick units
 TRACK_SPEED_GAIN = 2.0  # m/s of track surface per unit of forward stick
@@ -75,16 +74,17 @@ def pd_torque(q_ref: float, q: float, dq_ref: float, dq: float) -> float:
     return TURRET_P_GAIN * (q_ref - q) + TURRET_D_GAIN * (dq_ref - dq)
 
 # %% auto #0
-__all__ = ['JOY_TOPIC', 'TRACK_DEAD_ZONE', 'TURRET_DEAD_ZONE', 'TRACK_SPEED_GAIN', 'TURN_SPEED_GAIN', 'TURRET_P_GAIN',
-           'TURRET_D_GAIN', 'TURRET_RATE', 'TURRET_JOINTS', 'TRACKS', 'DEFAULT_JOY_TIMEOUT', 'track_velocities',
-           'turret_rates', 'pd_torque', 'RttTankController']
+__all__ = ['TRACK_DEAD_ZONE', 'TURRET_DEAD_ZONE', 'TRACK_SPEED_GAIN', 'TURN_SPEED_GAIN', 'TURRET_P_GAIN', 'TURRET_D_GAIN',
+           'TURRET_RATE', 'TURRET_JOINTS', 'TRACKS', 'DEFAULT_JOY_TIMEOUT', 'track_velocities', 'turret_rates',
+           'pd_torque', 'RttTankController']
 
 # %% ../../notebooks/01_step1_tank_controller.ipynb #2b6dbb93
 class RttTankController(SimpleController):
     """Step 1 controller: tracks by the left stick, turret by the right stick.
 
-    Topic: subscribes ``/joy`` (``sensor_msgs/Joy``), QoS reliable, keep
-    last 1: a controller needs only the newest stick state.
+    Topic: subscribes ``/joy`` (``sensor_msgs/Joy``), QoS
+    :func:`tutorial.interfaces.joy.joy_subscriber_qos`: reliable, keep last 1,
+    a controller needs only the newest stick state.
 
     Parameter ``joy_timeout`` (s, default 0.5, 0 disables): once no Joy has
     arrived for that long, the tracks stop and the turret holds its angle
@@ -93,8 +93,13 @@ class RttTankController(SimpleController):
     it.  It counts simulated time, the controller's own clock.
     """
 
-    PARAMETERS = {"joy_timeout": (float, DEFAULT_JOY_TIMEOUT,
-                                  "s without a Joy before the tank stops (0: never)")}
+    PARAMETERS = {
+        "joy_timeout": (
+            float,
+            DEFAULT_JOY_TIMEOUT,
+            "s without a Joy before the tank stops (0: never)",
+        )
+    }
 
     def __init__(self):
         self._lock = threading.Lock()
@@ -109,7 +114,6 @@ class RttTankController(SimpleController):
 
     # ---- main thread ------------------------------------------------------
     def configure(self, config: ControllerConfig) -> bool:
-        from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
         from sensor_msgs.msg import Joy
 
         self.config = config
@@ -117,10 +121,9 @@ class RttTankController(SimpleController):
         if self.joy_timeout < 0:
             config.log.error("joy_timeout must be >= 0 s, got %s", self.joy_timeout)
             return False
-        qos = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST,
-                         reliability=ReliabilityPolicy.RELIABLE)
         self.subscription = config.node.create_subscription(
-            Joy, JOY_TOPIC, self.on_joy, qos)
+            Joy, joy.TOPIC, self.on_joy, joy.joy_subscriber_qos()
+        )
         return True
 
     def unconfigure(self) -> None:
@@ -134,7 +137,7 @@ class RttTankController(SimpleController):
 
         Copies out of the message first, then swaps the copy in under the
         lock.  A malformed message (too few axes or buttons, NaN) is counted;
-        what it has is still used, read safely by :func:`tutorial.joy.axis`.
+        what it has is still used, read safely by :func:`tutorial.interfaces.joy.axis`.
         """
         axes, buttons = tuple(msg.axes), tuple(msg.buttons)
         well_formed = joy.is_well_formed(axes, buttons)
@@ -177,8 +180,11 @@ class RttTankController(SimpleController):
                 self.stopped = True
                 self.timeouts += 1
                 self.command(0.0, 0.0, (0.0, 0.0))  # the turret holds its reference
-                self.report("joy_timeout", f"no /joy for {self.joy_timeout:.2f} s: "
-                                           "tracks stopped, turret held")
+                self.report(
+                    "joy_timeout",
+                    f"no /joy for {self.joy_timeout:.2f} s: "
+                    "tracks stopped, turret held",
+                )
         self.control_turret()
         return True
 
@@ -208,13 +214,21 @@ class RttTankController(SimpleController):
             return  # not configured (a unit test): nobody to tell
         x, y, z = (round(float(v), 4) for v in self.io.body.root_pose()[0])
         node = self.config.node.get_fully_qualified_name()
-        record = {"event": event, "node": node, "t": round(self.io.current_time, 3),
-                  "root_position": [x, y, z], "line": f"[{node}] {text}"}
+        record = {
+            "event": event,
+            "node": node,
+            "t": round(self.io.current_time, 3),
+            "root_position": [x, y, z],
+            "line": f"[{node}] {text}",
+        }
         # A key of its own: two reports close together must not coalesce into one.
         self.config.call_later(self.config.output, record, key=object())
 
     def summary(self) -> dict:
         with self._lock:
             received, malformed = self._received, self._malformed
-        return {"joy_received": received, "joy_malformed": malformed,
-                "joy_timeouts": getattr(self, "timeouts", 0)}
+        return {
+            "joy_received": received,
+            "joy_malformed": malformed,
+            "joy_timeouts": getattr(self, "timeouts", 0),
+        }

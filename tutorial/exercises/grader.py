@@ -22,8 +22,8 @@ a check that simulates runs the simulation on the calling thread.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Callable, Iterable, Sequence
 
 PASS, FAIL = "\u2713", "\u2717"
 
@@ -94,9 +94,13 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
             return Result(exercise, False, what + (f" Hint: {hint}" if hint else ""), case.call)
         except Exception as exc:  # noqa: BLE001 - the learner's bug, reported with its input
             if not_done(exc):
-                return Result(exercise, False, f"not done yet: {case.call} raised NotImplementedError. "
-                                               "Write your code in place of the `raise NotImplementedError` line.",
-                              case.call)
+                return Result(
+                    exercise,
+                    False,
+                    f"not done yet: {case.call} raised NotImplementedError. "
+                    "Write your code in place of the `raise NotImplementedError` line.",
+                    case.call,
+                )
             hint = f" Hint: {case.hint}" if case.hint else ""
             return Result(exercise, False, f"{case.call} raised {type(exc).__name__}: {exc}.{hint}", case.call)
     if count == 0:
@@ -116,8 +120,12 @@ def not_done(exc: BaseException | None) -> bool:
 def same_numbers(got, expected, tol: float = 1e-9) -> bool:
     """True when ``got`` is a number or a sequence of numbers equal to ``expected`` within ``tol``."""
     if isinstance(expected, (int, float)):
-        return isinstance(got, (int, float)) and not isinstance(got, bool) and math.isfinite(got) \
+        return (
+            isinstance(got, (int, float))
+            and not isinstance(got, bool)
+            and math.isfinite(got)
             and abs(got - expected) <= tol
+        )
     try:
         got = list(got)
     except TypeError:

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from tutorial import joy
 from tutorial.exercises.grader import Case, CaseFailed, Result, expect_numbers, grade, show
+from tutorial.interfaces import joy
 
 DPAD_SPEED = 1.0  # m/s of both tracks for D-pad up
 DPAD_TURN = 0.5  # m/s of each track, opposite ways, for D-pad left or right
@@ -34,15 +34,31 @@ def check_dpad_steering(func) -> Result:
         ("released", _axes(), (0.0, 0.0), "nothing pressed: both tracks stand still."),
         ("up", _axes(dv=1.0), (DPAD_SPEED, DPAD_SPEED), "axis 5 (D-pad vertical) is +1 for up: both forward."),
         ("down", _axes(dv=-1.0), (-DPAD_SPEED, -DPAD_SPEED), "down is axis 5 = -1: both backward."),
-        ("left", _axes(dh=1.0), (-DPAD_TURN, DPAD_TURN),
-         "axis 4 (D-pad horizontal) is +1 for left, as the sticks: turning left, the left track runs backward."),
+        (
+            "left",
+            _axes(dh=1.0),
+            (-DPAD_TURN, DPAD_TURN),
+            "axis 4 (D-pad horizontal) is +1 for left, as the sticks: turning left, the left track runs backward.",
+        ),
         ("right", _axes(dh=-1.0), (DPAD_TURN, -DPAD_TURN), "right is axis 4 = -1: the right track runs backward."),
-        ("up and left", _axes(dh=1.0, dv=1.0), (DPAD_SPEED - DPAD_TURN, DPAD_SPEED + DPAD_TURN),
-         "a diagonal is the sum of its two directions."),
-        ("a Joy with only 4 axes", [0.0, 0.0, 0.0, 0.0], (0.0, 0.0),
-         "a message without axes 4 and 5 must not raise: read axes with joy.axis(axes, index)."),
-        ("NaN on the vertical axis", _axes(dv=float("nan")), (0.0, 0.0),
-         "a non-finite value counts as 0: joy.axis() does that for you."),
+        (
+            "up and left",
+            _axes(dh=1.0, dv=1.0),
+            (DPAD_SPEED - DPAD_TURN, DPAD_SPEED + DPAD_TURN),
+            "a diagonal is the sum of its two directions.",
+        ),
+        (
+            "a Joy with only 4 axes",
+            [0.0, 0.0, 0.0, 0.0],
+            (0.0, 0.0),
+            "a message without axes 4 and 5 must not raise: read axes with joy.axis(axes, index).",
+        ),
+        (
+            "NaN on the vertical axis",
+            _axes(dv=float("nan")),
+            (0.0, 0.0),
+            "a non-finite value counts as 0: joy.axis() does that for you.",
+        ),
         ("left stick up, D-pad released", _axes(lv=1.0), (0.0, 0.0), "only axes 4 and 5 count here."),
     ]
 
@@ -83,12 +99,20 @@ def check_shot_counter(cls) -> Result:
     stores the sticks, as ``RttTankController``'s does).
     """
     sequences = [
-        ("A held for 10 repeats, then released", [A] * 10 + [NONE] * 3, 1,
-         "a press is a change from released to pressed: remember whether A was down in the last Joy."),
+        (
+            "A held for 10 repeats, then released",
+            [A] * 10 + [NONE] * 3,
+            1,
+            "a press is a change from released to pressed: remember whether A was down in the last Joy.",
+        ),
         ("press, release, press", [A, NONE, A], 2, "each 0 -> 1 change of A is a shot."),
         ("the first Joy already has A pressed", [A], 1, "before any Joy, A counts as released."),
-        ("a Joy with no buttons between two presses", [A, [], A], 2,
-         "a Joy with too few buttons reads A as released (and must not raise)."),
+        (
+            "a Joy with no buttons between two presses",
+            [A, [], A],
+            2,
+            "a Joy with too few buttons reads A as released (and must not raise).",
+        ),
         ("only B pressed", [B, B, NONE, B], 0, "A is button 0 (joy.BUTTON_A); B is button 1."),
     ]
 
@@ -102,6 +126,7 @@ def check_shot_counter(cls) -> Result:
             shots = controller.summary().get("shots")
             if shots != expected:
                 raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.", hint)
+
         return Case(call, run, hint)
 
     def still_drives():
@@ -110,9 +135,11 @@ def check_shot_counter(cls) -> Result:
         controller.on_joy(_joy(A, stick))
         count_, axes, _ = controller.take_input()
         if list(axes) != stick or count_ != 1 or controller.summary().get("joy_received") != 1:
-            raise CaseFailed(f"after on_joy(axes={show(stick)}), take_input() gave ({count_}, {show(list(axes))}, ...) "
-                             f"and summary() {controller.summary()}: the sticks are no longer stored.",
-                             "call super().on_joy(msg) first, so the controller still drives.")
+            raise CaseFailed(
+                f"after on_joy(axes={show(stick)}), take_input() gave ({count_}, {show(list(axes))}, ...) "
+                f"and summary() {controller.summary()}: the sticks are no longer stored.",
+                "call super().on_joy(msg) first, so the controller still drives.",
+            )
 
     cases = [count(*row) for row in sequences]
     cases.append(Case(f"{cls.__name__}: on_joy(a Joy with the left stick up)", still_drives))

@@ -26,7 +26,7 @@ class _Probe:
     """A controller that keeps the simulation's state at every step, by step number (simulation thread)."""
 
     def __init__(self):
-        from tutorial.controller import SimpleController
+        from tutorial.core.controller import SimpleController
 
         class Probe(SimpleController):
             def initialize(probe, io):
@@ -50,21 +50,28 @@ def _drive(name: str, cls, parameters: dict):
     """Run the scripted drive with ``cls`` attached as ``name``; ``(capturing node, probe, app)``.
 
     Raises:
-        tutorial.app.ControllerError: the learner's controller refused to configure (or raised there).
+        tutorial.core.app.ControllerError: the learner's controller refused to configure (or raised there).
     """
     import rclpy
 
     from tutorial.controllers.tank_controller import RttTankController
+    from tutorial.joystick.scripted import ScriptedJoy
     from tutorial.notebook.runs import load, run_headless
-    from tutorial.scripted_input import ScriptedJoy
 
     project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
     node = CapturingNode(rclpy.create_node("exercise_check"))
     probe = _Probe()
     tank = RttTankController()
-    summary, app = run_headless(project, DURATION, node=node, attach=[
-        ("Tank", "ScriptedJoy", ScriptedJoy(tank)), ("Tank", "RttTankController", tank),
-        ("Tank", "Probe", probe.controller)])
+    summary, app = run_headless(
+        project,
+        DURATION,
+        node=node,
+        attach=[
+            ("Tank", "ScriptedJoy", ScriptedJoy(tank)),
+            ("Tank", "RttTankController", tank),
+            ("Tank", "Probe", probe.controller),
+        ],
+    )
     if summary.get("error"):
         if "NotImplementedError" in summary["error"]:
             raise NotImplementedError
@@ -84,16 +91,19 @@ def check_selected_joints(cls) -> Result:
     order, with the right values; an empty string means every joint; a name
     the body does not have makes ``configure`` refuse.
     """
-    from tutorial.app import ControllerError
-    from tutorial.controllers.joint_state_publisher import joint_state_topic
+    from tutorial.core.app import ControllerError
+    from tutorial.interfaces.joint_state import joint_state_topic
 
     def published(joints: str, rate: float):
         node, probe, app = _drive("Selected", cls, {"joints": joints, "rate": rate})
         pubs = node.published(joint_state_topic("Tank"))
         if len(pubs) != 1:
-            raise CaseFailed(f"with joints={joints!r} the controller made {len(pubs)} publishers of "
-                             f"{joint_state_topic('Tank')}, expected 1.", "let RttJointStatePublisher.configure "
-                             "create it: call super().configure(config) and check what it returns.")
+            raise CaseFailed(
+                f"with joints={joints!r} the controller made {len(pubs)} publishers of "
+                f"{joint_state_topic('Tank')}, expected 1.",
+                "let RttJointStatePublisher.configure "
+                "create it: call super().configure(config) and check what it returns.",
+            )
         return pubs[0].messages(), probe, app
 
     def selects(joints: str, expected: list[str], rate: float = 50.0, hint: str = ""):
@@ -104,8 +114,10 @@ def check_selected_joints(cls) -> Result:
             body = app.bodies["Tank"]
             want = round(rate * DURATION)
             if len(messages) < want:
-                raise CaseFailed(f"{call} published {len(messages)} messages in {DURATION} s, expected at "
-                                 f"least {want}.", "keep publishing through RttJointStatePublisher.control().")
+                raise CaseFailed(
+                    f"{call} published {len(messages)} messages in {DURATION} s, expected at least {want}.",
+                    "keep publishing through RttJointStatePublisher.control().",
+                )
             for msg in messages[:want]:
                 names = list(msg.name)
                 if names != expected:
@@ -116,14 +128,19 @@ def check_selected_joints(cls) -> Result:
                 for name, q in zip(names, msg.position):
                     true = float(state[0][body.joint(name).info.qpos_adr])
                     if abs(q - true) > 1e-9:
-                        raise CaseFailed(f"{call}: at t = {_stamp(msg):.3f} s {name} was published as "
-                                         f"{q:.6f} rad, but the simulation had {true:.6f} rad.",
-                                         "each joint's position must come from its own qpos address, in the "
-                                         "order of the names you publish.")
+                        raise CaseFailed(
+                            f"{call}: at t = {_stamp(msg):.3f} s {name} was published as "
+                            f"{q:.6f} rad, but the simulation had {true:.6f} rad.",
+                            "each joint's position must come from its own qpos address, in the "
+                            "order of the names you publish.",
+                        )
                 if not (len(msg.position) == len(msg.velocity) == len(msg.effort) == len(names)):
-                    raise CaseFailed(f"{call}: name, position, velocity and effort have lengths "
-                                     f"{len(names)}, {len(msg.position)}, {len(msg.velocity)}, {len(msg.effort)}.",
-                                     "a JointState's arrays must all be as long as its name list.")
+                    raise CaseFailed(
+                        f"{call}: name, position, velocity and effort have lengths "
+                        f"{len(names)}, {len(msg.position)}, {len(msg.velocity)}, {len(msg.effort)}.",
+                        "a JointState's arrays must all be as long as its name list.",
+                    )
+
         return Case(call, run, hint)
 
     def refuses(joints: str):
@@ -136,21 +153,30 @@ def check_selected_joints(cls) -> Result:
                 if not_done(exc):
                     raise
                 return
-            raise CaseFailed(f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.",
-                             "configure() should return False when a name is not in config.body.joint_names "
-                             "(and log why with config.log.error).")
+            raise CaseFailed(
+                f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.",
+                "configure() should return False when a name is not in config.body.joint_names "
+                "(and log why with config.log.error).",
+            )
+
         return Case(call, run)
 
-    return grade("Exercise 2.1, publish chosen joints", [
-        selects("TURRET_P,TURRET_Y", ["TURRET_P", "TURRET_Y"],
-                hint="publish the joints in the order the parameter names them."),
-        selects("TURRET_Y", ["TURRET_Y"], hint="only the named joints: one name, one entry."),
-        selects(" TURRET_P , TURRET_Y ", ["TURRET_P", "TURRET_Y"], hint="spaces around a name are ignored."),
-        selects("", ["TURRET_Y", "TURRET_P"], hint="an empty string means every joint, as before."),
-        selects("TURRET_P", ["TURRET_P"], rate=10.0, hint="the rate parameter still applies."),
-        refuses("GUN"),
-        refuses("TURRET_Y,GUN"),
-    ])
+    return grade(
+        "Exercise 2.1, publish chosen joints",
+        [
+            selects(
+                "TURRET_P,TURRET_Y",
+                ["TURRET_P", "TURRET_Y"],
+                hint="publish the joints in the order the parameter names them.",
+            ),
+            selects("TURRET_Y", ["TURRET_Y"], hint="only the named joints: one name, one entry."),
+            selects(" TURRET_P , TURRET_Y ", ["TURRET_P", "TURRET_Y"], hint="spaces around a name are ignored."),
+            selects("", ["TURRET_Y", "TURRET_P"], hint="an empty string means every joint, as before."),
+            selects("TURRET_P", ["TURRET_P"], rate=10.0, hint="the rate parameter still applies."),
+            refuses("GUN"),
+            refuses("TURRET_Y,GUN"),
+        ],
+    )
 
 
 def check_pose_publisher(cls) -> Result:
@@ -171,11 +197,12 @@ def check_pose_publisher(cls) -> Result:
             pubs = node.published("/Tank/pose")
             if len(pubs) != 1:
                 topics = [p.topic for p in node.published()]
-                raise CaseFailed(f"{call} published on {topics}, expected one publisher of /Tank/pose.",
-                                 "name the topic after the body: f\"/{config.body_name}/pose\".")
+                raise CaseFailed(
+                    f"{call} published on {topics}, expected one publisher of /Tank/pose.",
+                    'name the topic after the body: f"/{config.body_name}/pose".',
+                )
             if pubs[0].msg_type is not PoseStamped:
-                raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__}, "
-                                 "expected geometry_msgs/PoseStamped.")
+                raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__}, expected geometry_msgs/PoseStamped.")
             runs.append((pubs[0].messages(), probe))
         return runs[0]
 
@@ -184,28 +211,36 @@ def check_pose_publisher(cls) -> Result:
     def timing():
         messages, _ = poses()
         if len(messages) < want:
-            raise CaseFailed(f"{call} published {len(messages)} poses, expected {want} (10 Hz for {DURATION} s).",
-                             "use a PeriodAccumulator(io.time_step, rate) in initialize and tick() it in control().")
+            raise CaseFailed(
+                f"{call} published {len(messages)} poses, expected {want} (10 Hz for {DURATION} s).",
+                "use a PeriodAccumulator(io.time_step, rate) in initialize and tick() it in control().",
+            )
         for k, msg in enumerate(messages[:want]):
             t = _stamp(msg)
             if abs(t - 0.1 * k) > 1e-9:
-                raise CaseFailed(f"{call}: pose {k} is stamped {t:.4f} s, expected {0.1 * k:.4f} s.",
-                                 "stamp with simulation time (io.data.time), the first at t = 0, every 0.1 s.")
+                raise CaseFailed(
+                    f"{call}: pose {k} is stamped {t:.4f} s, expected {0.1 * k:.4f} s.",
+                    "stamp with simulation time (io.data.time), the first at t = 0, every 0.1 s.",
+                )
 
     def position():
         messages, probe = poses()
         for msg in messages[:want]:
             t = _stamp(msg)
             if msg.header.frame_id != "world":
-                raise CaseFailed(f"{call}: frame_id is {msg.header.frame_id!r}, expected 'world'.",
-                                 "the pose is the root link's, in the world frame.")
+                raise CaseFailed(
+                    f"{call}: frame_id is {msg.header.frame_id!r}, expected 'world'.",
+                    "the pose is the root link's, in the world frame.",
+                )
             _, pos, _ = probe.at(t)
             p = msg.pose.position
             got = (p.x, p.y, p.z)
             if max(abs(a - b) for a, b in zip(got, pos)) > 5e-3:
-                raise CaseFailed(f"{call}: at t = {t:.2f} s the position was {show(list(got))}, the root was at "
-                                 f"{show([round(float(v), 4) for v in pos])} m.",
-                                 "io.body.root_pose() gives the root's (position, quaternion).")
+                raise CaseFailed(
+                    f"{call}: at t = {t:.2f} s the position was {show(list(got))}, the root was at "
+                    f"{show([round(float(v), 4) for v in pos])} m.",
+                    "io.body.root_pose() gives the root's (position, quaternion).",
+                )
 
     def orientation():
         messages, probe = poses()
@@ -215,17 +250,21 @@ def check_pose_publisher(cls) -> Result:
             o = msg.pose.orientation
             got, expected = (o.x, o.y, o.z, o.w), (quat[1], quat[2], quat[3], quat[0])
             if not _same_rotation(got, expected):
-                raise CaseFailed(f"{call}: at t = {t:.2f} s the orientation (x, y, z, w) was "
-                                 f"{show([round(v, 4) for v in got])}, expected "
-                                 f"{show([round(float(v), 4) for v in expected])}.",
-                                 "ROS orders a quaternion x, y, z, w; MuJoCo (root_pose) orders it w, x, y, z.")
+                raise CaseFailed(
+                    f"{call}: at t = {t:.2f} s the orientation (x, y, z, w) was "
+                    f"{show([round(v, 4) for v in got])}, expected "
+                    f"{show([round(float(v), 4) for v in expected])}.",
+                    "ROS orders a quaternion x, y, z, w; MuJoCo (root_pose) orders it w, x, y, z.",
+                )
 
-    return grade("Exercise 2.2, publish the pose", [
-        Case(f"{call}: 10 Hz from t = 0, stamped with simulation time", timing),
-        Case(f"{call}: the root's position, frame world", position),
-        Case(f"{call}: the root's orientation", orientation),
-    ])
-
+    return grade(
+        "Exercise 2.2, publish the pose",
+        [
+            Case(f"{call}: 10 Hz from t = 0, stamped with simulation time", timing),
+            Case(f"{call}: the root's position, frame world", position),
+            Case(f"{call}: the root's orientation", orientation),
+        ],
+    )
 
 
 def _same_rotation(a, b, tol: float = 1e-2) -> bool:

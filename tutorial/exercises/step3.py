@@ -36,9 +36,9 @@ def _tank():
     """A Body of the tank alone, over its own MjData (the caller's thread owns it)."""
     import mujoco
 
-    from tutorial.body import Body
+    from tutorial.core.body import Body
+    from tutorial.core.world import build_world
     from tutorial.notebook.runs import load
-    from tutorial.world import build_world
 
     model = build_world(load("tank_view.yaml").models)
     data = mujoco.MjData(model)
@@ -49,9 +49,9 @@ def _tank():
 def _crane():
     import mujoco
 
-    from tutorial.body import Body
+    from tutorial.core.body import Body
+    from tutorial.core.world import ModelEntry, build_world
     from tutorial.notebook.session import MODEL
-    from tutorial.world import ModelEntry, build_world
 
     model = build_world([ModelEntry("Crane", MODEL / "crane.xml")])
     return Body(model, mujoco.MjData(model), "Crane")
@@ -61,12 +61,12 @@ def check_own_matcher(func) -> Result:
     """Check ``func(joints, names, positions) -> {name: position}`` against the library's matcher.
 
     ``joints`` is ``Body.joint_infos``; the result must be exactly what
-    :func:`tutorial.joint_matching.match_joint_state` applies: matched by
+    :func:`tutorial.interfaces.joint_state.match_joint_state` applies: matched by
     name in any order; unknown names, every entry of a duplicated name,
     entries without a position, non-finite values and values outside the
     joint's range by more than 0.05 rad (0.01 m for a slide) are skipped.
     """
-    from tutorial.joint_matching import match_joint_state
+    from tutorial.interfaces.joint_state import match_joint_state
 
     tank, crane = _tank().joint_infos, _crane().joint_infos
     rows = [(label, tank, names, positions) for label, names, positions in HOSTILE]
@@ -97,10 +97,15 @@ def check_own_matcher(func) -> Result:
         def run():
             expected = match_joint_state(joints, names, positions).applied
             got = func(joints, list(names), list(positions))
-            if not isinstance(got, dict) or set(got) != set(expected) or any(
-                    not _same(got[k], expected[k]) for k in expected):
-                raise CaseFailed(f"{call} returned {_show_dict(got)}, expected {_show_dict(expected)}.",
-                                 hints.get(label, ""))
+            if (
+                not isinstance(got, dict)
+                or set(got) != set(expected)
+                or any(not _same(got[k], expected[k]) for k in expected)
+            ):
+                raise CaseFailed(
+                    f"{call} returned {_show_dict(got)}, expected {_show_dict(expected)}.", hints.get(label, "")
+                )
+
         return Case(call, run, hints.get(label, ""))
 
     return grade("Exercise 3.2, your own joint matcher", [case(*row) for row in rows])
@@ -127,7 +132,7 @@ def check_wrong_model(cls) -> Result:
     import rclpy
     from sensor_msgs.msg import JointState
 
-    from tutorial.controller import ControllerConfig
+    from tutorial.core.controller import ControllerConfig
 
     def message(names, positions):
         msg = JointState()
@@ -142,8 +147,10 @@ def check_wrong_model(cls) -> Result:
             controller = cls()
             config = ControllerConfig(name="Strict", body=body, node=node)
             if not controller.configure(config):
-                raise CaseFailed(f"{cls.__name__}.configure() returned False.",
-                                 "keep RttJointStateSubscriber.configure: call super().configure(config).")
+                raise CaseFailed(
+                    f"{cls.__name__}.configure() returned False.",
+                    "keep RttJointStateSubscriber.configure: call super().configure(config).",
+                )
             for msg in messages:
                 controller.update_joint_state(msg)
             summary = controller.summary()
@@ -160,30 +167,76 @@ def check_wrong_model(cls) -> Result:
             body, summary = run_messages(messages)
             got = {k: round(v, 9) for k, v in body.joint_positions().items()}
             if summary.get("applied") != applied or summary.get("rejected") != rejected:
-                raise CaseFailed(f"{call} gave applied={summary.get('applied')!r}, rejected={summary.get('rejected')!r}"
-                                 f"; expected applied={applied}, rejected={rejected}.", hint)
+                raise CaseFailed(
+                    f"{call} gave applied={summary.get('applied')!r}, rejected={summary.get('rejected')!r}"
+                    f"; expected applied={applied}, rejected={rejected}.",
+                    hint,
+                )
             if got != positions:
                 raise CaseFailed(f"{call} left the tank at {got}, expected {positions}.", hint)
+
         return Case(call, run, hint)
 
     zero = {"TURRET_Y": 0.0, "TURRET_P": 0.0}
-    return grade("Exercise 3.1, refuse another model's message", [
-        expect("the tank's own message", [message(TANK, [0.3, 0.2])], 1, {},
-               {"TURRET_Y": 0.3, "TURRET_P": 0.2}, "a message of this body's joints is applied as before."),
-        expect("the tank's joints, reordered", [message(["TURRET_P", "TURRET_Y"], [0.2, 0.3])], 1, {},
-               {"TURRET_Y": 0.3, "TURRET_P": 0.2}, "order does not matter: the names are all the tank's."),
-        expect("the crane's message", [message(["SLEW", "LUFF", "TROLLEY"], [0.5, 0.2, 1.0])], 0,
-               {"wrong_model": 1}, zero,
-               "none of these names is a joint of the body (self.body.joint_names): refuse it whole, "
-               "count self.rejected['wrong_model'] += 1, and do not call super().update_joint_state()."),
-        expect("one of the tank's joints and one unknown", [message(["TURRET_Y", "GUN"], [0.3, 0.1])], 0,
-               {"wrong_model": 1}, zero, "one unknown name is enough: the message is from another model."),
-        expect("an empty message", [message([], [])], 0, {"wrong_model": 1}, zero,
-               "a message that names none of the body's joints is not this body's."),
-        expect("the tank's, with a NaN", [message(TANK, [math.nan, 0.2])], 1, {"not_finite": 1},
-               {"TURRET_Y": 0.0, "TURRET_P": 0.2},
-               "a message of this body stays with the matcher, which rejects the NaN entry alone."),
-        expect("the crane's, then the tank's", [message(["SLEW"], [0.5]), message(TANK, [0.4, 0.1])], 1,
-               {"wrong_model": 1}, {"TURRET_Y": 0.4, "TURRET_P": 0.1},
-               "after refusing one message, the next good one is applied."),
-    ])
+    return grade(
+        "Exercise 3.1, refuse another model's message",
+        [
+            expect(
+                "the tank's own message",
+                [message(TANK, [0.3, 0.2])],
+                1,
+                {},
+                {"TURRET_Y": 0.3, "TURRET_P": 0.2},
+                "a message of this body's joints is applied as before.",
+            ),
+            expect(
+                "the tank's joints, reordered",
+                [message(["TURRET_P", "TURRET_Y"], [0.2, 0.3])],
+                1,
+                {},
+                {"TURRET_Y": 0.3, "TURRET_P": 0.2},
+                "order does not matter: the names are all the tank's.",
+            ),
+            expect(
+                "the crane's message",
+                [message(["SLEW", "LUFF", "TROLLEY"], [0.5, 0.2, 1.0])],
+                0,
+                {"wrong_model": 1},
+                zero,
+                "none of these names is a joint of the body (self.body.joint_names): refuse it whole, "
+                "count self.rejected['wrong_model'] += 1, and do not call super().update_joint_state().",
+            ),
+            expect(
+                "one of the tank's joints and one unknown",
+                [message(["TURRET_Y", "GUN"], [0.3, 0.1])],
+                0,
+                {"wrong_model": 1},
+                zero,
+                "one unknown name is enough: the message is from another model.",
+            ),
+            expect(
+                "an empty message",
+                [message([], [])],
+                0,
+                {"wrong_model": 1},
+                zero,
+                "a message that names none of the body's joints is not this body's.",
+            ),
+            expect(
+                "the tank's, with a NaN",
+                [message(TANK, [math.nan, 0.2])],
+                1,
+                {"not_finite": 1},
+                {"TURRET_Y": 0.0, "TURRET_P": 0.2},
+                "a message of this body stays with the matcher, which rejects the NaN entry alone.",
+            ),
+            expect(
+                "the crane's, then the tank's",
+                [message(["SLEW"], [0.5]), message(TANK, [0.4, 0.1])],
+                1,
+                {"wrong_model": 1},
+                {"TURRET_Y": 0.4, "TURRET_P": 0.1},
+                "after refusing one message, the next good one is applied.",
+            ),
+        ],
+    )

@@ -32,8 +32,8 @@ class _Probe:
     """A controller keeping every step's accelerometer reading, by step number (simulation thread)."""
 
     def __init__(self):
-        from tutorial.controller import SimpleController
-        from tutorial.controllers.imu_state_publisher import find_imu
+        from tutorial.core.controller import SimpleController
+        from tutorial.interfaces.imu import find_imu
 
         class ImuProbe(SimpleController):
             def initialize(probe, io):
@@ -62,22 +62,29 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
     Raises:
         NotImplementedError: the learner's code is not written yet.
         CaseFailed: the simulation failed.
-        tutorial.app.ControllerError: the controller refused to configure (or raised there).
+        tutorial.core.app.ControllerError: the controller refused to configure (or raised there).
     """
     import rclpy
 
     from tutorial.controllers.tank_controller import RttTankController
-    from tutorial.joy_input import SCRIPTS
+    from tutorial.joystick.scripted import ScriptedJoy
+    from tutorial.joystick.sources import SCRIPTS
     from tutorial.notebook.runs import load, run_headless
-    from tutorial.scripted_input import ScriptedJoy
 
     project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
     node = CapturingNode(rclpy.create_node("exercise_check_imu"))
     probe = _Probe()
     tank = RttTankController()
-    summary, _ = run_headless(project, duration, node=node, attach=[
-        ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=SCRIPTS[script])),
-        ("Tank", "RttTankController", tank), ("Tank", "ImuProbe", probe.controller)])
+    summary, _ = run_headless(
+        project,
+        duration,
+        node=node,
+        attach=[
+            ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=SCRIPTS[script])),
+            ("Tank", "RttTankController", tank),
+            ("Tank", "ImuProbe", probe.controller),
+        ],
+    )
     if summary.get("error"):
         if "NotImplementedError" in summary["error"]:
             raise NotImplementedError
@@ -94,22 +101,28 @@ def _one_publisher(node, topic: str, msg_type, call: str, hint: str):
     pubs = node.published(topic)
     if len(pubs) != 1:
         topics = sorted({p.topic for p in node.published()})
-        raise CaseFailed(f"{call} made {len(pubs)} publishers of {topic} (its topics: {topics}), "
-                         "expected 1.", hint)
+        raise CaseFailed(f"{call} made {len(pubs)} publishers of {topic} (its topics: {topics}), expected 1.", hint)
     if pubs[0].msg_type is not msg_type:
-        raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__} on {topic}, expected "
-                         f"{msg_type.__module__.split('.')[0]}/{msg_type.__name__}.", hint)
+        raise CaseFailed(
+            f"{call} publishes {pubs[0].msg_type.__name__} on {topic}, expected "
+            f"{msg_type.__module__.split('.')[0]}/{msg_type.__name__}.",
+            hint,
+        )
     return pubs[0]
 
 
 def _imu_messages(node, call: str):
     from sensor_msgs.msg import Imu
 
-    from tutorial.controllers.imu_state_publisher import imu_topic
+    from tutorial.interfaces.imu import imu_topic
 
-    return _one_publisher(node, imu_topic("Tank"), Imu, call,
-                          "keep publishing the Imu: call super().configure(config) and "
-                          "super().publish() (or super().control()).").messages()
+    return _one_publisher(
+        node,
+        imu_topic("Tank"),
+        Imu,
+        call,
+        "keep publishing the Imu: call super().configure(config) and super().publish() (or super().control()).",
+    ).messages()
 
 
 def _windows(imu_messages) -> list[tuple[int, int]]:
@@ -142,13 +155,20 @@ def check_peak_publisher(cls) -> Result:
             call = f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s"
             node, probe = _drive("PeakImuPublisher", cls, {"rate": rate})
             imu = _imu_messages(node, call)
-            peaks = _one_publisher(node, "/Tank/peak_acceleration", Float64, call,
-                                   "create it in configure: config.node.create_publisher(Float64, "
-                                   "f\"/{config.body_name}/peak_acceleration\", imu_qos()).").messages()
+            peaks = _one_publisher(
+                node,
+                "/Tank/peak_acceleration",
+                Float64,
+                call,
+                "create it in configure: config.node.create_publisher(Float64, "
+                'f"/{config.body_name}/peak_acceleration", imu_qos()).',
+            ).messages()
             if len(peaks) != len(imu):
-                raise CaseFailed(f"{call} published {len(peaks)} peaks and {len(imu)} Imu messages, "
-                                 "expected one peak after each Imu message.",
-                                 "publish the peak in publish(), right after super().publish().")
+                raise CaseFailed(
+                    f"{call} published {len(peaks)} peaks and {len(imu)} Imu messages, "
+                    "expected one peak after each Imu message.",
+                    "publish the peak in publish(), right after super().publish().",
+                )
             runs[rate] = (imu, [p.data for p in peaks], probe)
         return runs[rate]
 
@@ -169,18 +189,32 @@ def check_peak_publisher(cls) -> Result:
                         f"{call}: the peak published with the Imu message of t = {t:.2f} s was "
                         f"{_num(got)} m/s^2, expected {_num(expected)} (the largest of its "
                         f"{last - first + 1} steps; their mean was {_num(mean)}).",
-                        _diagnose(got, mean, readings, first, last) or hint)
+                        _diagnose(got, mean, readings, first, last) or hint,
+                    )
+
         return Case(call, check, hint)
 
-    return grade("Exercise 4.1, the peak of each period", [
-        compare("at rest, t <= 0.5 s", 20.0, lambda t: t <= 0.5,
-                "the peak of a period is the largest math.hypot(a[0], a[1]) of its steps' readings."),
-        compare("hitting the wall, t = 2.1 s", 20.0, lambda t: abs(t - 2.1) < 1e-6,
-                "the peak of a period is the largest math.hypot(a[0], a[1]) of its steps' readings."),
-        compare("every period", 20.0, lambda t: True,
-                "each peak covers exactly the steps its Imu message averages."),
-        compare("every period", 10.0, lambda t: True, "the rate parameter still sets the period."),
-    ])
+    return grade(
+        "Exercise 4.1, the peak of each period",
+        [
+            compare(
+                "at rest, t <= 0.5 s",
+                20.0,
+                lambda t: t <= 0.5,
+                "the peak of a period is the largest math.hypot(a[0], a[1]) of its steps' readings.",
+            ),
+            compare(
+                "hitting the wall, t = 2.1 s",
+                20.0,
+                lambda t: abs(t - 2.1) < 1e-6,
+                "the peak of a period is the largest math.hypot(a[0], a[1]) of its steps' readings.",
+            ),
+            compare(
+                "every period", 20.0, lambda t: True, "each peak covers exactly the steps its Imu message averages."
+            ),
+            compare("every period", 10.0, lambda t: True, "the rate parameter still sets the period."),
+        ],
+    )
 
 
 def _num(value) -> str:
@@ -194,20 +228,24 @@ def _same(got, expected: float) -> bool:
 
 def _diagnose(got, mean: float, readings, first: int, last: int) -> str:
     """A hint naming the likely mistake, when ``got`` is what a known mistake gives ("" if none)."""
+
     def largest(steps, norm=_horizontal):
         return max((norm(readings[s]) for s in steps), default=0.0)
 
     if _same(got, mean):
-        return ("that is the horizontal part of the period's mean, what the Imu message carries; "
-                "the peak is the largest single step's reading: look at "
-                "self.data.sensordata[self.accel] in every control().")
+        return (
+            "that is the horizontal part of the period's mean, what the Imu message carries; "
+            "the peak is the largest single step's reading: look at "
+            "self.data.sensordata[self.accel] in every control()."
+        )
     if _same(got, largest(range(first, last + 1), lambda a: float(sum(v * v for v in a)) ** 0.5)):
         return "horizontal means x and y only: math.hypot(a[0], a[1]); z carries gravity."
     if _same(got, largest(range(0, last + 1))) and first > 0:
         return "start over after publishing each peak: set it back to 0."
     if _same(got, largest(range(max(first - 1, 0), last))):
-        return ("the step that publishes belongs to the period it ends: add its reading before "
-                "super().control() publishes.")
+        return (
+            "the step that publishes belongs to the period it ends: add its reading before super().control() publishes."
+        )
     return ""
 
 
@@ -233,9 +271,14 @@ def check_collision_reporter(cls) -> Result:
         def check():
             node, _ = _drive("CollisionReporter", cls, parameters)
             imu = _imu_messages(node, call)
-            got = _one_publisher(node, "/Tank/collision", Vector3Stamped, call,
-                                 "create it in configure: config.node.create_publisher("
-                                 "Vector3Stamped, f\"/{config.body_name}/collision\", imu_qos()).").messages()
+            got = _one_publisher(
+                node,
+                "/Tank/collision",
+                Vector3Stamped,
+                call,
+                "create it in configure: config.node.create_publisher("
+                'Vector3Stamped, f"/{config.body_name}/collision", imu_qos()).',
+            ).messages()
             threshold, holdoff = parameters.get("threshold", 20.0), parameters.get("holdoff", 0.5)
             expected, last = [], None
             for msg in imu:
@@ -244,35 +287,48 @@ def check_collision_reporter(cls) -> Result:
                     expected.append(msg)
                     last = t
             if not expected:
-                raise CaseFailed(f"{call}: the Imu messages show no collision at all; the tank "
-                                 "should have hit the wall at about 2.05 s.",
-                                 "keep RttImuStatePublisher's behaviour: call super().publish().")
+                raise CaseFailed(
+                    f"{call}: the Imu messages show no collision at all; the tank "
+                    "should have hit the wall at about 2.05 s.",
+                    "keep RttImuStatePublisher's behaviour: call super().publish().",
+                )
             at = [round(_stamp_ns(m) * 1e-9, 3) for m in got]
             want = [round(_stamp_ns(m) * 1e-9, 3) for m in expected]
             if len(got) != len(expected):
-                raise CaseFailed(f"{call} made {_reports(len(got))}, stamped t = {at} s; expected "
-                                 f"{_reports(len(expected))}, at t = {want} s.",
-                                 "report when hypot(x, y) of the mean is above threshold, and then not "
-                                 "again until holdoff s of simulated time have passed.")
+                raise CaseFailed(
+                    f"{call} made {_reports(len(got))}, stamped t = {at} s; expected "
+                    f"{_reports(len(expected))}, at t = {want} s.",
+                    "report when hypot(x, y) of the mean is above threshold, and then not "
+                    "again until holdoff s of simulated time have passed.",
+                )
             for report, msg, t in zip(got, expected, want):
                 a = msg.linear_acceleration
                 vector = [report.vector.x, report.vector.y, report.vector.z]
                 if _stamp_ns(report) != _stamp_ns(msg):
-                    raise CaseFailed(f"{call}: the report of the Imu message of t = {t} s is stamped "
-                                     f"{_stamp_ns(report) * 1e-9:.3f} s.",
-                                     "copy the Imu message's header (stamp and frame_id).")
+                    raise CaseFailed(
+                        f"{call}: the report of the Imu message of t = {t} s is stamped "
+                        f"{_stamp_ns(report) * 1e-9:.3f} s.",
+                        "copy the Imu message's header (stamp and frame_id).",
+                    )
                 if report.header.frame_id != msg.header.frame_id:
-                    raise CaseFailed(f"{call}: the report at t = {t} s has frame_id "
-                                     f"{report.header.frame_id!r}, expected {msg.header.frame_id!r}.",
-                                     "the vector is in the IMU's frame: use the Imu message's frame_id.")
+                    raise CaseFailed(
+                        f"{call}: the report at t = {t} s has frame_id "
+                        f"{report.header.frame_id!r}, expected {msg.header.frame_id!r}.",
+                        "the vector is in the IMU's frame: use the Imu message's frame_id.",
+                    )
                 if max(abs(g - e) for g, e in zip(vector, [a.x, a.y, 0.0])) > 1e-9:
-                    raise CaseFailed(f"{call}: the report at t = {t} s carries {show(vector)}, "
-                                     f"expected {show([a.x, a.y, 0.0])}.",
-                                     "the vector is the mean acceleration's horizontal part: (x, y, 0).")
+                    raise CaseFailed(
+                        f"{call}: the report at t = {t} s carries {show(vector)}, expected {show([a.x, a.y, 0.0])}.",
+                        "the vector is the mean acceleration's horizontal part: (x, y, 0).",
+                    )
+
         return Case(call, check)
 
-    return grade("Exercise 4.2, report collisions", [
-        reports({}),
-        reports({"threshold": 10.0}),
-        reports({"threshold": 10.0, "holdoff": 0.1}),
-    ])
+    return grade(
+        "Exercise 4.2, report collisions",
+        [
+            reports({}),
+            reports({"threshold": 10.0}),
+            reports({"threshold": 10.0, "holdoff": 0.1}),
+        ],
+    )

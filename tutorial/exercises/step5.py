@@ -48,7 +48,7 @@ def _viewer(cls, name: str):
     """
     import rclpy
 
-    from tutorial.app import App, ControllerError
+    from tutorial.core.app import App, ControllerError
     from tutorial.notebook.runs import load
 
     project = load("tank_view.yaml").with_controller("Tank", name, cls)
@@ -60,8 +60,9 @@ def _viewer(cls, name: str):
         except ControllerError as exc:
             if isinstance(exc.__cause__, NotImplementedError):
                 raise NotImplementedError from exc
-            raise CaseFailed(f"{cls.__name__}: {exc}.", "call super().configure(config) and return "
-                             "what it returns (True).") from None
+            raise CaseFailed(
+                f"{cls.__name__}: {exc}.", "call super().configure(config) and return what it returns (True)."
+            ) from None
         controller = app.controller(name)
         clock = _Clock()
         controller.clock = clock
@@ -88,7 +89,7 @@ def _turn_left(app, controller, angle: float) -> None:
     from tutorial.controllers.imu_state_subscriber import root_position_address
 
     root = root_position_address(app.model, controller.body.root_id)
-    app.data.qpos[root + 3:root + 7] = [math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)]
+    app.data.qpos[root + 3 : root + 7] = [math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)]
     controller.body.notify_kinematic_state_change()
 
 
@@ -105,10 +106,12 @@ def check_horizontal_arrow(cls) -> Result:
     def arrow_of(app):
         arrow = app.overlays.arrows.get(ARROW)
         if arrow is None:
-            raise CaseFailed(f"{name} made the arrows {sorted(app.overlays.arrows)}, expected also "
-                             f"{ARROW!r}.", "in configure, after super().configure(config): "
-                             "config.overlays.arrow(f\"{config.body_name}/horizontal_acceleration\", "
-                             "(0.2, 0.8, 0.2)).")
+            raise CaseFailed(
+                f"{name} made the arrows {sorted(app.overlays.arrows)}, expected also {ARROW!r}.",
+                "in configure, after super().configure(config): "
+                'config.overlays.arrow(f"{config.body_name}/horizontal_acceleration", '
+                "(0.2, 0.8, 0.2)).",
+            )
         return arrow
 
     def shows(label, accel, vector, visible, turn=0.0, hint=""):
@@ -118,26 +121,34 @@ def check_horizontal_arrow(cls) -> Result:
             with _viewer(cls, "HorizontalArrow") as (app, controller, _):
                 arrow = arrow_of(app)
                 if tuple(round(c, 6) for c in arrow.color) != GREEN:
-                    raise CaseFailed(f"{call}: the arrow's color is {arrow.color}, expected {GREEN}.",
-                                     "green: (0.2, 0.8, 0.2).")
+                    raise CaseFailed(
+                        f"{call}: the arrow's color is {arrow.color}, expected {GREEN}.", "green: (0.2, 0.8, 0.2)."
+                    )
                 if turn:
                     _turn_left(app, controller, turn)
                 controller.update_imu(_imu(accel), controller.clock())
                 origin = app.data.site_xpos[controller.site]
                 if not np.allclose(arrow.origin, origin, atol=1e-9):
-                    raise CaseFailed(f"{call}: the arrow starts at {show(arrow.origin.tolist())}, the IMU "
-                                     f"is at {show(origin.tolist())} m.",
-                                     "start it at self.data.site_xpos[self.site].")
+                    raise CaseFailed(
+                        f"{call}: the arrow starts at {show(arrow.origin.tolist())}, the IMU "
+                        f"is at {show(origin.tolist())} m.",
+                        "start it at self.data.site_xpos[self.site].",
+                    )
                 if not np.allclose(arrow.vector, vector, atol=1e-9) or arrow.visible != visible:
-                    raise CaseFailed(f"{call}: the arrow is {show(arrow.vector.tolist())} m, visible="
-                                     f"{arrow.visible}; expected {show(list(vector))} m, visible={visible}.",
-                                     hint)
+                    raise CaseFailed(
+                        f"{call}: the arrow is {show(arrow.vector.tolist())} m, visible="
+                        f"{arrow.visible}; expected {show(list(vector))} m, visible={visible}.",
+                        hint,
+                    )
                 red = controller.accel_arrow.vector
                 expected_red = 0.1 * (np.array(accel) + [0.0, 0.0, -9.8])
                 if not turn and not np.allclose(red, expected_red, atol=1e-9):
-                    raise CaseFailed(f"{call}: the red arrow became {show(red.tolist())} m, expected "
-                                     f"{show(expected_red.tolist())} as before.",
-                                     "keep the other two arrows: call super().draw_arrows().")
+                    raise CaseFailed(
+                        f"{call}: the red arrow became {show(red.tolist())} m, expected "
+                        f"{show(expected_red.tolist())} as before.",
+                        "keep the other two arrows: call super().draw_arrows().",
+                    )
+
         return Case(call, run, hint)
 
     def keeps_after_rejection():
@@ -148,9 +159,10 @@ def check_horizontal_arrow(cls) -> Result:
             before = arrow.vector.copy(), arrow.visible
             controller.update_imu(_imu((math.nan, 0.0, 9.8)), controller.clock())
             if not np.array_equal(arrow.vector, before[0]) or arrow.visible != before[1]:
-                raise CaseFailed(f"{call}: the arrow changed to {show(arrow.vector.tolist())} m.",
-                                 "a rejected message changes nothing: draw from self.accel, which "
-                                 "only an accepted message sets.")
+                raise CaseFailed(
+                    f"{call}: the arrow changed to {show(arrow.vector.tolist())} m.",
+                    "a rejected message changes nothing: draw from self.accel, which only an accepted message sets.",
+                )
 
     def follows_the_shake():
         call = f"{name}: a hit of (-30, 0, 9.8) m/s^2, then a shake tick 20 ms later"
@@ -162,27 +174,49 @@ def check_horizontal_arrow(cls) -> Result:
             controller.shake_tick()
             moved = app.data.site_xpos[controller.site]
             if np.array_equal(moved, home):
-                raise CaseFailed(f"{call}: the view did not shake.",
-                                 "keep the viewer's behaviour: call super().update_imu().")
+                raise CaseFailed(
+                    f"{call}: the view did not shake.", "keep the viewer's behaviour: call super().update_imu()."
+                )
             if not np.allclose(arrow.origin, moved, atol=1e-12):
-                raise CaseFailed(f"{call}: the IMU moved to {show(moved.tolist())} m, but the green "
-                                 f"arrow still starts at {show(arrow.origin.tolist())}.",
-                                 "draw it in draw_arrows(), which the shake tick calls too, not in "
-                                 "update_imu().")
+                raise CaseFailed(
+                    f"{call}: the IMU moved to {show(moved.tolist())} m, but the green "
+                    f"arrow still starts at {show(arrow.origin.tolist())}.",
+                    "draw it in draw_arrows(), which the shake tick calls too, not in update_imu().",
+                )
 
-    hint_turn = ("the reading is in the IMU's axes: turn the vector into the world with "
-                 "self.data.site_xmat[self.site].reshape(3, 3) @ vector, as draw_arrows() does.")
-    return grade("Exercise 5.1, a third arrow", [
-        shows("driving over a bump", (3.0, 4.0, 11.8), (0.3, 0.4, 0.0), True,
-              hint="0.1 m per m/s^2 of x and y only: z is not horizontal."),
-        shows("0.042 m: hidden", (0.3, 0.3, 12.0), (0.03, 0.03, 0.0), False,
-              hint="hide the arrow when it is shorter than ACCEL_MIN_LENGTH (0.05 m)."),
-        shows("the tank turned 90 degrees left", (5.0, 0.0, 9.8), (0.0, 0.5, 0.0), True,
-              turn=math.pi / 2, hint=hint_turn),
-        Case(f"{name}.update_imu() of (3, 4, 11.8) m/s^2, then of a NaN", keeps_after_rejection),
-        Case(f"{name}: a hit of (-30, 0, 9.8) m/s^2, then a shake tick 20 ms later",
-             follows_the_shake),
-    ])
+    hint_turn = (
+        "the reading is in the IMU's axes: turn the vector into the world with "
+        "self.data.site_xmat[self.site].reshape(3, 3) @ vector, as draw_arrows() does."
+    )
+    return grade(
+        "Exercise 5.1, a third arrow",
+        [
+            shows(
+                "driving over a bump",
+                (3.0, 4.0, 11.8),
+                (0.3, 0.4, 0.0),
+                True,
+                hint="0.1 m per m/s^2 of x and y only: z is not horizontal.",
+            ),
+            shows(
+                "0.042 m: hidden",
+                (0.3, 0.3, 12.0),
+                (0.03, 0.03, 0.0),
+                False,
+                hint="hide the arrow when it is shorter than ACCEL_MIN_LENGTH (0.05 m).",
+            ),
+            shows(
+                "the tank turned 90 degrees left",
+                (5.0, 0.0, 9.8),
+                (0.0, 0.5, 0.0),
+                True,
+                turn=math.pi / 2,
+                hint=hint_turn,
+            ),
+            Case(f"{name}.update_imu() of (3, 4, 11.8) m/s^2, then of a NaN", keeps_after_rejection),
+            Case(f"{name}: a hit of (-30, 0, 9.8) m/s^2, then a shake tick 20 ms later", follows_the_shake),
+        ],
+    )
 
 
 def check_in_order(cls) -> Result:
@@ -213,39 +247,83 @@ def check_in_order(cls) -> Result:
                 summary = controller.summary()
                 got = (summary["accepted"], summary["rejected"])
                 if got != (accepted, rejected):
-                    raise CaseFailed(f"{call} gave accepted={got[0]}, rejected={got[1]}; expected "
-                                     f"accepted={accepted}, rejected={rejected}.", hint)
+                    raise CaseFailed(
+                        f"{call} gave accepted={got[0]}, rejected={got[1]}; expected "
+                        f"accepted={accepted}, rejected={rejected}.",
+                        hint,
+                    )
                 if shown is not None:
                     x = controller.accel_arrow.vector[0]
                     if abs(x - 0.1 * (shown + 1)) > 1e-9:
                         which = round(x / 0.1) - 1
-                        raise CaseFailed(f"{call}: the arrow shows the message stamped "
-                                         f"{stamps[which] if 0 <= which < len(stamps) else '?'} s, "
-                                         f"expected the one stamped {stamps[shown]:.2f} s.", hint)
+                        raise CaseFailed(
+                            f"{call}: the arrow shows the message stamped "
+                            f"{stamps[which] if 0 <= which < len(stamps) else '?'} s, "
+                            f"expected the one stamped {stamps[shown]:.2f} s.",
+                            hint,
+                        )
                 if shakes is not None and summary["shakes"] != shakes:
-                    raise CaseFailed(f"{call} shook the view {summary['shakes']} times, expected "
-                                     f"{shakes}.", hint)
+                    raise CaseFailed(f"{call} shook the view {summary['shakes']} times, expected {shakes}.", hint)
+
         return Case(call, run, hint)
 
-    refuse = ("a stamp not newer than the newest shown is refused: count self.rejected['out_of_order'] "
-              "+= 1 and return \"out_of_order\" before super().update_imu() can show it.")
-    return grade("Exercise 5.2, refuse old news", [
-        sequence("in order", [1.0, 1.05, 1.1], 3, {}, 2,
-                 hint="messages in order are all shown, as before."),
-        sequence("one late", [1.0, 1.1, 1.05], 2, {"out_of_order": 1}, 1, hint=refuse),
-        sequence("the same stamp twice", [1.0, 1.0], 1, {"out_of_order": 1}, 0,
-                 hint="the same stamp again is not newer: refuse it too."),
-        sequence("0.5 s back", [5.0, 4.5], 1, {"out_of_order": 1}, 0, hint=refuse),
-        sequence("a NaN stamped 2.00 s, then one stamped 1.50 s", [1.0, 2.0, 1.5], 2,
-                 {"not_finite": 1}, 2, nan=(1,),
-                 hint="only a message that was shown sets the newest stamp: a rejected NaN "
-                      "must not hold back the good messages after it."),
-        sequence("a restarted publisher", [5.0, 5.05, 0.0, 0.05], 4, {}, 3,
-                 hint="more than 1 s back is a new run (a restarted simulation): show it, and "
-                      "take its stamp as the newest."),
-        sequence("a late hit", [1.0, 1.1, 1.05], 2, {"out_of_order": 1}, 1, shakes=0, hits=(2,),
-                 hint="a refused message is not shown and does not shake the view: return "
-                      "before calling super().update_imu()."),
-        sequence("a hit in order", [1.0, 1.05], 2, {}, None, shakes=1, hits=(1,),
-                 hint="a message in order is shown as before, and a hit still shakes."),
-    ])
+    refuse = (
+        "a stamp not newer than the newest shown is refused: count self.rejected['out_of_order'] "
+        '+= 1 and return "out_of_order" before super().update_imu() can show it.'
+    )
+    return grade(
+        "Exercise 5.2, refuse old news",
+        [
+            sequence("in order", [1.0, 1.05, 1.1], 3, {}, 2, hint="messages in order are all shown, as before."),
+            sequence("one late", [1.0, 1.1, 1.05], 2, {"out_of_order": 1}, 1, hint=refuse),
+            sequence(
+                "the same stamp twice",
+                [1.0, 1.0],
+                1,
+                {"out_of_order": 1},
+                0,
+                hint="the same stamp again is not newer: refuse it too.",
+            ),
+            sequence("0.5 s back", [5.0, 4.5], 1, {"out_of_order": 1}, 0, hint=refuse),
+            sequence(
+                "a NaN stamped 2.00 s, then one stamped 1.50 s",
+                [1.0, 2.0, 1.5],
+                2,
+                {"not_finite": 1},
+                2,
+                nan=(1,),
+                hint="only a message that was shown sets the newest stamp: a rejected NaN "
+                "must not hold back the good messages after it.",
+            ),
+            sequence(
+                "a restarted publisher",
+                [5.0, 5.05, 0.0, 0.05],
+                4,
+                {},
+                3,
+                hint="more than 1 s back is a new run (a restarted simulation): show it, and "
+                "take its stamp as the newest.",
+            ),
+            sequence(
+                "a late hit",
+                [1.0, 1.1, 1.05],
+                2,
+                {"out_of_order": 1},
+                1,
+                shakes=0,
+                hits=(2,),
+                hint="a refused message is not shown and does not shake the view: return "
+                "before calling super().update_imu().",
+            ),
+            sequence(
+                "a hit in order",
+                [1.0, 1.05],
+                2,
+                {},
+                None,
+                shakes=1,
+                hits=(1,),
+                hint="a message in order is shown as before, and a hit still shakes.",
+            ),
+        ],
+    )

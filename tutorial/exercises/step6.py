@@ -57,10 +57,10 @@ class _Rig:
         import mujoco
         import rclpy
 
-        from tutorial.body import Body
-        from tutorial.controller import ControllerConfig, ControllerIO
+        from tutorial.core.body import Body
+        from tutorial.core.controller import ControllerConfig, ControllerIO
+        from tutorial.core.world import build_world
         from tutorial.notebook.runs import load
-        from tutorial.world import build_world
 
         self.name = cls.__name__
         self.model = build_world(load("tank_world.yaml").models, time_step=STEP)
@@ -77,8 +77,10 @@ class _Rig:
             if not self.configured:
                 self.close()
         if not self.configured:
-            raise CaseFailed(f"{self.name}.configure returned False.",
-                             "return what RttCameraImagePublisher.configure returned, and True after your own setup.")
+            raise CaseFailed(
+                f"{self.name}.configure returned False.",
+                "return what RttCameraImagePublisher.configure returned, and True after your own setup.",
+            )
         self.data = mujoco.MjData(self.model)  # the simulation's
         io = ControllerIO(body=Body(self.model, self.data, "Tank"), time_step=STEP, node=self.node, data=self.data)
         if not self.controller.initialize(io) or not self.controller.start():
@@ -93,8 +95,10 @@ class _Rig:
         pubs = self.node.published(IMAGE_TOPIC)
         if not pubs:
             topics = [p.topic for p in self.node.published()]
-            raise CaseFailed(f"{self.name} made no publisher of {IMAGE_TOPIC} (it made {topics}).",
-                             "let RttCameraImagePublisher.configure create it: call super().configure(config).")
+            raise CaseFailed(
+                f"{self.name} made no publisher of {IMAGE_TOPIC} (it made {topics}).",
+                "let RttCameraImagePublisher.configure create it: call super().configure(config).",
+            )
         return pubs[0]
 
     def picture(self, turret_y: float, turret_p: float) -> None:
@@ -104,8 +108,9 @@ class _Rig:
         for _ in range(steps):
             t = self.data.time
             if not self.controller.control():
-                raise CaseFailed(f"{self.name}.control() returned False at t = {t:.3f} s: "
-                                 f"{self._error() or 'no error was set'}.")
+                raise CaseFailed(
+                    f"{self.name}.control() returned False at t = {t:.3f} s: {self._error() or 'no error was set'}."
+                )
             self.steps += 1
             self.data.time = self.steps * STEP
         self.poses.append((t, self.data.qpos.copy()))
@@ -115,8 +120,10 @@ class _Rig:
             if self._error():
                 raise CaseFailed(f"{self.name}: the render thread failed: {self._error()}.")
             if time.monotonic() > deadline:
-                raise CaseFailed(f"{self.name}: the picture due at t = {t:.3f} s was not published within "
-                                 f"{WAIT:.0f} s.", "publish_image must publish the message it fills.")
+                raise CaseFailed(
+                    f"{self.name}: the picture due at t = {t:.3f} s was not published within {WAIT:.0f} s.",
+                    "publish_image must publish the message it fills.",
+                )
             time.sleep(0.005)
 
     def _error(self) -> str | None:
@@ -158,7 +165,7 @@ def _references(model, poses: list[tuple[float, np.ndarray]]) -> list[np.ndarray
     import mujoco
 
     from tutorial.controllers.camera_image_publisher import render_snapshot
-    from tutorial.simulator import Snapshot
+    from tutorial.core.simulator import Snapshot
 
     cam = model.camera("Tank/Kinect").id
     width, height = (int(v) for v in model.cam_resolution[cam])
@@ -191,8 +198,9 @@ def check_gray_camera(cls) -> Result:
             rig = _drive(cls)
             pub = rig.images()
             if pub.msg_type is not Image:
-                raise CaseFailed(f"{rig.name} publishes {pub.msg_type.__name__} on {IMAGE_TOPIC}, "
-                                 "expected sensor_msgs/Image.")
+                raise CaseFailed(
+                    f"{rig.name} publishes {pub.msg_type.__name__} on {IMAGE_TOPIC}, expected sensor_msgs/Image."
+                )
             runs.append((pub.messages(), rig.poses, _references(rig.model, rig.poses)))
         return runs[0]
 
@@ -202,35 +210,55 @@ def check_gray_camera(cls) -> Result:
         def run():
             messages, poses, references = drive()
             msg, (t, _), colour = messages[k], poses[k], references[k]
-            fields = {"encoding": msg.encoding, "height": msg.height, "width": msg.width, "step": msg.step,
-                      "is_bigendian": msg.is_bigendian, "frame_id": msg.header.frame_id}
-            expected = {"encoding": "mono8", "height": 240, "width": 320, "step": 320, "is_bigendian": 0,
-                        "frame_id": "Kinect"}
-            hints = {"encoding": "a gray picture of one byte a pixel is mono8.",
-                     "step": "step is the bytes in one row: one byte a pixel, so the width.",
-                     "height": "height is the number of rows, width the pixels in a row: gray.shape is (rows, "
-                               "columns).",
-                     "width": "height is the number of rows, width the pixels in a row.",
-                     "is_bigendian": "set is_bigendian to 0.",
-                     "frame_id": "keep the frame_id RttCameraImagePublisher.configure set: reuse self.msg."}
+            fields = {
+                "encoding": msg.encoding,
+                "height": msg.height,
+                "width": msg.width,
+                "step": msg.step,
+                "is_bigendian": msg.is_bigendian,
+                "frame_id": msg.header.frame_id,
+            }
+            expected = {
+                "encoding": "mono8",
+                "height": 240,
+                "width": 320,
+                "step": 320,
+                "is_bigendian": 0,
+                "frame_id": "Kinect",
+            }
+            hints = {
+                "encoding": "a gray picture of one byte a pixel is mono8.",
+                "step": "step is the bytes in one row: one byte a pixel, so the width.",
+                "height": "height is the number of rows, width the pixels in a row: gray.shape is (rows, columns).",
+                "width": "height is the number of rows, width the pixels in a row.",
+                "is_bigendian": "set is_bigendian to 0.",
+                "frame_id": "keep the frame_id RttCameraImagePublisher.configure set: reuse self.msg.",
+            }
             for name, want in expected.items():
                 if fields[name] != want:
                     raise CaseFailed(f"{call}: {name} was {fields[name]!r}, expected {want!r}.", hints[name])
             if len(msg.data) != 320 * 240:
-                raise CaseFailed(f"{call}: data has {len(msg.data)} bytes, expected step x height = 76800.",
-                                 "one byte a pixel: the gray array as uint8.")
+                raise CaseFailed(
+                    f"{call}: data has {len(msg.data)} bytes, expected step x height = 76800.",
+                    "one byte a pixel: the gray array as uint8.",
+                )
             if abs(_stamp(msg) - t) > 1e-9:
-                raise CaseFailed(f"{call}: stamped {_stamp(msg):.3f} s, expected {t:.3f} s.",
-                                 "stamp each picture with its time_s: stamp_parts(time_s).")
+                raise CaseFailed(
+                    f"{call}: stamped {_stamp(msg):.3f} s, expected {t:.3f} s.",
+                    "stamp each picture with its time_s: stamp_parts(time_s).",
+                )
             gray = np.frombuffer(bytes(msg.data), np.uint8).reshape(240, 320).astype(int)
             want = np.round(colour @ np.array(LUMA)).astype(int)
             wrong = np.argwhere(np.abs(gray - want) > 1)
             if len(wrong):
                 r, c = (int(v) for v in wrong[0])
-                raise CaseFailed(f"{call}: {len(wrong)} pixels are off by more than 1, e.g. row {r}, column {c} "
-                                 f"is {gray[r, c]}, expected {want[r, c]} (R, G, B = "
-                                 f"{show([int(v) for v in colour[r, c]])}).",
-                                 "gray = 0.299 R + 0.587 G + 0.114 B, rounded: green counts most, blue least.")
+                raise CaseFailed(
+                    f"{call}: {len(wrong)} pixels are off by more than 1, e.g. row {r}, column {c} "
+                    f"is {gray[r, c]}, expected {want[r, c]} (R, G, B = "
+                    f"{show([int(v) for v in colour[r, c]])}).",
+                    "gray = 0.299 R + 0.587 G + 0.114 B, rounded: green counts most, blue least.",
+                )
+
         return Case(call, run)
 
     return grade("Exercise 6.1, a gray camera", [picture(k, label) for k, (label, _, _) in enumerate(POSES)])
@@ -245,9 +273,11 @@ def expected_camera_info(width: int, height: int, fovy_deg: float) -> dict:
     """
     fy = (height / 2) / math.tan(math.radians(fovy_deg) / 2)
     fx, cx, cy = fy, (width - 1) / 2, (height - 1) / 2
-    return {"k": [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0],
-            "r": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-            "p": [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0]}
+    return {
+        "k": [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0],
+        "r": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        "p": [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0],
+    }
 
 
 def check_camera_info(cls) -> Result:
@@ -271,8 +301,10 @@ def check_camera_info(cls) -> Result:
             pubs = rig.node.published(INFO_TOPIC)
             if len(pubs) != 1:
                 topics = [p.topic for p in rig.node.published()]
-                raise CaseFailed(f"{name} made publishers of {topics}, expected one of {INFO_TOPIC}.",
-                                 'name it after the body: f"/{config.body_name}/camera/camera_info".')
+                raise CaseFailed(
+                    f"{name} made publishers of {topics}, expected one of {INFO_TOPIC}.",
+                    'name it after the body: f"/{config.body_name}/camera/camera_info".',
+                )
             cam = rig.model.camera("Tank/Kinect").id
             runs.append((images, pubs[0], float(rig.model.cam_fovy[cam])))
         return runs[0]
@@ -284,26 +316,33 @@ def check_camera_info(cls) -> Result:
     def one_with_each(call):
         images, pub, _ = drive()
         if pub.msg_type is not CameraInfo:
-            raise CaseFailed(f"{call}: it publishes {pub.msg_type.__name__} on {INFO_TOPIC}, "
-                             "expected sensor_msgs/CameraInfo.")
+            raise CaseFailed(
+                f"{call}: it publishes {pub.msg_type.__name__} on {INFO_TOPIC}, expected sensor_msgs/CameraInfo."
+            )
         qos = pub.real.qos_profile
         if qos.reliability != ReliabilityPolicy.BEST_EFFORT or qos.depth != 1:
-            raise CaseFailed(f"{call}: it is published {qos.reliability.name.lower()}, depth {qos.depth}; "
-                             "expected the camera's QoS (best effort, keep last 1).",
-                             "a subscriber takes the Image and its CameraInfo together: use camera_image_qos().")
+            raise CaseFailed(
+                f"{call}: it is published {qos.reliability.name.lower()}, depth {qos.depth}; "
+                "expected the camera's QoS (best effort, keep last 1).",
+                "a subscriber takes the Image and its CameraInfo together: use camera_image_qos().",
+            )
         infos = pub.messages()
         if len(infos) != len(images):
-            raise CaseFailed(f"{call}: {len(infos)} CameraInfo were published with {len(images)} pictures.",
-                             "publish one in publish_image, after the Image.")
+            raise CaseFailed(
+                f"{call}: {len(infos)} CameraInfo were published with {len(images)} pictures.",
+                "publish one in publish_image, after the Image.",
+            )
 
     def stamps(call):
         images, pub, _ = drive()
         for k, (image, info) in enumerate(zip(images, pub.messages())):
             if (_stamp(info), info.header.frame_id) != (_stamp(image), image.header.frame_id):
-                raise CaseFailed(f"{call}: CameraInfo {k + 1} is stamped {_stamp(info):.3f} s, frame "
-                                 f"{info.header.frame_id!r}; its Image {_stamp(image):.3f} s, frame "
-                                 f"{image.header.frame_id!r}.",
-                                 "give each CameraInfo its Image's header: the same stamp and frame_id.")
+                raise CaseFailed(
+                    f"{call}: CameraInfo {k + 1} is stamped {_stamp(info):.3f} s, frame "
+                    f"{info.header.frame_id!r}; its Image {_stamp(image):.3f} s, frame "
+                    f"{image.header.frame_id!r}.",
+                    "give each CameraInfo its Image's header: the same stamp and frame_id.",
+                )
 
     def size(call):
         _, pub, _ = drive()
@@ -311,9 +350,10 @@ def check_camera_info(cls) -> Result:
         got = [info.width, info.height, info.distortion_model, [float(v) for v in info.d]]
         want = [320, 240, "plumb_bob", [0.0] * 5]
         if got != want:
-            raise CaseFailed(f"{call}: width, height, distortion_model, d were {show(got)}, expected "
-                             f"{show(want)}.",
-                             "a simulated camera has no lens distortion: plumb_bob with five zero coefficients.")
+            raise CaseFailed(
+                f"{call}: width, height, distortion_model, d were {show(got)}, expected {show(want)}.",
+                "a simulated camera has no lens distortion: plumb_bob with five zero coefficients.",
+            )
 
     def matrix(key: str):
         def run(call):
@@ -322,18 +362,30 @@ def check_camera_info(cls) -> Result:
             want = expected_camera_info(320, 240, fovy)[key]
             got = [float(v) for v in getattr(info, key)]
             if not np.allclose(got, want, rtol=0, atol=1e-6):
-                raise CaseFailed(f"{call}: {key} was {show([round(v, 3) for v in got])}, expected "
-                                 f"{show([round(v, 3) for v in want])}.")
+                raise CaseFailed(
+                    f"{call}: {key} was {show([round(v, 3) for v in got])}, expected "
+                    f"{show([round(v, 3) for v in want])}."
+                )
+
         return run
 
-    return grade("Exercise 6.2, publish the CameraInfo", [
-        case(f"one CameraInfo on {INFO_TOPIC} with each Image", one_with_each),
-        case("each CameraInfo has its Image's stamp and frame", stamps),
-        case("size and distortion", size),
-        case("k, from the vertical field of view", matrix("k"),
-             "fy = (height / 2) / tan(fovy / 2), fovy in radians; fx = fy (square pixels); "
-             "cx = (width - 1) / 2, cy = (height - 1) / 2."),
-        case("r, the identity", matrix("r"), "a single camera needs no rectifying rotation."),
-        case("p, k with a fourth column of zeros", matrix("p"),
-             "p is the 3 x 4 matrix [k | 0], row by row: a single camera has no baseline."),
-    ])
+    return grade(
+        "Exercise 6.2, publish the CameraInfo",
+        [
+            case(f"one CameraInfo on {INFO_TOPIC} with each Image", one_with_each),
+            case("each CameraInfo has its Image's stamp and frame", stamps),
+            case("size and distortion", size),
+            case(
+                "k, from the vertical field of view",
+                matrix("k"),
+                "fy = (height / 2) / tan(fovy / 2), fovy in radians; fx = fy (square pixels); "
+                "cx = (width - 1) / 2, cy = (height - 1) / 2.",
+            ),
+            case("r, the identity", matrix("r"), "a single camera needs no rectifying rotation."),
+            case(
+                "p, k with a fourth column of zeros",
+                matrix("p"),
+                "p is the 3 x 4 matrix [k | 0], row by row: a single camera has no baseline.",
+            ),
+        ],
+    )

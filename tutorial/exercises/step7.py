@@ -67,6 +67,7 @@ def check_release_times(func) -> Result:
     times (when the recorder received the message), in seconds since the
     bag's first ``/joy`` message.  Other topics are ignored.
     """
+
     def bag(label, messages, expected, hint):
         call = f"release_times(a bag: {label})"
 
@@ -79,28 +80,68 @@ def check_release_times(func) -> Result:
             except (TypeError, ValueError):
                 raise CaseFailed(f"{call} returned {got!r}, expected a list of seconds {show(expected)}.") from None
             if len(got_list) != len(expected) or any(abs(a - b) > 1e-6 for a, b in zip(got_list, expected)):
-                raise CaseFailed(f"{call} returned {show([round(t, 4) for t in got_list])}, expected {show(expected)}.",
-                                 hint)
+                raise CaseFailed(
+                    f"{call} returned {show([round(t, 4) for t in got_list])}, expected {show(expected)}.", hint
+                )
+
         return Case(call, run, hint)
 
     repeat = [0.05 * k for k in range(20)]  # a joy node repeating its state at 20 Hz for 1 s
-    return grade("Exercise 7.1, when did the operator let go", [
-        bag("forward for 1 s, then let go", [("/joy", t, _joy(lv=0.5)) for t in repeat] + [("/joy", 1.0, _joy())],
-            [1.0], "a release is a Joy with every axis 0, right after one that was not."),
-        bag("let go, then repeated at 20 Hz", [("/joy", 0.0, _joy(lv=0.5)), ("/joy", 0.4, _joy()),
-                                               *[("/joy", 0.4 + 0.05 * k, _joy()) for k in range(1, 10)]],
-            [0.4], "a joy node repeats a released state: only the first released Joy after a push counts."),
-        bag("two pushes", [("/joy", 0.0, _joy(lv=1.0)), ("/joy", 0.5, _joy()), ("/joy", 1.0, _joy(rh=-0.6)),
-                           ("/joy", 2.25, _joy())], [0.5, 2.25], "every push that ends is one release."),
-        bag("still pushed at the end", [("/joy", 0.0, _joy()), ("/joy", 0.3, _joy(lv=0.8))], [],
-            "a bag that starts released and ends pushed holds no release."),
-        bag("joint states around the Joys",
-            [("/Tank/joint_state", 0.0, _state(0.0, 0.0)), ("/joy", 0.5, _joy(lv=0.5)),
-             ("/Tank/joint_state", 0.6, _state(0.1, 0.2)), ("/joy", 1.5, _joy())],
-            [1.0], "read only /joy (read_messages(path, topics=['/joy'])), and count from the first Joy."),
-        bag("a Joy with no axes", [("/joy", 0.0, _joy(rh=0.7)), ("/joy", 0.2, _joy(axes=[]))], [0.2],
-            "a Joy with no axes has no stick pushed: it is released."),
-    ])
+    return grade(
+        "Exercise 7.1, when did the operator let go",
+        [
+            bag(
+                "forward for 1 s, then let go",
+                [("/joy", t, _joy(lv=0.5)) for t in repeat] + [("/joy", 1.0, _joy())],
+                [1.0],
+                "a release is a Joy with every axis 0, right after one that was not.",
+            ),
+            bag(
+                "let go, then repeated at 20 Hz",
+                [
+                    ("/joy", 0.0, _joy(lv=0.5)),
+                    ("/joy", 0.4, _joy()),
+                    *[("/joy", 0.4 + 0.05 * k, _joy()) for k in range(1, 10)],
+                ],
+                [0.4],
+                "a joy node repeats a released state: only the first released Joy after a push counts.",
+            ),
+            bag(
+                "two pushes",
+                [
+                    ("/joy", 0.0, _joy(lv=1.0)),
+                    ("/joy", 0.5, _joy()),
+                    ("/joy", 1.0, _joy(rh=-0.6)),
+                    ("/joy", 2.25, _joy()),
+                ],
+                [0.5, 2.25],
+                "every push that ends is one release.",
+            ),
+            bag(
+                "still pushed at the end",
+                [("/joy", 0.0, _joy()), ("/joy", 0.3, _joy(lv=0.8))],
+                [],
+                "a bag that starts released and ends pushed holds no release.",
+            ),
+            bag(
+                "joint states around the Joys",
+                [
+                    ("/Tank/joint_state", 0.0, _state(0.0, 0.0)),
+                    ("/joy", 0.5, _joy(lv=0.5)),
+                    ("/Tank/joint_state", 0.6, _state(0.1, 0.2)),
+                    ("/joy", 1.5, _joy()),
+                ],
+                [1.0],
+                "read only /joy (read_messages(path, topics=['/joy'])), and count from the first Joy.",
+            ),
+            bag(
+                "a Joy with no axes",
+                [("/joy", 0.0, _joy(rh=0.7)), ("/joy", 0.2, _joy(axes=[]))],
+                [0.2],
+                "a Joy with no axes has no stick pushed: it is released.",
+            ),
+        ],
+    )
 
 
 def check_peak_speed(func) -> Result:
@@ -114,8 +155,12 @@ def check_peak_speed(func) -> Result:
 
     def series(stamps, q):
         stamps = np.asarray(stamps, dtype=float)
-        return JointSeries("/Tank/joint_state", stamps, stamps - stamps[0] if len(stamps) else stamps,
-                           {"TURRET_Y": np.asarray(q, dtype=float), "TURRET_P": np.zeros(len(stamps))})
+        return JointSeries(
+            "/Tank/joint_state",
+            stamps,
+            stamps - stamps[0] if len(stamps) else stamps,
+            {"TURRET_Y": np.asarray(q, dtype=float), "TURRET_P": np.zeros(len(stamps))},
+        )
 
     def case(label, s, joint, expected, hint):
         call = f"peak_speed(a series: {label}, {joint!r})"
@@ -129,24 +174,64 @@ def check_peak_speed(func) -> Result:
             want_speed, want_at = expected
             same_at = (math.isnan(at) and math.isnan(want_at)) or abs(at - want_at) <= 1e-9
             if abs(speed - want_speed) > 1e-9 or not same_at:
-                raise CaseFailed(f"{call} returned ({speed:.6g}, {at:.6g}), expected ({want_speed:.6g}, {want_at:.6g}).",
-                                 hint)
+                raise CaseFailed(
+                    f"{call} returned ({speed:.6g}, {at:.6g}), expected ({want_speed:.6g}, {want_at:.6g}).", hint
+                )
+
         return Case(call, run, hint)
 
     t = [0.0, 0.02, 0.04, 0.06, 0.08]
-    return grade("Exercise 7.2, the turret's top speed", [
-        case("steady at 1 rad/s", series(t, [0.0, 0.02, 0.04, 0.06, 0.08]), "TURRET_Y", (1.0, 0.02),
-             "speed = |q[i+1] - q[i]| / (stamp[i+1] - stamp[i]); ties: the first pair."),
-        case("one fast step", series(t, [0.0, 0.02, 0.10, 0.12, 0.14]), "TURRET_Y", (4.0, 0.04),
-             "the time is the later stamp of the fastest pair."),
-        case("turning back", series(t, [0.5, 0.4, 0.1, 0.05, 0.0]), "TURRET_Y", (15.0, 0.04),
-             "a speed has no sign: take the absolute value."),
-        case("a state without the joint", series(t, [0.0, np.nan, 0.04, 0.06, 0.08]), "TURRET_Y", (1.0, 0.04),
-             "skip a state whose position is NaN (its message did not carry the joint): pair the usable ones."),
-        case("two states with one stamp", series([0.0, 0.02, 0.02, 0.04], [0.0, 0.02, 0.05, 0.06]), "TURRET_Y",
-             (1.0, 0.02), "a pair with no time between them has no speed: skip it (never divide by zero)."),
-        case("another joint", series(t, [0.0, 1.0, 2.0, 3.0, 4.0]), "TURRET_P", (0.0, 0.02),
-             "use series.positions[joint], the joint asked for."),
-        case("a single state", series([0.0], [0.3]), "TURRET_Y", (0.0, math.nan),
-             "with fewer than two usable states, return (0.0, math.nan)."),
-    ])
+    return grade(
+        "Exercise 7.2, the turret's top speed",
+        [
+            case(
+                "steady at 1 rad/s",
+                series(t, [0.0, 0.02, 0.04, 0.06, 0.08]),
+                "TURRET_Y",
+                (1.0, 0.02),
+                "speed = |q[i+1] - q[i]| / (stamp[i+1] - stamp[i]); ties: the first pair.",
+            ),
+            case(
+                "one fast step",
+                series(t, [0.0, 0.02, 0.10, 0.12, 0.14]),
+                "TURRET_Y",
+                (4.0, 0.04),
+                "the time is the later stamp of the fastest pair.",
+            ),
+            case(
+                "turning back",
+                series(t, [0.5, 0.4, 0.1, 0.05, 0.0]),
+                "TURRET_Y",
+                (15.0, 0.04),
+                "a speed has no sign: take the absolute value.",
+            ),
+            case(
+                "a state without the joint",
+                series(t, [0.0, np.nan, 0.04, 0.06, 0.08]),
+                "TURRET_Y",
+                (1.0, 0.04),
+                "skip a state whose position is NaN (its message did not carry the joint): pair the usable ones.",
+            ),
+            case(
+                "two states with one stamp",
+                series([0.0, 0.02, 0.02, 0.04], [0.0, 0.02, 0.05, 0.06]),
+                "TURRET_Y",
+                (1.0, 0.02),
+                "a pair with no time between them has no speed: skip it (never divide by zero).",
+            ),
+            case(
+                "another joint",
+                series(t, [0.0, 1.0, 2.0, 3.0, 4.0]),
+                "TURRET_P",
+                (0.0, 0.02),
+                "use series.positions[joint], the joint asked for.",
+            ),
+            case(
+                "a single state",
+                series([0.0], [0.3]),
+                "TURRET_Y",
+                (0.0, math.nan),
+                "with fewer than two usable states, return (0.0, math.nan).",
+            ),
+        ],
+    )

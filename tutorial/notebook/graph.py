@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from tutorial.notebook import session
 
 
-def graph_picture(ready: Callable[[object], bool] = lambda graph: True, timeout: float = 20.0,
-                  node_name: str = "rtt_notebook_graph"):
+def graph_picture(
+    ready: Callable[[object], bool] = lambda graph: True, timeout: float = 20.0, node_name: str = "rtt_notebook_graph"
+):
     """The ROS graph as seen from a new node: ``(Graph, PNG bytes)`` (kernel thread).
 
     Args:
@@ -22,7 +23,7 @@ def graph_picture(ready: Callable[[object], bool] = lambda graph: True, timeout:
     """
     import rclpy
 
-    from tutorial.graph_node import draw_graph, read_graph
+    from tutorial.ros.graph import draw_graph, read_graph
 
     session.init_ros()
     node = rclpy.create_node(node_name)

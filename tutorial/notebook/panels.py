@@ -49,9 +49,11 @@ class Panel:
         bundle = self.widget._repr_mimebundle_(**kwargs)
         text = f"{self.title}: {self.description} (a live panel: run this cell in JupyterLab to use it)"
         bundle["text/plain"] = text
-        bundle["text/html"] = (f'<div style="border: 1px solid #bbb; border-radius: 4px; padding: 6px 10px; '
-                               f'color: #444"><b>{html.escape(self.title)}</b>: {html.escape(self.description)}'
-                               "<br><i>A live panel: in JupyterLab this cell shows its controls.</i></div>")
+        bundle["text/html"] = (
+            f'<div style="border: 1px solid #bbb; border-radius: 4px; padding: 6px 10px; '
+            f'color: #444"><b>{html.escape(self.title)}</b>: {html.escape(self.description)}'
+            "<br><i>A live panel: in JupyterLab this cell shows its controls.</i></div>"
+        )
         return bundle
 
     def close(self, why: str = "closed by reset(): run this cell again to use it") -> None:
@@ -70,8 +72,10 @@ class RunControls(Panel):
     def __init__(self, run):
         import ipywidgets as w
 
-        super().__init__(f"Start/Stop for /{run.node_name}",
-                         "buttons that start and stop the run, and a line saying what it is doing")
+        super().__init__(
+            f"Start/Stop for /{run.node_name}",
+            "buttons that start and stop the run, and a line saying what it is doing",
+        )
         self.run = run
         self.start = w.Button(description="Start", button_style="success")
         self.stop = w.Button(description="Stop")

@@ -8,9 +8,9 @@ by side, with an animation of what the robot did.
 
 The commands are meshcat's own (``SetObject``, ``SetTransform``,
 ``SetAnimation``, packed with msgpack as its server stores them).
-:class:`SceneRecorder` collects them in place of a server and keeps the
+:class:`ViewRecording` collects them in place of a server and keeps the
 same scene tree meshcat's server keeps (``meshcat.servers.tree``), so a
-:class:`tutorial.scene.Scene` draws into it exactly as into a live page,
+:class:`tutorial.view.scene.Scene` draws into it exactly as into a live page,
 and the page replays the tree the way meshcat's own static page does.
 
 Size: meshcat's viewer script is 850 kB.  A page carries it once,
@@ -31,8 +31,8 @@ import gzip
 import html
 import json
 import re
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
 
@@ -40,7 +40,7 @@ DECIMALS = 4  # animation values: 0.1 mm, 1e-4 of a unit quaternion
 _UUID = re.compile(r"^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")
 
 
-class SceneRecorder:
+class ViewRecording:
     """A meshcat "window" that keeps the scene tree instead of sending it to a server.
 
     ``visualizer()`` gives a ``meshcat.Visualizer`` drawing into it.  The
@@ -50,7 +50,7 @@ class SceneRecorder:
     thread at a time.
     """
 
-    zmq_url = None  # tells tutorial.scene.Scene to send every command through send()
+    zmq_url = None  # tells tutorial.view.scene.Scene to send every command through send()
 
     def __init__(self):
         from meshcat.servers.tree import SceneTree
@@ -73,7 +73,7 @@ class SceneRecorder:
         return value
 
     def visualizer(self):
-        """A ``meshcat.Visualizer`` whose commands land in this recorder."""
+        """A ``meshcat.Visualizer`` whose commands land in this recording."""
         import meshcat
 
         return meshcat.Visualizer(window=self)
@@ -105,7 +105,7 @@ class SceneRecorder:
         elif kind == "set_animation":
             node.animation = packed
         else:
-            raise ValueError(f"SceneRecorder: meshcat command {kind!r} is not recorded")
+            raise ValueError(f"ViewRecording: meshcat command {kind!r} is not recorded")
 
     def commands(self) -> list[bytes]:
         """The packed commands that rebuild the scene, in meshcat's static-page order."""
@@ -123,8 +123,8 @@ class SceneRecorder:
         return out
 
 
-def record_scene(model, qpos, camera=None, root: str = "rtt") -> SceneRecorder:
-    """A recorder holding ``model`` drawn at one posture (no animation).
+def record_scene(model, qpos, camera=None, root: str = "rtt") -> ViewRecording:
+    """A recording holding ``model`` drawn at one posture (no animation).
 
     Args:
         model: the ``MjModel`` to draw.
@@ -134,9 +134,17 @@ def record_scene(model, qpos, camera=None, root: str = "rtt") -> SceneRecorder:
     return record_replay(model, [qpos], fps=1.0, camera=camera, root=root, animate=False)
 
 
-def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, root: str = "rtt",
-                  animate: bool = True, overlays=None, overlay_frames=None) -> SceneRecorder:
-    """A recorder holding ``model`` and a looping animation of ``frames``.
+def record_replay(
+    model,
+    frames: Sequence[np.ndarray],
+    fps: float,
+    camera=None,
+    root: str = "rtt",
+    animate: bool = True,
+    overlays=None,
+    overlay_frames=None,
+) -> ViewRecording:
+    """A recording holding ``model`` and a looping animation of ``frames``.
 
     Args:
         model: the ``MjModel`` the frames belong to.
@@ -145,8 +153,8 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
         camera: optional ``(position, target)`` for the initial view, m.
         root: the meshcat path everything is drawn under.
         animate: False draws the first frame only.
-        overlays: optional :class:`tutorial.overlays.Overlays` whose arrows to draw too,
-            as ``overlay_frames`` says: one :meth:`~tutorial.overlays.Overlays.snapshot`
+        overlays: optional :class:`tutorial.view.overlays.Overlays` whose arrows to draw too,
+            as ``overlay_frames`` says: one :meth:`~tutorial.view.overlays.Overlays.snapshot`
             per frame (the arrows of a run are not in ``qpos``).
 
     Raises:
@@ -155,14 +163,14 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
     import mujoco
     from meshcat.animation import Animation, AnimationClip
 
-    from tutorial.scene import Scene
+    from tutorial.view.scene import Scene
 
     if len(frames) == 0:
         raise ValueError("record_replay: no frames to record")
     if overlays is not None and len(overlay_frames or ()) != len(frames):
         raise ValueError(f"record_replay: {len(overlay_frames or ())} overlay snapshots for {len(frames)} frames")
-    recorder = SceneRecorder()
-    vis = recorder.visualizer()
+    recording = ViewRecording()
+    vis = recording.visualizer()
     data = mujoco.MjData(model)
     data.qpos[:] = frames[0]
     mujoco.mj_kinematics(model, data)
@@ -171,11 +179,11 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
     if camera is not None:
         scene.set_camera(*camera)
     if overlays is not None:
-        from tutorial.overlays import draw_arrow_snapshot
+        from tutorial.view.overlays import draw_arrow_snapshot
 
         draw_arrow_snapshot(vis, overlays, overlay_frames[0])
     if not animate or len(frames) < 2:
-        return recorder
+        return recording
     bodies = scene.moving_bodies
     # (frames, bodies, 7): position x y z, then quaternion x y z w (three.js order)
     poses = np.empty((len(frames), len(bodies), 7))
@@ -194,11 +202,11 @@ def record_replay(model, frames: Sequence[np.ndarray], fps: float, camera=None, 
             clip.set_property(int(frame), "quaternion", "quaternion", poses[frame, k, 3:].tolist())
         animation.clips[vis[scene.body_path(body)].path] = clip
     if overlays is not None:
-        from tutorial.overlays import add_arrow_clips
+        from tutorial.view.overlays import add_arrow_clips
 
         add_arrow_clips(vis, overlays, overlay_frames, animation, fps, decimals=DECIMALS)
     vis.set_animation(animation, play=True, repetitions=np.inf)
-    return recorder
+    return recording
 
 
 def _key_frames(track: np.ndarray) -> np.ndarray:
@@ -251,7 +259,7 @@ body {{ margin: 0; display: flex; height: 100vh; background: #fff; font: 12px sa
 """
 
 
-def page_html(scenes: Sequence[SceneRecorder], labels: Sequence[str] = (), title: str = "recording") -> str:
+def page_html(scenes: Sequence[ViewRecording], labels: Sequence[str] = (), title: str = "recording") -> str:
     """One HTML page showing ``scenes`` side by side, each with an optional label.
 
     Args:
@@ -263,16 +271,23 @@ def page_html(scenes: Sequence[SceneRecorder], labels: Sequence[str] = (), title
         A complete page that needs no server and no network.
     """
     panes = "\n".join(
-        f'<div class="pane">' + (f'<div class="label">{html.escape(label)}</div>' if label else "")
+        '<div class="pane">'
+        + (f'<div class="label">{html.escape(label)}</div>' if label else "")
         + f'<div class="view" id="view{i}"></div></div>'
         for i, label in enumerate(list(labels) + [""] * (len(scenes) - len(labels)))
     )
     encoded = [[base64.b64encode(c).decode("ascii") for c in s.commands()] for s in scenes]
-    return _PAGE.format(title=html.escape(title), panes=panes, script=_viewer_script_gzip_base64(),
-                        scenes=json.dumps(encoded, separators=(",", ":")))
+    return _PAGE.format(
+        title=html.escape(title),
+        panes=panes,
+        script=_viewer_script_gzip_base64(),
+        scenes=json.dumps(encoded, separators=(",", ":")),
+    )
 
 
 def iframe_html(page: str, height: int = 380) -> str:
     """``page`` in an ``<iframe srcdoc=...>``: how a notebook output or a book page embeds it."""
-    return (f'<div><iframe srcdoc="{html.escape(page, quote=True)}" '
-            f'style="width: 100%; height: {int(height)}px; border: none"></iframe></div>')
+    return (
+        f'<div><iframe srcdoc="{html.escape(page, quote=True)}" '
+        f'style="width: 100%; height: {int(height)}px; border: none"></iframe></div>'
+    )

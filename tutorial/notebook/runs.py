@@ -21,15 +21,15 @@ from __future__ import annotations
 import threading
 from pathlib import Path
 
+from tutorial.core.project import Project, load_project
 from tutorial.notebook import session
-from tutorial.project import Project, load_project
 
 
 def load(project: str | Path | Project) -> Project:
     """A project: a file name in ``project/``, a path, or an already loaded :class:`Project`.
 
     Raises:
-        tutorial.project.ProjectError: the file is missing or wrong (the message names it).
+        tutorial.core.project.ProjectError: the file is missing or wrong (the message names it).
     """
     if isinstance(project, Project):
         return project
@@ -38,7 +38,7 @@ def load(project: str | Path | Project) -> Project:
 
 
 def _headless_app(project, duration: float, node_name: str, realtime: bool, output, attach, node=None):
-    """An unopened headless :class:`tutorial.app.App` on a node that is never spun, and that node.
+    """An unopened headless :class:`tutorial.core.app.App` on a node that is never spun, and that node.
 
     Nothing spins the node, so no subscription callback ever runs: no message
     from the network (a teleop panel, an ``rtt-joy`` in a terminal) can
@@ -46,12 +46,19 @@ def _headless_app(project, duration: float, node_name: str, realtime: bool, outp
     """
     import rclpy
 
-    from tutorial.app import App
+    from tutorial.core.app import App
 
     session.init_ros()
     node = node if node is not None else rclpy.create_node(node_name)
-    app = App(load(project), node=node, headless=True, realtime_sync=realtime, duration=duration,
-              output=output or (lambda record: None), attach=attach)
+    app = App(
+        load(project),
+        node=node,
+        headless=True,
+        realtime_sync=realtime,
+        duration=duration,
+        output=output or (lambda record: None),
+        attach=attach,
+    )
     return app, node
 
 
@@ -66,15 +73,16 @@ def _run_to_end(app, node) -> dict:
     return app.summary()
 
 
-def run_headless(project, duration: float, attach=(), output=None, node_name: str = "rtt_headless",
-                 realtime: bool = False, node=None):
+def run_headless(
+    project, duration: float, attach=(), output=None, node_name: str = "rtt_headless", realtime: bool = False, node=None
+):
     """Run a project to its end on this thread, headless, deaf to the network: deterministic.
 
     Args:
         project: a project (see :func:`load`).
         duration: simulated seconds.
         attach: extra ``(body name, controller name, controller instance)`` to
-            attach first (as :class:`tutorial.app.App` takes them).
+            attach first (as :class:`tutorial.core.app.App` takes them).
         output: called with each status record (default: dropped).
         node_name: the run's node name.
         realtime: keep simulated time with wall time (False: as fast as possible).
@@ -85,7 +93,7 @@ def run_headless(project, duration: float, attach=(), output=None, node_name: st
         hold the final state).
 
     Raises:
-        tutorial.app.ControllerError: a controller refused to configure.
+        tutorial.core.app.ControllerError: a controller refused to configure.
 
     Its node is never spun (no subscription callback runs), so the same
     arguments give the same numbers on every run.
@@ -94,41 +102,48 @@ def run_headless(project, duration: float, attach=(), output=None, node_name: st
     return _run_to_end(app, node), app
 
 
-def run_project(project, duration: float, node_name: str = "rtt_scripted", scripted: bool = True,
-                fps: float = 30.0, realtime: bool = False, script: str = "drive"):
+def run_project(
+    project,
+    duration: float,
+    node_name: str = "rtt_scripted",
+    scripted: bool = True,
+    fps: float = 30.0,
+    realtime: bool = False,
+    script: str = "drive",
+):
     """Run a project to its end on this thread with the demo script: the same numbers every run.
 
     Args:
         project: a project (see :func:`load`).
         duration: simulated seconds.
         node_name: the run's node name (not ``rtt``: a live run may be using that one).
-        scripted: feed the demo script (:mod:`tutorial.scripted_input`) to the
+        scripted: feed the demo script (:mod:`tutorial.joystick.scripted`) to the
             project's ``RttTankController`` by simulated time, repeated at 20 Hz.
         fps: frame rate of the recorded states.
         realtime: keep simulated time with wall time (False: as fast as possible).
-        script: which demo script, a key of :data:`tutorial.joy_input.SCRIPTS`
+        script: which demo script, a key of :data:`tutorial.joystick.sources.SCRIPTS`
             (``"drive"``, or ``"wall"``: Step 5's wall ramming).
 
     Returns:
-        ``(summary, app, recorder)``: the exit summary, the closed app (its
-        bodies hold the final state) and the :class:`tutorial.recorder.StateRecorder`.
+        ``(summary, app, trajectory)``: the exit summary, the closed app (its
+        bodies hold the final state) and the :class:`tutorial.core.trajectory.TrajectoryLog`.
 
     Deaf to the network, as :func:`run_headless`; what it publishes still goes out.
     """
-    from tutorial.joy_input import SCRIPTS
-    from tutorial.recorder import StateRecorder
-    from tutorial.scripted_input import ScriptedJoy
+    from tutorial.core.trajectory import TrajectoryLog
+    from tutorial.joystick.scripted import ScriptedJoy
+    from tutorial.joystick.sources import SCRIPTS
 
     proj = load(project)
     body = next(m.name for m in proj.models if m.controllers)
-    recorder = StateRecorder(fps)
-    attach = [(body, "Recorder", recorder)]
+    trajectory = TrajectoryLog(fps)
+    attach = [(body, "Trajectory", trajectory)]
     if scripted:
         # The tank controller exists once the app has configured it: look it up then.
         joystick = ScriptedJoy(lambda: app.controller("RttTankController"), script=SCRIPTS[script])
         attach.insert(0, (body, "ScriptedJoy", joystick))
     app, node = _headless_app(proj, duration, node_name, realtime, None, attach)
-    return _run_to_end(app, node), app, recorder
+    return _run_to_end(app, node), app, trajectory
 
 
 class BackgroundApp:
@@ -141,17 +156,18 @@ class BackgroundApp:
         duration: stop after this many seconds (simulated, or wall time without a simulator).
         label: what the view's caption calls this run (default: the node name).
 
-    The owner thread creates, opens, runs and closes the :class:`tutorial.app.App`;
+    The owner thread creates, opens, runs and closes the :class:`tutorial.core.app.App`;
     it owns everything the app's main thread owns.  Every method may be called
     from any thread.  :meth:`close` (what ``reset()`` calls) stops the run and
     turns its view into a recording.
 
     Raises:
-        tutorial.project.ProjectError: the project cannot be loaded.
+        tutorial.core.project.ProjectError: the project cannot be loaded.
     """
 
-    def __init__(self, project, node_name: str, headless: bool = False, duration: float | None = None,
-                 label: str | None = None):
+    def __init__(
+        self, project, node_name: str, headless: bool = False, duration: float | None = None, label: str | None = None
+    ):
         from tutorial.notebook.views import LiveView
 
         self.project = load(project)
@@ -191,13 +207,19 @@ class BackgroundApp:
 
     # ---- the owner thread ---------------------------------------------------------------
     def _run(self) -> None:
-        from tutorial.app import App
+        from tutorial.core.app import App
 
         app = vis = None
         try:
             vis = self.view.visualizer() if self.view is not None else None
-            app = App(self.project, node_name=self.node_name, headless=self.headless, vis=vis,
-                      duration=self.duration, output=self._output)
+            app = App(
+                self.project,
+                node_name=self.node_name,
+                headless=self.headless,
+                vis=vis,
+                duration=self.duration,
+                output=self._output,
+            )
             self.app = app
             app.open()
             self._opened.set()
@@ -234,7 +256,7 @@ class BackgroundApp:
         return f"finished{at} (its duration was reached): press Start to run it again"
 
     # ---- any thread ---------------------------------------------------------------------
-    def start(self) -> "BackgroundApp":
+    def start(self) -> BackgroundApp:
         """Start the run (nothing happens if it is running).
 
         Raises:
@@ -284,7 +306,7 @@ class BackgroundApp:
         if joint < 0 or model.jnt_type[joint] != 0:  # mjJNT_FREE is 0
             raise ValueError(f"{body}'s root has no free joint: it does not move in the world")
         adr = model.jnt_qposadr[joint]
-        return [float(v) for v in app.sim.snapshot().qpos[adr:adr + 3]]
+        return [float(v) for v in app.sim.snapshot().qpos[adr : adr + 3]]
 
     def controller(self, name: str):
         """A configured controller of the running app, by name.

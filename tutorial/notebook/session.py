@@ -20,10 +20,10 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
-from tutorial import ros_env
+from tutorial.ros import env as ros_env
 
 TEST_MODE = os.environ.get("RTT_TEST_MODE") == "1"
 ROOT = Path(__file__).resolve().parent.parent.parent

@@ -14,12 +14,9 @@ some callback wrote in full and no lock is needed.
 
 from __future__ import annotations
 
-from tutorial import joy
+from tutorial.interfaces import joy
 from tutorial.notebook import session
 from tutorial.notebook.panels import Panel
-
-AUTOREPEAT = 20.0  # Hz, as rtt-joy and ROS 2's joy_node
-TOPIC = "/joy"
 
 
 class TeleopPanel(Panel):
@@ -28,8 +25,7 @@ class TeleopPanel(Panel):
     Args:
         node_name: the panel's node name.
 
-    QoS: reliable, keep last 10, as ``rtt-joy`` (a Joy is small; a
-    subscriber with queue 1 keeps only what it needs).
+    QoS: :func:`tutorial.interfaces.joy.joy_publisher_qos`, as ``rtt-joy``.
     """
 
     AXES = ("left H", "left V", "right H", "right V")
@@ -39,19 +35,23 @@ class TeleopPanel(Panel):
         import rclpy
         from sensor_msgs.msg import Joy
 
-        from tutorial.ros_env import SpinThread
+        from tutorial.ros.env import SpinThread
 
-        super().__init__(f"Teleop panel /{node_name}",
-                         f"sliders for the left and right sticks that publish {TOPIC} (sensor_msgs/Joy)")
+        super().__init__(
+            f"Teleop panel /{node_name}",
+            f"sliders for the left and right sticks that publish {joy.TOPIC} (sensor_msgs/Joy)",
+        )
         session.init_ros()
         self.node = rclpy.create_node(node_name)
-        self.publisher = self.node.create_publisher(Joy, TOPIC, 10)
+        self.publisher = self.node.create_publisher(Joy, joy.TOPIC, joy.joy_publisher_qos())
         self.msg_type = Joy
         self.published = 0
         self._axes = (0.0,) * joy.NUM_AXES  # replaced whole by the kernel thread, read by the timer
         self._listeners = -1
-        self.sliders = [w.FloatSlider(value=0.0, min=-1.0, max=1.0, step=0.05, description=d,
-                                      continuous_update=True) for d in self.AXES]
+        self.sliders = [
+            w.FloatSlider(value=0.0, min=-1.0, max=1.0, step=0.05, description=d, continuous_update=True)
+            for d in self.AXES
+        ]
         for s in self.sliders:
             s.observe(lambda change: self._changed(), names="value")
         self.center = w.Button(description="release sticks")
@@ -59,11 +59,12 @@ class TeleopPanel(Panel):
         self.gamepad = w.Controller(index=0)
         self.gamepad.observe(self._on_gamepad, names="axes")
         self.controls = [*self.sliders, self.center]
-        self.widget = w.VBox([w.HBox(self.sliders[:2]), w.HBox(self.sliders[2:]),
-                              w.HBox([self.center, self.line]), self.gamepad])
-        self.node.create_timer(1.0 / AUTOREPEAT, self.publish)
+        self.widget = w.VBox(
+            [w.HBox(self.sliders[:2]), w.HBox(self.sliders[2:]), w.HBox([self.center, self.line]), self.gamepad]
+        )
+        self.node.create_timer(1.0 / joy.AUTOREPEAT, self.publish)
         self.spin = SpinThread(self.node).start()
-        self.say(f"publishing {TOPIC} at {AUTOREPEAT:.0f} Hz")
+        self.say(f"publishing {joy.TOPIC} at {joy.AUTOREPEAT:.0f} Hz")
         session.register(self)
 
     def _on_gamepad(self, change) -> None:
@@ -95,9 +96,9 @@ class TeleopPanel(Panel):
         if listeners != self._listeners:
             self._listeners = listeners
             if listeners:
-                self.say(f"publishing {TOPIC} at {AUTOREPEAT:.0f} Hz to {listeners} subscriber(s)")
+                self.say(f"publishing {joy.TOPIC} at {joy.AUTOREPEAT:.0f} Hz to {listeners} subscriber(s)")
             else:
-                self.say(f"nothing subscribes to {TOPIC}: start the simulation to drive", warning=True)
+                self.say(f"nothing subscribes to {joy.TOPIC}: start the simulation to drive", warning=True)
 
     def release(self) -> None:
         """All sticks back to the centre (kernel thread)."""

@@ -53,7 +53,7 @@ class LiveView:
     SECONDS = 60.0  # the recording keeps the last this many seconds of the run
 
     def __init__(self, label: str, height: int = 380):
-        from tutorial.meshcat_server import start_server
+        from tutorial.view.meshcat_server import start_server
 
         self.label = label
         self.height = height
@@ -80,7 +80,7 @@ class LiveView:
         Args:
             model: the run's ``MjModel``.
             camera: ``(position, target)`` the run placed its camera at, m, for the recording.
-            overlays: the run's :class:`tutorial.overlays.Overlays` (arrows its controllers
+            overlays: the run's :class:`tutorial.view.overlays.Overlays` (arrows its controllers
                 draw), recorded with each frame; None when it has none.
         """
         with self._lock:
@@ -107,7 +107,7 @@ class LiveView:
 
     # ---- kernel thread ---------------------------------------------------------------------
     def recording(self):
-        """A :class:`tutorial.notebook.replay.SceneRecorder` of the last run, or None if nothing was drawn."""
+        """A :class:`tutorial.notebook.replay.ViewRecording` of the last run, or None if nothing was drawn."""
         with self._lock:
             model, camera, overlays, frames = self._model, self._camera, self._overlays, list(self._frames)
         if model is None or not frames:
@@ -182,16 +182,25 @@ def live_html(urls: list[str], frames: str, caption_id: str, what: str) -> str:
         what: what the frames show, for the notice (e.g. ``"simulation /rtt"``).
     """
     box_id = f"rtt-live-{uuid.uuid4().hex}"
-    notice = (f"Not live any more: the kernel that ran {what} was restarted or shut down, so nothing runs "
-              "here now. Run the section again for a live view.")
-    caption = (f'<div style="font-size: 90%"><b>{html.escape(what)}</b> (not live): its kernel has gone, '
-               "so nothing runs; run the section again for a live view.</div>")
+    notice = (
+        f"Not live any more: the kernel that ran {what} was restarted or shut down, so nothing runs "
+        "here now. Run the section again for a live view."
+    )
+    caption = (
+        f'<div style="font-size: 90%"><b>{html.escape(what)}</b> (not live): its kernel has gone, '
+        "so nothing runs; run the section again for a live view.</div>"
+    )
 
     def js(value) -> str:  # a JavaScript literal that cannot end the script early
         return json.dumps(value).replace("</", "<\\/")
 
-    script = _WATCH % {"urls": js(urls), "notice": js(notice), "caption": js(caption),
-                       "box_id": js(box_id), "caption_id": js(caption_id)}
+    script = _WATCH % {
+        "urls": js(urls),
+        "notice": js(notice),
+        "caption": js(caption),
+        "box_id": js(box_id),
+        "caption_id": js(caption_id),
+    }
     return f'<div id="{box_id}" style="position: relative">{frames}</div>{script}'
 
 
@@ -204,10 +213,16 @@ class _Display:
         self.views = views
         self.height = height
         self.caption_id = f"rtt-caption-{uuid.uuid4().hex}"
-        frames = "".join(f'<iframe src="{v.url}" style="flex: 1; min-width: 0; height: {height}px; border: none">'
-                         "</iframe>" for v in views)
-        page = live_html([v.url for v in views], f'<div style="display: flex; gap: 4px">{frames}</div>',
-                         self.caption_id, " and ".join(v.label for v in views))
+        frames = "".join(
+            f'<iframe src="{v.url}" style="flex: 1; min-width: 0; height: {height}px; border: none"></iframe>'
+            for v in views
+        )
+        page = live_html(
+            [v.url for v in views],
+            f'<div style="display: flex; gap: 4px">{frames}</div>',
+            self.caption_id,
+            " and ".join(v.label for v in views),
+        )
         self.page = display(HTML(page), display_id=True)
         self.caption = display(HTML(self._caption()), display_id=True)
         for v in views:
@@ -234,18 +249,27 @@ class _Display:
             return
         scenes = [v.recording() for v in self.views]
         if any(s is None for s in scenes):
-            self.page.update(HTML("<p><i>This view closed before its run drew anything: "
-                                  "there is nothing to replay. Run the section again to see it live.</i></p>"))
+            self.page.update(
+                HTML(
+                    "<p><i>This view closed before its run drew anything: "
+                    "there is nothing to replay. Run the section again to see it live.</i></p>"
+                )
+            )
         else:
             labels = [f"{v.label}: recorded, {v.recorded_seconds():.1f} s" for v in self.views]
             page = replay.page_html(scenes, labels, title="recording")
             self.page.update(HTML(replay.iframe_html(page, self.height)))
         seconds = ", ".join(f"{v.label} {v.recorded_seconds():.1f} s" for v in self.views)
-        self.caption.update(HTML(
-            '<div style="font-size: 90%"><b>Recorded</b> (' + html.escape(seconds) + f", {LiveView.FPS:.0f} frames/s): "
-            "the run has ended and its live page is gone, so this is a recording of what it showed. "
-            "Drag to turn, scroll to zoom; <i>Open Controls, Animations</i> pauses it. "
-            "Run the section again for a live view.</div>"))
+        self.caption.update(
+            HTML(
+                '<div style="font-size: 90%"><b>Recorded</b> ('
+                + html.escape(seconds)
+                + f", {LiveView.FPS:.0f} frames/s): "
+                "the run has ended and its live page is gone, so this is a recording of what it showed. "
+                "Drag to turn, scroll to zoom; <i>Open Controls, Animations</i> pauses it. "
+                "Run the section again for a live view.</div>"
+            )
+        )
 
 
 def show(*views: LiveView, height: int | None = None) -> None:
@@ -263,21 +287,21 @@ class MeshcatPage:
     """A meshcat page to draw in by hand, shown inline; a still picture of it stays after it closes.
 
     ``vis`` is a ``meshcat.Visualizer`` that draws both into the live page
-    and into a recorder, so :meth:`close` can leave the scene as it was.
+    and into a recording, so :meth:`close` can leave the scene as it was.
     Owned by the kernel thread (meshcat's socket is not thread-safe).
     """
 
     def __init__(self, label: str = "meshcat page", height: int = 350):
         import meshcat
 
-        from tutorial.meshcat_server import start_server
+        from tutorial.view.meshcat_server import start_server
 
         self.label = label
         self.height = height
         self.server = start_server()
         self.url = self.server.web_url
-        self.recorder = replay.SceneRecorder()
-        self.vis = meshcat.Visualizer(window=_Tee(self.server.visualizer().window, self.recorder))
+        self.recording = replay.ViewRecording()
+        self.vis = meshcat.Visualizer(window=_Tee(self.server.visualizer().window, self.recording))
         self.closed = False
         self._handle = None
         session.register(self)
@@ -289,8 +313,10 @@ class MeshcatPage:
         caption_id = f"rtt-caption-{uuid.uuid4().hex}"
         frame = f'<iframe src="{self.url}" style="width: 100%; height: {self.height}px; border: none"></iframe>'
         self._handle = display(HTML(live_html([self.url], frame, caption_id, self.label)), display_id=True)
-        self._caption = display(HTML(f'<div id="{caption_id}" style="font-size: 90%"><b>{html.escape(self.label)}</b> '
-                                     "(live)</div>"), display_id=True)
+        self._caption = display(
+            HTML(f'<div id="{caption_id}" style="font-size: 90%"><b>{html.escape(self.label)}</b> (live)</div>'),
+            display_id=True,
+        )
 
     def close(self) -> None:
         """Leave a still copy of the scene in the output, then stop the server (kernel thread)."""
@@ -300,26 +326,30 @@ class MeshcatPage:
             return
         self.closed = True
         if self._handle is not None:
-            page = replay.page_html([self.recorder], [self.label], title=self.label)
+            page = replay.page_html([self.recording], [self.label], title=self.label)
             self._handle.update(HTML(replay.iframe_html(page, self.height)))
-            self._caption.update(HTML(f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> '
-                                      "(a saved copy: the live page has closed; drag to turn, scroll to zoom)</div>"))
+            self._caption.update(
+                HTML(
+                    f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> '
+                    "(a saved copy: the live page has closed; drag to turn, scroll to zoom)</div>"
+                )
+            )
         self.server.close()
 
 
 class _Tee:
-    """A meshcat window that sends each command to a live window and to a recorder."""
+    """A meshcat window that sends each command to a live window and to a recording."""
 
-    zmq_url = None  # one path for every command, so the recorder sees them all
+    zmq_url = None  # one path for every command, so the recording sees them all
 
-    def __init__(self, live, recorder: replay.SceneRecorder):
+    def __init__(self, live, recording: replay.ViewRecording):
         self.live = live
-        self.recorder = recorder
+        self.recording = recording
         self.web_url = live.web_url
 
     def send(self, command) -> None:
         self.live.send(command)
-        self.recorder.send(command)
+        self.recording.send(command)
 
 
 def show_recording(model, frames, fps: float, label: str, camera=None, height: int = 380) -> None:

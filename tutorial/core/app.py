@@ -1,0 +1,456 @@
+"""Run a project: build the world, attach controllers, simulate and show it.
+
+This is what Choreonoid does when it opens a ``.cnoid`` project, and what
+``rtt-run`` and the notebooks use.  Threads:
+
+* **main thread** (the one that creates the :class:`App`): owns the project's
+  bodies (over ``App.data``), the meshcat scene and the :class:`MainLoop`;
+  runs ``configure``/``unconfigure`` and every ``call_later`` call.
+* **spin thread** (:class:`tutorial.ros.env.SpinThread`): runs the node's
+  subscription callbacks.
+* **simulation thread** (:class:`tutorial.core.simulator.Simulator`, only when the
+  project has a simulator): owns the simulation's ``MjData``; the main thread
+  copies a snapshot of it once per frame to draw.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections.abc import Callable
+
+import mujoco
+
+from tutorial.core.body import Body
+from tutorial.core.call_later import MainLoop
+from tutorial.core.controller import ControllerConfig
+from tutorial.core.project import Project, check_parameter
+from tutorial.core.simulator import Attachment, Simulator
+from tutorial.core.world import build_world
+from tutorial.view.overlays import MeshcatOverlays, Overlays
+
+DEFAULT_NODE_NAME = "rtt"
+FRAME_RATE = 60.0  # Hz, the most often the scene is redrawn
+SETTLE = 0.004  # s: a frame waits this long after a change for more of the same burst (see App.next_frame_due)
+SETTLE_MAX = 0.008  # s: ... and at most this long after the first change it shows
+GRAPH_CHECK_PERIOD = 2.0  # s, how often the node graph is checked for a twin name
+
+
+class ControllerError(RuntimeError):
+    """A controller refused a lifecycle step or raised."""
+
+
+class App:
+    """One running project.
+
+    Args:
+        project: the loaded project.
+        node: the ``rclpy`` node to use (its callbacks must be spun by the
+            caller), or None to create ``node_name`` and spin it here.
+        node_name: name of the node created when ``node`` is None.
+        headless: no meshcat server and scene.
+        realtime_sync: override the project's ``simulator.realtime_sync``.
+        duration: stop after this many seconds: simulated time when the
+            project simulates, wall-clock time otherwise (None: until stopped).
+        output: called with one dict per status line or event (main thread).
+        vis: an existing ``meshcat.Visualizer`` to draw in (notebooks),
+            instead of starting a server; the owner thread must own it.
+        attach: extra ``(body name, controller name, controller instance)``
+            to attach in code, before the project's own (as adding a
+            controller item in Choreonoid's GUI).
+        record_timing: keep each step's lateness in ``sim.lateness`` (benchmarks).
+
+    Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
+    becomes the owner of everything the main thread owns.
+    """
+
+    def __init__(
+        self,
+        project: Project,
+        node=None,
+        node_name: str = DEFAULT_NODE_NAME,
+        headless: bool = False,
+        realtime_sync: bool | None = None,
+        duration: float | None = None,
+        output: Callable[[dict], None] | None = None,
+        vis=None,
+        attach=(),
+        record_timing: bool = False,
+    ):
+        self.project = project
+        self.node = node
+        self.node_name = node_name
+        self.headless = headless
+        self.realtime_sync = realtime_sync
+        self.duration = duration
+        self.output = output or (lambda record: print(record, flush=True))
+        self.vis = vis
+        self.attach = list(attach)
+        self.record_timing = record_timing
+        self.loop = MainLoop()
+        self.log = logging.getLogger("rtt")
+        self.server = None
+        self.scene = None
+        self.camera = None  # (position, target) of the view's camera, m, once the view is open
+        self.overlays = Overlays()  # what controllers draw over the view (main thread)
+        self.overlay_view = None
+        self.sim: Simulator | None = None
+        self.spin = None
+        self._own_node = node is None
+        self.controllers: list[tuple[str, object, str]] = []  # (name, controller, body name), configured
+        self._unconfigured = False
+        self.warned_duplicate = False
+        self._started = None
+        self._last_frame = 0.0  # time.monotonic() of the last frame, on the frame clock
+        self._changes_seen = 0  # self.changes() when step() last looked
+        self._first_change = None  # time.monotonic() of the first change not yet drawn, or None
+        self._last_change = None  # ... and of the newest
+        self._drawn_changes: dict[tuple[str, str], int] = {}  # each burst member's count at the last frame
+        self._drawn_step = -1
+        self.stop_requested = False
+
+    # ---- lifecycle (owner thread) -------------------------------------------------
+    def open(self) -> App:
+        """Build the world, configure the controllers, start simulation and view.
+
+        Raises:
+            ValueError: a model does not load.
+            ControllerError: a controller refused to configure or to start.
+        """
+        settings = self.project.simulator
+        kwargs = {} if settings is None else {"time_step": settings.time_step, "gravity": settings.gravity}
+        self.model = build_world(self.project.models, **kwargs)
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_forward(self.model, self.data)
+        self.bodies = {m.name: Body(self.model, self.data, m.name) for m in self.project.models}
+        if self.node is None:
+            from rclpy.node import Node
+
+            from tutorial.ros.env import SpinThread
+
+            self.node = Node(self.node_name)
+            self.spin = SpinThread(self.node, hand_over_to=self.loop)
+        for body_name, name, controller in self.attach:
+            self._configure_instance(body_name, name, controller, {})
+        for entry in self.project.models:
+            for c in entry.controllers:
+                self._configure_instance(entry.name, c.name, c.cls(), self._ros_parameters(c))
+        self.node_fqn = self.node.get_fully_qualified_name()
+        if self.spin is not None:
+            self.spin.start()
+        self.loop.call_every(GRAPH_CHECK_PERIOD, self.check_node_name)
+        if not self.headless:
+            self._open_view()
+        if settings is not None:
+            realtime = settings.realtime_sync if self.realtime_sync is None else self.realtime_sync
+            sim_data = mujoco.MjData(self.model)
+            mujoco.mj_forward(self.model, sim_data)
+            attachments = [Attachment(n, c, b) for n, c, b in self.controllers]
+            self.sim = Simulator(
+                self.model,
+                sim_data,
+                attachments,
+                node=self.node,
+                realtime_sync=realtime,
+                duration=self.duration,
+                record_timing=self.record_timing,
+            ).start()
+        self._started = time.monotonic()
+        return self
+
+    def controller(self, name: str):
+        """A configured controller by name (any thread, after :meth:`open` has configured it).
+
+        Raises:
+            KeyError: no controller of that name.
+        """
+        for n, c, _ in self.controllers:
+            if n == name:
+                return c
+        raise KeyError(f"no controller named {name!r}")
+
+    def _configure_instance(self, body_name: str, name: str, controller, params: dict) -> None:
+        config = ControllerConfig(
+            name=name,
+            body=self.bodies[body_name],
+            node=self.node,
+            parameters=params,
+            call_later=self.loop.call_later,
+            call_every=self.loop.call_every,
+            output=self.output,
+            log=logging.getLogger(f"rtt.{name}"),
+            overlays=self.overlays,
+        )
+        try:
+            ok = controller.configure(config)
+        except Exception as exc:
+            raise ControllerError(f"controller {name} failed to configure: {exc!r}") from exc
+        if not ok:
+            raise ControllerError(f"controller {name} refused to configure")
+        self.controllers.append((name, controller, body_name))
+
+    def _ros_parameters(self, entry) -> dict:
+        """Declare the controller's parameters on the node: ``<controller>.<parameter>``.
+
+        The project's value is the default; ``--ros-args -p RttJointStatePublisher.rate:=100``
+        overrides it.  A wrong type is a ControllerError naming the parameter.
+        """
+        from rcl_interfaces.msg import ParameterDescriptor
+
+        values = dict(entry.parameters)
+        for name, (typ, _default, description) in entry.cls.PARAMETERS.items():
+            full = f"{entry.name}.{name}"
+            if not self.node.has_parameter(full):
+                self.node.declare_parameter(
+                    full, values[name], ParameterDescriptor(description=description), ignore_override=False
+                )
+            value = self.node.get_parameter(full).value
+
+            def fail(msg, full=full):
+                return ControllerError(f"parameter {full}: {msg}")
+
+            values[name] = check_parameter(typ, value, fail)
+        return values
+
+    def _open_view(self) -> None:
+        from tutorial.view.scene import Scene
+
+        if self.vis is None:
+            from tutorial.view.meshcat_server import start_server
+
+            self.server = start_server()
+            self.vis = self.server.visualizer()
+        self.scene = Scene(self.vis, self.model)
+        self.scene.build(self.data)
+        self.overlay_view = MeshcatOverlays(self.vis, self.overlays)
+        root = self.bodies[self.project.models[-1].name].root_pose()[0]
+        if self.project.simulator is not None:
+            self.camera = (root + [-1.4, -2.2, 1.6], root + [1.0, 0.2, 0.0])  # the robot in its room
+        else:
+            self.camera = (root + [-1.1, -1.2, 0.8], root)  # the robot, close up
+        self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it
+        self.output(
+            {
+                "event": "meshcat",
+                "node": self.node_fqn,
+                "url": self.vis.url() if self.server is None else self.server.web_url,
+            }
+        )
+
+    def step(self, timeout: float = 1.0 / FRAME_RATE) -> bool:
+        """Run posted calls, and draw a frame when there is something new to show (owner thread).
+
+        Waits for posted calls at most ``timeout`` s, and never past the time
+        the next frame is due (:meth:`next_frame_due`): a frame is drawn once a
+        burst of changes is complete or has settled, at most ``FRAME_RATE``
+        times a second.
+
+        Returns:
+            False when the app is done (duration reached, simulation ended or stop requested).
+        """
+        self.loop.run_once(max(0.0, min(timeout, self.next_frame_due() - time.monotonic())))
+        now = time.monotonic()
+        changes = self.changes()
+        if changes != self._changes_seen:
+            self._changes_seen = changes
+            if self._first_change is None:
+                self._first_change = now
+            self._last_change = now
+        due = self.next_frame_due()
+        if now >= due:
+            cap = self._last_frame + 1.0 / FRAME_RATE
+            # The frame clock advances one period per frame while a frame comes less than
+            # a period after it was allowed (a frame a little late does not push the next
+            # one back: 60 frames/s, not 59), else it restarts from now.  So frames come
+            # at most FRAME_RATE a second on average, and one may follow a late one sooner.
+            self._last_frame = cap if cap <= now < cap + 1.0 / FRAME_RATE else now
+            self._first_change = self._last_change = None
+            self._drawn_changes = dict(self._burst_members())
+            self._draw()
+        return not self.done()
+
+    def next_frame_due(self) -> float:
+        """The ``time.monotonic()`` at which the next frame is due (owner thread); ``inf``: nothing new to show.
+
+        While the project simulates, every frame has something new: frames
+        come ``1/FRAME_RATE`` s apart.  Otherwise a frame is due when the view
+        has changed (:meth:`changes`).  The states of one simulation step
+        arrive as a burst of messages, one per robot, and are drawn together:
+        at once when every body (and arrow) that has ever changed has changed
+        again since the last frame (the burst is complete, :meth:`burst_complete`,
+        which says what it cannot know); else
+        ``SETTLE`` s after the newest change, for the rest of the burst, and at
+        most ``SETTLE_MAX`` s after the first change, so a steady stream of
+        changes is still drawn.  Never before the frame clock allows
+        (``1/FRAME_RATE`` s per frame on average, see :meth:`step`).  A frame
+        drawn at a fixed 60 Hz, whatever came, showed a state that arrived
+        just after a frame 16.7 ms late (``book/benchmarks.md``).
+        """
+        cap = self._last_frame + 1.0 / FRAME_RATE
+        if self.sim is not None and not self.sim.finished.is_set():
+            return cap
+        if self._first_change is None:
+            return math.inf
+        if self.burst_complete():
+            return cap
+        return max(cap, min(self._last_change + SETTLE, self._first_change + SETTLE_MAX))
+
+    def burst_complete(self) -> bool:
+        """True when everything that has ever changed the view has changed since the last frame (owner thread).
+
+        The members of a burst are the bodies (their kinematic-state
+        changes) and the overlay arrows (their versions) that have changed at
+        least once.  What it cannot know:
+
+        - a member whose updates stopped (its publisher ended) keeps it False:
+          frames then wait ``SETTLE`` s after the newest change;
+        - members updated at different rates (a 20 Hz IMU's arrows beside
+          50 Hz joint states) complete it only when their updates coincide;
+        - states faster than ``FRAME_RATE``: a burst completed early waits for
+          the frame clock, and the frame may show part of the next burst too;
+        - the first state of a new robot alone completes it, once.
+        """
+        moved_since = [count > self._drawn_changes.get(key, 0) for key, count in self._burst_members() if count]
+        return bool(moved_since) and all(moved_since)
+
+    def _burst_members(self):
+        """((kind, name), change count) of every body and overlay arrow (owner thread)."""
+        for name, b in self.bodies.items():
+            yield ("body", name), b.kinematic_state_changes
+        for name, a in self.overlays.arrows.items():
+            yield ("arrow", name), a.version
+
+    def changes(self) -> int:
+        """Counts what changed the view (owner thread): bodies' kinematic-state changes and arrows.
+
+        A controller that moves a body calls ``body.notify_kinematic_state_change()``,
+        as in Choreonoid, and that is what makes the view redraw.
+        """
+        return sum(count for _, count in self._burst_members())
+
+    def _sync_from_simulation(self) -> None:
+        """Copy the simulation's newest snapshot into the main thread's data (owner thread)."""
+        if self.sim is not None:
+            snap = self.sim.snapshot()
+            if snap.step != self._drawn_step:
+                self._drawn_step = snap.step
+                self.data.qpos[:] = snap.qpos
+                self.data.time = snap.time
+                mujoco.mj_kinematics(self.model, self.data)
+
+    def _draw(self) -> None:
+        self._sync_from_simulation()
+        if self.scene is not None:
+            self.scene.update(self.data)
+            self.overlay_view.update()
+
+    def request_stop(self) -> None:
+        """Ask the app to finish its current step and end (any thread, or a signal handler)."""
+        self.stop_requested = True
+        self.loop.wake()
+
+    def done(self) -> bool:
+        if self.stop_requested:
+            return True
+        if self.spin is not None and self.spin.error is not None:
+            return True  # a subscription callback raised and spinning ended: summary() reports it
+        if self.sim is not None:
+            return self.sim.finished.is_set()
+        return self.duration is not None and time.monotonic() - self._started >= self.duration
+
+    def run(self) -> None:
+        """Step until done (owner thread); Ctrl-C propagates as KeyboardInterrupt."""
+        while self.step():
+            pass
+        self._draw()  # show the final state
+
+    def close(self) -> None:
+        """Stop the simulation, unconfigure the controllers, stop ROS and meshcat (owner thread)."""
+        if self.sim is not None:
+            self.sim.request_stop()
+            self.sim.join(5.0)
+            self._sync_from_simulation()  # the bodies end in the simulation's final state
+        if self.spin is not None:
+            self.spin.stop()
+        # Work handed over before the spin thread stopped still runs, so the
+        # last state received is the last state shown.
+        self.loop.process_pending()
+        if not self._unconfigured:
+            self._unconfigured = True
+            for name, controller, _ in reversed(self.controllers):
+                try:
+                    controller.unconfigure()
+                except Exception as exc:  # noqa: BLE001 - close the rest anyway
+                    self.log.error("controller %s failed to unconfigure: %r", name, exc)
+        if self._own_node and self.node is not None:
+            self.node.destroy_node()
+        if self.scene is not None:
+            self.scene.close()
+        if self.server is not None:
+            self.server.close()
+
+    # ---- monitoring ---------------------------------------------------------------
+    def check_node_name(self) -> None:
+        """Warn when another node on the graph has this node's name (main thread).
+
+        ROS 2 lets two nodes share a name, but tools cannot tell them apart and
+        their parameters collide: rename one with ``--ros-args -r __node:=NAME``.
+        """
+        me = (self.node.get_name(), self.node.get_namespace())
+        count = sum(1 for n in self.node.get_node_names_and_namespaces() if n == me)
+        if count > 1 and not self.warned_duplicate:
+            self.warned_duplicate = True
+            self.output(
+                {
+                    "event": "warning",
+                    "node": self.node_fqn,
+                    "message": f"{count} nodes are named {self.node_fqn}; "
+                    "rename this one with --ros-args -r __node:=NAME",
+                }
+            )
+        elif count <= 1:
+            self.warned_duplicate = False
+
+    def summary(self) -> dict:
+        """Exit summary: times, root poses and joint positions (owner thread, after run)."""
+        record: dict = {"event": "summary", "project": self.project.name, "node": getattr(self, "node_fqn", None)}
+        if self.sim is not None:
+            record.update(
+                simulated_time=round(self.sim.steps * self.sim.time_step, 6),
+                wall_time=round(self.sim.wall_time, 3),
+                real_time_factor=round(self.sim.real_time_factor, 3),
+                steps=self.sim.steps,
+            )
+            if self.sim.error:
+                record["error"] = self.sim.error
+        else:
+            record["wall_time"] = round(time.monotonic() - self._started, 3) if self._started else 0.0
+        bodies = {}
+        for entry in self.project.models:
+            body = self.bodies[entry.name]
+            if body.num_joints == 0 and not entry.controllers:
+                continue  # the room: nothing to report
+            pos, quat = body.root_pose()
+            w, x, y, z = (float(v) for v in quat)
+            bodies[entry.name] = {
+                "root_position": [round(float(v), 6) for v in pos],
+                "root_yaw": round(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)), 6),
+                "joint_positions": {k: round(v, 9) for k, v in body.joint_positions().items()},
+            }
+        record["bodies"] = bodies
+        if self.spin is not None and self.spin.error is not None:
+            import traceback
+
+            text = "a subscription callback raised; callbacks stopped:\n" + "".join(
+                traceback.format_exception(self.spin.error)
+            )
+            record["error"] = record["error"] + "\n" + text if record.get("error") else text
+        controllers = {}
+        for name, controller, _ in self.controllers:
+            s = controller.summary()
+            if s:
+                controllers[name] = s
+        if controllers:
+            record["controllers"] = controllers
+        return record

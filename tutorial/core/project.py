@@ -1,0 +1,286 @@
+"""Project files: the ``.cnoid`` analog, in YAML.
+
+A project says which models make the world, which controllers attach to
+which body, and whether (and how) to simulate.  Example (``project/step1.yaml``)::
+
+    name: step1
+    models:
+      - name: Room
+        file: ../model/room.xml
+      - name: Tank
+        file: ../model/tank.xml
+        controllers:
+          - name: RttTankController
+            class: tutorial.controllers.tank_controller:RttTankController
+    simulator:
+      time_step: 0.001
+      realtime_sync: true
+
+Paths are relative to the project file.  A project without ``simulator`` only
+loads its models and configures their controllers (Step 3's viewer).
+
+Every mistake raises one :class:`ProjectError` naming the file and the key,
+e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from tutorial.core.controller import SimpleController
+from tutorial.core.world import ModelEntry
+
+NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+class ProjectError(ValueError):
+    """A project file cannot be used; the message names the file and the key."""
+
+
+@dataclass
+class ControllerEntry:
+    """A controller attached to a body.
+
+    Attributes:
+        name: its name (also the prefix of its ROS parameters).
+        cls: the controller class, a :class:`SimpleController` subclass.
+        class_path: ``module:Class`` as written in the project.
+        parameters: validated parameter values (project values over defaults).
+    """
+
+    name: str
+    cls: type
+    class_path: str
+    parameters: dict = field(default_factory=dict)
+
+
+@dataclass
+class SimulatorSettings:
+    """Simulator settings: ``time_step`` in s, ``realtime_sync``, ``gravity`` (3,) m/s^2."""
+
+    time_step: float = 0.001
+    realtime_sync: bool = True
+    gravity: tuple = (0.0, 0.0, -9.80665)
+
+
+@dataclass
+class Project:
+    """A loaded, validated project file."""
+
+    path: Path
+    name: str
+    models: list[ModelEntry]
+    simulator: SimulatorSettings | None
+
+    def with_controller(self, model: str, name: str, cls: type, parameters: dict | None = None) -> Project:
+        """A copy of this project with one more controller attached to ``model``.
+
+        This is what adding a controller item under a body item does in
+        Choreonoid; a notebook attaches the class it has just built this way.
+
+        Args:
+            model: the model (body) name, e.g. ``Tank``.
+            name: the controller's name (also the prefix of its ROS parameters).
+            cls: the controller class, a :class:`SimpleController` subclass.
+            parameters: values for the class's ``PARAMETERS`` (defaults for the rest).
+
+        Raises:
+            ProjectError: no such model, a bad or repeated name, a class that is
+                not a controller, an unknown parameter or a value of the wrong type.
+
+        Any thread may call this; the project itself is not changed.
+        """
+        r = _Reader(self.path)
+        index = next((i for i, m in enumerate(self.models) if m.name == model), None)
+        if index is None:
+            raise r.fail("models", f"no model named {model!r}; the project has {[m.name for m in self.models]}")
+        key = f"models[{index}].controllers[{len(self.models[index].controllers)}]"
+        r.name(name, f"{key}.name")
+        if any(c.name == name for c in self.models[index].controllers):
+            raise r.fail(f"{key}.name", f"{name!r} is used twice on {model}")
+        if not (isinstance(cls, type) and issubclass(cls, SimpleController)):
+            raise r.fail(f"{key}.class", f"expected a SimpleController subclass, got {cls!r}")
+        params = _parameters(r, cls, parameters or {}, f"{key}.parameters")
+        entry = ControllerEntry(name, cls, f"{cls.__module__}:{cls.__qualname__}", params)
+        models = list(self.models)
+        models[index] = dataclasses.replace(models[index], controllers=[*models[index].controllers, entry])
+        return dataclasses.replace(self, models=models)
+
+
+class _Reader:
+    """Walks the YAML tree, raising ProjectError with the file and key path."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def fail(self, key: str, message: str) -> ProjectError:
+        return ProjectError(f"{self.path}: {key}: {message}" if key else f"{self.path}: {message}")
+
+    def mapping(self, value: Any, key: str, allowed: dict[str, bool]) -> dict:
+        """Check a mapping's keys: ``allowed`` maps key -> required."""
+        if not isinstance(value, dict):
+            raise self.fail(key, f"expected a mapping, got {type(value).__name__}")
+        for k in value:
+            if k not in allowed:
+                raise self.fail(_join(key, str(k)), f"unknown key; allowed: {', '.join(allowed)}")
+        for k, required in allowed.items():
+            if required and k not in value:
+                raise self.fail(_join(key, k), "missing (required)")
+        return value
+
+    def number(self, value: Any, key: str, positive: bool = False) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise self.fail(key, f"expected a finite number, got {value!r}")
+        if positive and value <= 0:
+            raise self.fail(key, f"must be > 0, got {value!r}")
+        return float(value)
+
+    def vector(self, value: Any, key: str, n: int) -> tuple:
+        if not isinstance(value, (list, tuple)) or len(value) != n:
+            raise self.fail(key, f"expected a list of {n} numbers, got {value!r}")
+        return tuple(self.number(v, f"{key}[{i}]") for i, v in enumerate(value))
+
+    def name(self, value: Any, key: str) -> str:
+        if not isinstance(value, str) or not NAME_PATTERN.match(value):
+            raise self.fail(key, f"expected a name of letters, digits and _, starting with a letter, got {value!r}")
+        return value
+
+
+def _join(prefix: str, key: str) -> str:
+    return f"{prefix}.{key}" if prefix else key
+
+
+def load_project(path: str | Path) -> Project:
+    """Read and validate a project file.
+
+    Args:
+        path: the YAML file.
+
+    Returns:
+        The :class:`Project`; model paths are resolved and checked to exist,
+        controller classes imported and their parameters validated.
+
+    Raises:
+        ProjectError: anything wrong, with the file and the key in the message.
+
+    Any thread may call this (it imports controller modules).
+    """
+    path = Path(path)
+    r = _Reader(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ProjectError(f"{path}: cannot read the project file: {exc.strerror or exc}") from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ProjectError(f"{path}: not valid YAML: {exc}") from None
+    if doc is None:
+        raise ProjectError(f"{path}: the project file is empty")
+    r.mapping(doc, "", {"name": False, "description": False, "models": True, "simulator": False})
+    name = r.name(doc.get("name", path.stem), "name") if "name" in doc else path.stem
+    models_doc = doc["models"]
+    if not isinstance(models_doc, list) or not models_doc:
+        raise r.fail("models", "expected a non-empty list of models")
+    models: list[ModelEntry] = []
+    seen: set[str] = set()
+    for i, m in enumerate(models_doc):
+        key = f"models[{i}]"
+        r.mapping(m, key, {"name": True, "file": True, "position": False, "yaw": False, "controllers": False})
+        mname = r.name(m["name"], f"{key}.name")
+        if mname in seen:
+            raise r.fail(f"{key}.name", f"{mname!r} is used twice; model names must be unique")
+        seen.add(mname)
+        if not isinstance(m["file"], str):
+            raise r.fail(f"{key}.file", f"expected a path, got {m['file']!r}")
+        mfile = (path.parent / m["file"]).resolve()
+        if not mfile.is_file():
+            raise r.fail(f"{key}.file", f"no such model file: {mfile}")
+        entry = ModelEntry(
+            name=mname,
+            file=mfile,
+            position=r.vector(m.get("position", [0, 0, 0]), f"{key}.position", 3),
+            yaw=r.number(m.get("yaw", 0.0), f"{key}.yaw"),
+        )
+        controllers = m.get("controllers", [])
+        if not isinstance(controllers, list):
+            raise r.fail(f"{key}.controllers", "expected a list of controllers")
+        cnames: set[str] = set()
+        for j, c in enumerate(controllers):
+            ckey = f"{key}.controllers[{j}]"
+            r.mapping(c, ckey, {"name": True, "class": True, "parameters": False})
+            cname = r.name(c["name"], f"{ckey}.name")
+            if cname in cnames:
+                raise r.fail(f"{ckey}.name", f"{cname!r} is used twice on {mname}")
+            cnames.add(cname)
+            cls = _import_controller(r, c["class"], f"{ckey}.class")
+            params = _parameters(r, cls, c.get("parameters", {}) or {}, f"{ckey}.parameters")
+            entry.controllers.append(ControllerEntry(cname, cls, c["class"], params))
+        models.append(entry)
+    simulator = None
+    if "simulator" in doc:
+        s = doc["simulator"] or {}
+        r.mapping(s, "simulator", {"time_step": False, "realtime_sync": False, "gravity": False})
+        rt = s.get("realtime_sync", True)
+        if not isinstance(rt, bool):
+            raise r.fail("simulator.realtime_sync", f"expected true or false, got {rt!r}")
+        simulator = SimulatorSettings(
+            time_step=r.number(s.get("time_step", 0.001), "simulator.time_step", positive=True),
+            realtime_sync=rt,
+            gravity=r.vector(s.get("gravity", [0, 0, -9.80665]), "simulator.gravity", 3),
+        )
+    return Project(path=path, name=name, models=models, simulator=simulator)
+
+
+def _import_controller(r: _Reader, spec: Any, key: str) -> type:
+    if not isinstance(spec, str) or spec.count(":") != 1:
+        raise r.fail(key, f"expected 'module:Class', got {spec!r}")
+    module_name, class_name = spec.split(":")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise r.fail(key, f"cannot import module {module_name!r}: {exc}") from None
+    cls = getattr(module, class_name, None)
+    if not (isinstance(cls, type) and issubclass(cls, SimpleController)):
+        raise r.fail(key, f"{module_name} has no SimpleController subclass named {class_name!r}")
+    return cls
+
+
+def _parameters(r: _Reader, cls: type, given: Any, key: str) -> dict:
+    if not isinstance(given, dict):
+        raise r.fail(key, "expected a mapping of parameter names to values")
+    values = {name: default for name, (_, default, _) in cls.PARAMETERS.items()}
+    for name, value in given.items():
+        if name not in cls.PARAMETERS:
+            known = ", ".join(cls.PARAMETERS) or "none"
+            raise r.fail(_join(key, str(name)), f"unknown parameter of {cls.__name__}; known: {known}")
+        typ = cls.PARAMETERS[name][0]
+        values[name] = check_parameter(typ, value, lambda msg: r.fail(_join(key, name), msg))  # noqa: B023 - called in this iteration
+    return values
+
+
+def check_parameter(typ: type, value: Any, fail) -> Any:
+    """Validate one controller parameter value (used for project values and ROS overrides).
+
+    Raises:
+        whatever ``fail(message)`` returns, when ``value`` is not a ``typ``.
+    """
+    if typ is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise fail(f"expected a finite number, got {value!r}")
+        return float(value)
+    if typ is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise fail(f"expected an integer, got {value!r}")
+        return value
+    if not isinstance(value, typ):
+        raise fail(f"expected {typ.__name__}, got {value!r}")
+    return value

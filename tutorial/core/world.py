@@ -1,0 +1,140 @@
+"""Build one MuJoCo world from several MJCF model files.
+
+Choreonoid loads a world item with body items under it; here a project names
+the model files and :func:`build_world` attaches each under its own name
+prefix (``Tank/``) to an empty ``MjSpec``, so two robots can share joint
+names and every element stays traceable to the body it came from.
+
+Models that other packages ship often leave bodies and joints unnamed, and
+MuJoCo does not prefix an element without a name.  So before attaching,
+:func:`name_unnamed_elements` gives every unnamed body, joint, geom and site
+of a model a stable name (the rule is in its docstring): in the world, every
+element of a model is then named ``<model name>/...``, and the world's
+top-level bodies so named are the model's roots (:class:`tutorial.core.body.Body`
+owns their kinematic subtrees).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+
+# The kinds of element that get a name when they have none: the ones a Body
+# owns by its kinematic tree (bodies, and what hangs on them), and the one
+# whose name goes on the wire (joints).  (MjSpec list attribute, name stem.)
+NAMED_KINDS = (("bodies", "body"), ("joints", "joint"), ("geoms", "geom"), ("sites", "site"))
+
+
+@dataclass
+class ModelEntry:
+    """One model placed in the world.
+
+    Attributes:
+        name: the body name, e.g. ``Tank``; also the prefix of its elements and
+            the first part of its ROS topics (``/Tank/joint_state``).
+        file: path of the MJCF file.
+        position: (3,) placement of the model's frame in the world, m.
+        yaw: rotation of the model's frame about +Z, rad.
+    """
+
+    name: str
+    file: Path
+    position: Sequence[float] = (0.0, 0.0, 0.0)
+    yaw: float = 0.0
+    controllers: list = field(default_factory=list)
+
+
+def build_world(
+    entries: Sequence[ModelEntry],
+    time_step: float = 0.001,
+    gravity: Sequence[float] = (0.0, 0.0, -9.80665),
+) -> mujoco.MjModel:
+    """Compile the models into one ``MjModel``.
+
+    Args:
+        entries: the models, attached in this order.
+        time_step: simulation step, s.
+        gravity: (3,) gravity vector, m/s^2.
+
+    Returns:
+        The compiled model; each entry's bodies, joints, geoms and sites are
+        named ``<name>/<element>``, unnamed ones by the rule of
+        :func:`name_unnamed_elements`.
+
+    Raises:
+        ValueError: a model file does not parse or the world does not compile
+            (MuJoCo's message, with the file name).
+
+    Any thread may call this; the returned model is read-only for everyone.
+    """
+    spec = mujoco.MjSpec()
+    spec.modelname = "world"
+    spec.option.timestep = time_step
+    spec.option.gravity = list(gravity)
+    # implicitfast treats the velocity actuators of the tracks implicitly, so
+    # their stiff gains stay stable at 1 ms.
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.compiler.degree = False
+    for entry in entries:
+        try:
+            child = mujoco.MjSpec.from_file(str(entry.file))
+        except Exception as exc:  # mujoco raises ValueError with the parser's text
+            raise ValueError(f"{entry.file}: {exc}") from exc
+        name_unnamed_elements(child)
+        half = entry.yaw / 2.0
+        frame = spec.worldbody.add_frame(pos=list(entry.position), quat=[math.cos(half), 0.0, 0.0, math.sin(half)])
+        with warnings.catch_warnings():
+            # MuJoCo warns when a child's <option> differs from the world's;
+            # the world's (the project's) settings are the ones we want.
+            warnings.simplefilter("ignore")
+            spec.attach(child, prefix=f"{entry.name}/", frame=frame)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return spec.compile()
+    except Exception as exc:
+        raise ValueError(f"the world does not compile: {exc}") from exc
+
+
+def name_unnamed_elements(spec: mujoco.MjSpec) -> int:
+    """Name every unnamed body, joint, geom and site of one model, in place.
+
+    The rule: an unnamed element is named after its kind and its id in the
+    model file compiled on its own (its index in ``MjModel``'s arrays of
+    that kind, as ``mujoco.MjModel.from_xml_path(file)`` numbers it; the
+    world body is body 0): ``body4``, ``joint0``, ``geom12``, ``site3``.
+    The name is stable as long as the file is: the simulation and a viewer
+    that load the same file agree on it.  If the model already uses that
+    name for another element of the kind, ``_1``, ``_2``, ... is appended
+    until it is free.  Named elements keep their names.
+
+    Args:
+        spec: a model's ``MjSpec`` before it is attached or compiled.
+
+    Returns:
+        How many elements were named.
+
+    The ids come from the order of ``MjSpec.bodies`` (``joints``, ...), which is
+    the order MuJoCo's compiler numbers them in (depth first, frames
+    included).  Any thread may call this on a spec no other thread uses.
+    """
+    named = 0
+    for attribute, stem in NAMED_KINDS:
+        elements = list(getattr(spec, attribute))
+        taken = {e.name for e in elements if e.name}
+        for index, element in enumerate(elements):
+            if element.name:
+                continue
+            name, n = f"{stem}{index}", 0
+            while name in taken:
+                n += 1
+                name = f"{stem}{index}_{n}"
+            element.name = name
+            taken.add(name)
+            named += 1
+    return named

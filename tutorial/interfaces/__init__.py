@@ -1,0 +1,16 @@
+"""The ROS interfaces the project speaks: one module per message.
+
+Each module holds its topic's name, its QoS and why, the units, and the
+checks on received data, so every step, tool and test that uses the topic
+agrees on it, and editing one step's notebook changes no other step.
+
+==================  ================================================================
+module              message
+==================  ================================================================
+``joy``             ``/joy``, ``sensor_msgs/Joy``: axes and buttons, their checks
+``joint_state``     ``/<body>/joint_state``, ``sensor_msgs/JointState``; matching by name
+``imu``             ``/<body>/imu``, ``sensor_msgs/Imu``; finding a body's IMU; its checks
+``image``           ``/<body>/camera/image``, ``sensor_msgs/Image``; reading one safely
+``timing``          simulation-time stamps, and the exact periodic counter every publisher uses
+==================  ================================================================
+"""

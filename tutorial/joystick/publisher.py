@@ -1,0 +1,67 @@
+"""Publish an input source on ``/joy``: the node behind ``rtt-joy``.
+
+Like ROS 2's ``joy_node``, :class:`JoyPublisher` publishes when the input
+changes (at most ``rate`` Hz) and repeats the current state at
+``autorepeat`` Hz, so a subscriber that starts late, or missed a message,
+still gets the sticks' state.  Its sources are in :mod:`tutorial.joystick.sources`.
+"""
+
+from __future__ import annotations
+
+import time
+
+from tutorial.interfaces import joy
+
+
+class JoyPublisher:
+    """Publishes an input source on ``/joy`` from a timer (spin thread).
+
+    Args:
+        node: the ``rclpy`` node.
+        source: an object with ``read(now) -> (axes, buttons) | None``.
+        rate: how often the source is read, Hz.
+        autorepeat: how often an unchanged state is published again, Hz (0: never).
+        duration: stop after this many seconds (None: never), counted from the
+            start of a demo that waits for a subscriber, else from now.
+
+    QoS: :func:`tutorial.interfaces.joy.joy_publisher_qos`.
+    """
+
+    def __init__(self, node, source, rate=60.0, autorepeat=20.0, duration=None):
+        from sensor_msgs.msg import Joy
+
+        self.node = node
+        self.source = source
+        self.msg_type = Joy
+        self.publisher = node.create_publisher(Joy, joy.TOPIC, joy.joy_publisher_qos())
+        self.autorepeat = autorepeat
+        self.duration = duration
+        self.until = None if duration is None or getattr(source, "waiting", False) else time.monotonic() + duration
+        self.last = None
+        self.last_sent = 0.0
+        self.published = 0
+        self.done = False
+        self.timer = node.create_timer(1.0 / rate, self.tick)
+
+    def tick(self) -> None:
+        now = time.monotonic()
+        if getattr(self.source, "waiting", False) and self.publisher.get_subscription_count() > 0:
+            # A scripted demo starts when someone listens, so no part of it is lost.
+            self.source.begin(now)
+            if self.duration is not None:
+                self.until = now + self.duration
+            print(f"[{self.node.get_fully_qualified_name()}] {joy.TOPIC} has a subscriber: the demo starts", flush=True)
+        state = self.source.read(now)
+        if state is None or (self.until is not None and now >= self.until):
+            self.done = True
+            return
+        repeat_due = self.autorepeat > 0 and now - self.last_sent >= 1.0 / self.autorepeat
+        if state != self.last or repeat_due:
+            msg = self.msg_type()
+            msg.header.stamp = self.node.get_clock().now().to_msg()
+            msg.axes = [float(a) for a in state[0]]
+            msg.buttons = [int(b) for b in state[1]]
+            self.publisher.publish(msg)
+            self.published += 1
+            self.last = state
+            self.last_sent = now

@@ -1,0 +1,14 @@
+"""The ``rtt-*`` programs: one thin ``main`` per program, built from the library.
+
+==================  ================================================================
+module              program
+==================  ================================================================
+``rtt_run``         ``rtt-run PROJECT``: open a project and run it, as Choreonoid does
+``rtt_joy``         ``rtt-joy``: publish ``/joy`` from a gamepad, the keyboard or a demo
+``rtt_plot``        ``rtt-plot``: joint positions over time (rqt_plot's stand-in)
+``rtt_graph``       ``rtt-graph``: nodes and topics (rqt_graph's stand-in)
+``rtt_image``       ``rtt-image``: a camera topic's pictures (rqt_image_view's stand-in)
+==================  ================================================================
+
+``rtt-bag`` is :mod:`tutorial.bag.cli`.  Nothing in the library imports these modules.
+"""

@@ -1,0 +1,194 @@
+"""``rtt-run PROJECT_FILE``: open a project and run it, as Choreonoid does.
+
+    rtt-run project/step1.yaml                 # simulate in real time, show in meshcat
+    rtt-run project/step1.yaml --headless --duration 5 --json
+    rtt-run project/step3.yaml --ros-args -r __node:=rtt_viewer
+
+A project with a simulator simulates (real time unless ``--fast``); one
+without only configures its controllers (Step 3's viewer).  The node is named
+``rtt``; rename a second instance with ``--ros-args -r __node:=NAME``.
+On exit it prints a summary (``--json``: one JSON object per line for every
+status line and the summary).
+
+Exit status: 0 on a clean end or Ctrl-C/SIGTERM, 1 when a controller or the
+simulation failed, 2 for a bad command line or project file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+
+from tutorial.core.app import DEFAULT_NODE_NAME, App, ControllerError
+from tutorial.core.project import ProjectError, load_project
+from tutorial.ros import env as ros_env
+from tutorial.view.status import format_status
+
+
+def _brief(value) -> str:
+    """A value of a summary's dict as text; a dict in it (an arrow's length and visibility) in parentheses."""
+    if isinstance(value, dict):
+        return "(" + ", ".join(f"{k}={v}" for k, v in value.items()) + ")"
+    return str(value)
+
+
+def format_record(record: dict) -> str:
+    """One status record as a human-readable line (or a few, for the summary)."""
+    event = record.get("event")
+    if event in ("status", "stale", "recovered", "first_state", "publishers"):
+        return format_status(record, record.get("node", ""))
+    if event == "imu_status":
+        age = "no reading yet" if record["age_ms"] is None else f"newest {record['age_ms']:.0f} ms old"
+        arrows = ", ".join(
+            f"{k.replace('_', ' ')} {a['length']:.3f} m{'' if a['visible'] else ' (hidden)'}"
+            for k, a in record["arrows"].items()
+        )
+        rejected = ", ".join(f"{k} {v}" for k, v in record["rejected"].items()) or "none"
+        shaking = " [SHAKING]" if record["shaking"] else ""
+        return (
+            f"[{record['node']}] {record['topic']}: {record['rate_hz']:.1f} msg/s, {age}, arrows: {arrows}, "
+            f"shakes {record['shakes']}, rejected: {rejected}{shaking}"
+        )
+    if event == "shake":
+        return (
+            f"[{record['node']}] {record['body']}: collision, {record['horizontal_acceleration']:.1f} m/s^2 "
+            "horizontal: shaking the view"
+        )
+    if event == "shake_end":
+        return f"[{record['node']}] {record['body']}: shake over, back at its position"
+    if event == "meshcat":
+        return f"[{record['node']}] meshcat: open {record['url']} in a browser"
+    if event == "warning":
+        return f"[{record.get('node', '')}] WARNING: {record['message']}"
+    if event == "summary":
+        lines = [f"--- summary: project {record['project']}, node {record['node']} ---"]
+        if "simulated_time" in record:
+            lines.append(
+                f"simulated {record['simulated_time']:.3f} s in {record['wall_time']:.3f} s wall "
+                f"(real-time factor {record['real_time_factor']:.3f}, {record['steps']} steps)"
+            )
+        for name, b in record.get("bodies", {}).items():
+            x, y, z = b["root_position"]
+            lines.append(f"{name}: root at ({x:.3f}, {y:.3f}, {z:.3f}) m, yaw {b['root_yaw']:.3f} rad")
+            joints = "  ".join(f"{k}={v:.4f}" for k, v in b["joint_positions"].items())
+            lines.append(f"{name}: joints  {joints}")
+        for name, s in record.get("controllers", {}).items():
+            lines.append(f"{name}: " + ", ".join(f"{k}={v}" for k, v in s.items() if not isinstance(v, dict)))
+            for k, v in s.items():
+                if isinstance(v, dict):
+                    lines.append(f"{name}: {k}: " + (", ".join(f"{a}={_brief(b)}" for a, b in v.items()) or "none"))
+        if record.get("error"):
+            lines.append("ERROR:\n" + record["error"])
+        return "\n".join(lines)
+    if "line" in record:
+        return record["line"]
+    return " ".join(f"{k}={v}" for k, v in record.items())
+
+
+def make_output(json_lines: bool):
+    """A printer for status records: JSON lines, or :func:`format_record` text.
+
+    Each record goes out in one write, newline included, so lines never mix.
+    """
+
+    def output(record: dict) -> None:
+        text = json.dumps(record, sort_keys=False) if json_lines else format_record(record)
+        sys.stdout.write(text + "\n")
+        sys.stdout.flush()
+
+    return output
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The command line of ``rtt-run`` (ROS arguments are removed before it parses)."""
+    p = argparse.ArgumentParser(
+        prog="rtt-run",
+        description="Open a tutorial project file and run it.",
+        epilog="ROS arguments go after --ros-args, e.g. --ros-args -r __node:=rtt_viewer",
+    )
+    p.add_argument("project", help="project file, e.g. project/step1.yaml")
+    p.add_argument("--fast", action="store_true", help="simulate as fast as possible instead of in real time")
+    p.add_argument(
+        "--duration",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="stop after this much simulated time (wall time for a project without simulator)",
+    )
+    p.add_argument("--headless", action="store_true", help="no meshcat viewer")
+    p.add_argument("--json", action="store_true", help="status lines and summary as JSON, one object per line")
+    return p
+
+
+def _stop_on_signal(app: App) -> None:
+    """Ctrl-C or SIGTERM asks the app to stop at the end of its current step; a second one interrupts at once.
+
+    A stop request instead of an exception raised at an arbitrary point keeps
+    output lines and the meshcat connection whole.
+    """
+
+    def handler(signum, frame):
+        if app.stop_requested:
+            raise KeyboardInterrupt
+        app.request_stop()
+
+    signal.signal(signal.SIGINT, handler)
+    signal.signal(signal.SIGTERM, handler)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``rtt-run``: parse the command line, run the project, print the summary; the exit status (main thread)."""
+    from rclpy.utilities import remove_ros_args
+
+    argv = list(sys.argv if argv is None else argv)
+    args = build_parser().parse_args(remove_ros_args(argv)[1:])
+    if args.duration is not None and not args.duration > 0:
+        build_parser().error("--duration must be > 0")
+    output = make_output(args.json)
+    try:
+        project = load_project(args.project)
+    except ProjectError as exc:
+        print(f"rtt-run: {exc}", file=sys.stderr)
+        return 2
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.signals import SignalHandlerOptions
+
+    ros_env.use_localhost_by_default()
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    app = App(
+        project,
+        node_name=DEFAULT_NODE_NAME,
+        headless=args.headless,
+        realtime_sync=False if args.fast else None,
+        duration=args.duration,
+        output=output,
+    )
+    _stop_on_signal(app)  # SIGTERM (a launcher stopping us) ends the run like Ctrl-C: cleanly
+    status = 0
+    try:
+        app.open()
+        app.run()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (ControllerError, ValueError, RuntimeError) as exc:
+        print(f"rtt-run: {exc}", file=sys.stderr)
+        status = 1
+    finally:
+        ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
+        try:
+            app.close()
+            if hasattr(app, "bodies"):
+                record = app.summary()
+                if record.get("error"):
+                    status = 1
+                output(record)
+        finally:
+            rclpy.try_shutdown()
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
