@@ -3,11 +3,20 @@
 Every body's probe (``benchmarks.probes.ProbedJointStateSubscriber``) hears of each frame.
 
     python -m benchmarks.viewer_proc PROJECT --duration S [--headless]
+    python -m benchmarks.viewer_proc PROJECT --duration S --record-meshcat FILE.json
+
+``--record-meshcat`` starts the meshcat server here (so the commands can be
+tapped before the scene is built), prints ``{"event": "meshcat_url", ...}``
+as a JSON line, and writes every command the viewer sent to meshcat to FILE:
+each with its send time (``time.monotonic_ns()``), its type, path and bytes
+(hex), and for a transform the body it moves and the stamp of the state the
+body showed (``benchmarks.browser`` replays and joins them).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 
@@ -25,19 +34,33 @@ def main() -> int:
     p.add_argument("--duration", type=float, required=True)
     p.add_argument("--headless", action="store_true")
     p.add_argument("--name", default="rtt_viewer")
+    p.add_argument("--record-meshcat", metavar="FILE", help="tap and record every command sent to meshcat")
     args = p.parse_args()
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    server = vis = tape = None
+    if args.record_meshcat:
+        from tutorial.view.meshcat_server import start_server
+
+        server = start_server()
+        vis = server.visualizer()
+        tape = CommandTape()
+        vis.window.zmq_socket = tape.tap(vis.window.zmq_socket)
+        print(json.dumps({"event": "meshcat_url", "url": server.web_url}), flush=True)
     app = App(
         load_project(args.project),
         node_name=args.name,
         headless=args.headless,
         duration=args.duration,
+        vis=vis,
         output=lambda record: print(record, flush=True) if record.get("event") != "status" else None,
     )
     try:
         app.open()
         probes = [c for _, c, _ in app.controllers if hasattr(c, "frame_drawn")]
+        if tape is not None and app.scene is not None and app.scene._pipe is not None:
+            tape.probes = {probe.config.body_name: probe for probe in probes}
+            app.scene._pipe.socket = tape.tap(app.scene._pipe.socket)
 
         def drawn(seconds: float) -> None:
             for probe in probes:  # every body's probe notes which of its states this frame shows
@@ -59,7 +82,45 @@ def main() -> int:
     finally:
         app.close()
         rclpy.try_shutdown()
+        if tape is not None:
+            with open(args.record_meshcat, "w") as f:
+                json.dump(tape.commands, f)
+        if server is not None:
+            server.close()
     return 0
+
+
+class CommandTape:
+    """Records every meshcat command a zmq socket sends, with its time (viewer's main thread only).
+
+    A transform's record also names the body it moves (the first path part
+    that is a probed body's name) and the stamp of the state that body's
+    probe last applied: the state this frame shows.
+    """
+
+    def __init__(self):
+        self.commands: list[list] = []  # [monotonic ns, type, path, data hex, body, stamp ns]
+        self.probes: dict = {}
+
+    def tap(self, socket):
+        tape = self
+
+        class Tapped:
+            def send_multipart(self, frames, *a, **k):
+                # A DEALER's frames start with an empty delimiter; a REQ's do not.
+                kind, path, data = (frames[1:] if frames[0] == b"" else frames)[:3]
+                tape.note(kind.decode(), path.decode(), data)
+                return socket.send_multipart(frames, *a, **k)
+
+            def __getattr__(self, name):
+                return getattr(socket, name)
+
+        return Tapped()
+
+    def note(self, kind: str, path: str, data: bytes) -> None:
+        body = next((part for part in path.split("/") if part in self.probes), None)
+        stamp = self.probes[body].latest_stamp if body is not None else None
+        self.commands.append([time.monotonic_ns(), kind, path, data.hex(), body, stamp])
 
 
 if __name__ == "__main__":

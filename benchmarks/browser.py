@@ -1,0 +1,411 @@
+"""From a published state to the pixel: the viewer's meshcat page in a real browser, stage by stage.
+
+    python -m benchmarks.browser [--seconds 8] [--cases tank_50Hz tank_1kHz tanks_8 arm_48]
+
+Each case runs the simulation and the Step 3 viewer as two processes, as
+``make bench``'s pipeline runs do, but the viewer draws in meshcat, and
+Debian's Chromium (headless, driven by Playwright, as the JupyterLab test
+drives it) shows the viewer's page.  For every state the page draws, five
+moments are joined on the state's stamp, each taken where it happens:
+
+========================  ====================================================
+moment                    taken by
+========================  ====================================================
+published                 the simulation's step clock (``benchmarks.probes.StepClock``)
+received by the viewer    the viewer's subscription callback (its probe)
+sent to meshcat           the viewer's zmq socket, tapped (``benchmarks.viewer_proc --record-meshcat``)
+received by the page      the page's WebSocket, hooked before meshcat's own handler runs
+drawn                     the end of the first ``viewer.render()`` (three.js) after it arrived
+========================  ====================================================
+
+A message is recognised in the page by the CRC-32 of its bytes (the server
+forwards the bytes it was sent unchanged), in order.  The browser's clock
+(``performance.timeOrigin + performance.now()``, wall time, 0.1 ms) is turned
+into ``time.monotonic_ns()`` by this machine's offset between the two clocks.
+A state the viewer never drew (at 1 kHz it draws at most 60 frames a second,
+the newest state each time) has no drawn moment and is not counted.
+
+**The baseline, in the same run**: a bare script replays, to a bare meshcat
+server and page, the exact commands the viewer sent (the scene, then every
+transform, at the moments it sent them): no ROS and no tutorial code on its
+path, only zmq and meshcat's own server (bound to 127.0.0.1).  Its figure is
+send -> drawn.  The page's frames per second are its ``requestAnimationFrame``
+callbacks per second.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import queue
+import random
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.run import ROOT, arm_projects, pct, py, start, tanks_projects
+
+FRAME_MS = 1000.0 / 60.0
+CASES = {  # name: (kind, size, publisher rate Hz)
+    "tank_50Hz": ("tanks", 1, 50.0),
+    "tank_1kHz": ("tanks", 1, 1000.0),
+    "tanks_8": ("tanks", 8, 50.0),
+    "arm_48": ("arm", 48, 50.0),
+}
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--enable-unsafe-swiftshader",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-quic",
+    "--no-first-run",
+]
+
+# Runs in the page before meshcat's own script: hooks its WebSocket and its renders.
+PAGE_PROBE = r"""
+window.__rtt = {msgs: [], renders: [], render_ms: [], rafs: []};
+(function () {
+  const now = () => performance.timeOrigin + performance.now();
+  const table = new Uint32Array(256);
+  for (let n = 0; n < 256; n++) {
+    let c = n;
+    for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+    table[n] = c >>> 0;
+  }
+  function crc32(bytes) {
+    let c = 0xffffffff;
+    for (let i = 0; i < bytes.length; i++) c = table[(c ^ bytes[i]) & 0xff] ^ (c >>> 8);
+    return (c ^ 0xffffffff) >>> 0;
+  }
+  const Native = window.WebSocket;
+  function Probed(url, protocols) {
+    const ws = protocols === undefined ? new Native(url) : new Native(url, protocols);
+    ws.addEventListener("message", (ev) => {
+      const t = now();
+      if (ev.data instanceof ArrayBuffer) window.__rtt.msgs.push([t, crc32(new Uint8Array(ev.data))]);
+    });
+    return ws;
+  }
+  Probed.prototype = Native.prototype;
+  window.WebSocket = Probed;
+  function frame() { window.__rtt.rafs.push(now()); requestAnimationFrame(frame); }
+  requestAnimationFrame(frame);
+  const hook = setInterval(() => {
+    if (window.viewer && window.viewer.render) {
+      const render = window.viewer.render.bind(window.viewer);
+      window.viewer.render = function () {
+        const t0 = now();
+        const r = render();
+        const t1 = now();
+        window.__rtt.renders.push(t1);
+        window.__rtt.render_ms.push(t1 - t0);
+        return r;
+      };
+      window.viewer.__rtt_hooked = true;
+      clearInterval(hook);
+    }
+  }, 2);
+})();
+"""
+
+
+def clock_offset_ns() -> int:
+    """``time.time_ns() - time.monotonic_ns()``: adds to a monotonic time to give wall time (this machine)."""
+    pairs = []
+    for _ in range(5):
+        a = time.monotonic_ns()
+        w = time.time_ns()
+        b = time.monotonic_ns()
+        pairs.append((b - a, w - (a + b) // 2))
+    return min(pairs)[1]
+
+
+class Page:
+    """A headless Chromium page on a meshcat URL, with :data:`PAGE_PROBE` in it (one thread only)."""
+
+    def __init__(self, url: str, timeout_s: float = 30.0):
+        from playwright.sync_api import sync_playwright
+
+        assert url.startswith("http://127.0.0.1:"), url
+        self._pw = sync_playwright().start()
+        self._browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        self.page = self._browser.new_page(viewport={"width": 800, "height": 600})
+        self.page.add_init_script(PAGE_PROBE)
+        self.page.goto(url)
+        self.page.wait_for_function("window.viewer && window.viewer.__rtt_hooked", timeout=timeout_s * 1000)
+
+    def samples(self) -> dict:
+        """``{"msgs": [[wall ms, crc32], ...], "renders": [wall ms], "rafs": [wall ms]}`` so far."""
+        return self.page.evaluate("window.__rtt")
+
+    def close(self) -> None:
+        self._browser.close()
+        self._pw.stop()
+
+
+def _lines(proc: subprocess.Popen) -> queue.Queue:
+    """A queue of the process's stdout lines, read by a thread of its own."""
+    q: queue.Queue = queue.Queue()
+
+    def read():
+        for line in iter(proc.stdout.readline, ""):
+            q.put(line)
+        q.put(None)
+
+    threading.Thread(target=read, daemon=True).start()
+    return q
+
+
+def _meshcat_url(lines: queue.Queue, timeout: float) -> str:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            line = lines.get(timeout=max(0.0, deadline - time.monotonic()))
+        except queue.Empty:
+            break
+        if line is None:
+            break
+        if line.startswith("{") and '"meshcat_url"' in line:
+            return json.loads(line)["url"]
+    raise RuntimeError("the viewer printed no meshcat URL")
+
+
+def _wait(proc: subprocess.Popen, timeout: float) -> None:
+    try:
+        proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(10)
+        raise RuntimeError(f"{proc.args} did not finish in {timeout} s") from None
+    if proc.returncode != 0:
+        raise RuntimeError(f"{proc.args} exited {proc.returncode}: {proc.stderr.read()[-2000:]}")
+
+
+def tutorial_run(case: str, seconds: float, directory: Path) -> dict:
+    """One case through the tutorial: simulation, viewer, its page; the raw records of each."""
+    kind, size, rate = CASES[case]
+    sim_project, view_project = (tanks_projects if kind == "tanks" else arm_projects)(size, directory)
+    sim_probe, view_probe, tape = directory / "sim.json", directory / "view.json", directory / "tape.json"
+    viewer = start(
+        py("benchmarks.viewer_proc", str(view_project), "--duration", str(seconds + 12.0)) + ["--record-meshcat", str(tape)],
+        view_probe,
+    )
+    procs = [viewer]
+    page = None
+    try:
+        url = _meshcat_url(_lines(viewer), 60)
+        page = Page(url)
+        sim = start(
+            py("tutorial.tools.rtt_run", str(sim_project), "--headless", "--duration", str(seconds), "--json")
+            + ["--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}"],
+            sim_probe,
+        )
+        procs.append(sim)
+        joystick = start(py("tutorial.tools.rtt_joy", "--demo", "--duration", str(seconds + 6.0))) if kind == "tanks" else None
+        if joystick is not None:
+            procs.append(joystick)
+        _wait(sim, seconds + 40)
+        samples = page.samples()
+        _wait(viewer, seconds + 40)
+    finally:
+        if page is not None:
+            page.close()
+        for proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait(10)
+    views = {}
+    for f in directory.glob("view.*.json"):
+        views[f.name.split(".")[1]] = json.loads(f.read_text())
+    return {
+        "sim": json.loads(sim_probe.read_text()),
+        "views": views,
+        "tape": json.loads(tape.read_text()),
+        "page": samples,
+    }
+
+
+def bare_run(tape: list, lead_s: float = 1.0) -> tuple[dict, list]:
+    """Replay ``tape`` to a bare meshcat server and page, at its moments; the page's samples and the send log.
+
+    The scene's commands (every one before the first transform that names a
+    body) go first, then each transform at its recorded offset from the first.
+    Sends are pipelined as the viewer's are (a DEALER socket, then the replies).
+    """
+    import zmq
+
+    from tutorial.view.meshcat_server import start_server
+
+    server = start_server()
+    page = None
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.connect(server.zmq_url)
+    sent: list[tuple[int, int]] = []  # (monotonic ns, crc32)
+    try:
+        page = Page(server.web_url)
+        first = next(i for i, c in enumerate(tape) if c[4] is not None)
+        in_flight = 0
+
+        def send(command) -> None:
+            nonlocal in_flight
+            data = bytes.fromhex(command[3])
+            sock.send_multipart([b"", command[1].encode(), command[2].encode(), data])
+            sent.append((time.monotonic_ns(), zlib.crc32(data)))
+            in_flight += 1
+
+        def collect() -> None:
+            nonlocal in_flight
+            while in_flight:
+                if not sock.poll(5000):
+                    raise RuntimeError("the bare meshcat server did not answer")
+                sock.recv_multipart()
+                in_flight -= 1
+
+        for command in tape[:first]:
+            send(command)
+            collect()
+        time.sleep(lead_s)  # not synchronisation: the page draws the scene once before the clock starts
+        t0, base = time.monotonic_ns(), tape[first][0]
+        for command in tape[first:]:
+            due = t0 + (command[0] - base)
+            wait = (due - time.monotonic_ns()) / 1e9
+            if wait > 0:
+                collect()  # a frame's transforms went out together; their replies come before the next frame
+                time.sleep(wait)
+            send(command)
+        collect()
+        time.sleep(0.5)  # the last frames reach the page
+        samples = page.samples()
+    finally:
+        if page is not None:
+            page.close()
+        sock.close()
+        server.close()
+    return samples, sent
+
+
+def _match(msgs: list, crcs: list[int]) -> list[tuple[int, int]]:
+    """``(page message index, sent index)`` pairs: each page message to the next sent one of the same CRC."""
+    pairs, j = [], 0
+    for i, (_, crc) in enumerate(msgs):
+        k = j
+        while k < len(crcs) and crcs[k] != crc:
+            k += 1
+        if k < len(crcs):
+            pairs.append((i, k))
+            j = k + 1
+    return pairs
+
+
+def _first_after(times: np.ndarray, t: float) -> float | None:
+    i = int(np.searchsorted(times, t, side="left"))
+    return float(times[i]) if i < len(times) else None
+
+
+def analyse_tutorial(run: dict, offset_ns: int, warmup: float) -> dict:
+    """Stage by stage, per state drawn (ms), for one tutorial run."""
+    step_wall = {round(t / 1000): w for t, w in zip(run["sim"]["sim_ns"], run["sim"]["wall_ns"])}
+    end_ns = run["sim"]["wall_ns"][-1]
+    applied = {}
+    for body, v in run["views"].items():
+        for stamp, arrived, done in v["applied"]:
+            applied.setdefault((body, stamp), (arrived, done))
+    transforms = [c for c in run["tape"] if c[4] is not None and c[1] == "set_transform"]
+    crcs = [zlib.crc32(bytes.fromhex(c[3])) for c in transforms]
+    page = run["page"]
+    renders = np.array(sorted(page["renders"]))
+    to_mono = lambda wall_ms: wall_ms * 1e6 - offset_ns  # noqa: E731 - one line of arithmetic
+    start_ns = min(c[0] for c in transforms) + int(warmup * 1e9)
+    stages = {k: [] for k in ("publish_to_callback", "callback_to_applied", "applied_to_sent", "sent_to_page",
+                              "page_to_drawn", "publish_to_drawn")}
+    seen = set()
+    for i, k in _match(page["msgs"], crcs):
+        sent_ns, _, _, _, body, stamp = transforms[k]
+        if (body, stamp) in seen or stamp is None or not (start_ns <= sent_ns <= end_ns):
+            continue
+        step = step_wall.get(round(stamp / 1000))
+        arrived_done = applied.get((body, stamp))
+        received = to_mono(page["msgs"][i][0])
+        drawn = _first_after(renders, page["msgs"][i][0])
+        if step is None or arrived_done is None or drawn is None:
+            continue
+        seen.add((body, stamp))
+        arrived, done = arrived_done
+        drawn = to_mono(drawn)
+        for key, value in (("publish_to_callback", arrived - step), ("callback_to_applied", done - arrived),
+                           ("applied_to_sent", sent_ns - done), ("sent_to_page", received - sent_ns),
+                           ("page_to_drawn", drawn - received), ("publish_to_drawn", drawn - step)):
+            stages[key].append(value)
+    out = {k: pct(v, 1e-6) for k, v in stages.items()}
+    out.update(_page_rates(page, start_ns, end_ns, offset_ns), states_drawn=len(seen))
+    return out
+
+
+def analyse_bare(samples: dict, sent: list, offset_ns: int, warmup: float) -> dict:
+    """send -> page and send -> drawn (ms) for the bare replay."""
+    renders = np.array(sorted(samples["renders"]))
+    crcs = [c for _, c in sent]
+    start_ns = sent[0][0] + int(warmup * 1e9)
+    to_page, to_drawn = [], []
+    for i, k in _match(samples["msgs"], crcs):
+        t_sent = sent[k][0]
+        if t_sent < start_ns:
+            continue
+        received = samples["msgs"][i][0] * 1e6 - offset_ns
+        drawn = _first_after(renders, samples["msgs"][i][0])
+        if drawn is None:
+            continue
+        to_page.append(received - t_sent)
+        to_drawn.append(drawn * 1e6 - offset_ns - t_sent)
+    out = {"sent_to_page": pct(to_page, 1e-6), "sent_to_drawn": pct(to_drawn, 1e-6)}
+    out.update(_page_rates(samples, start_ns, sent[-1][0], offset_ns))
+    return out
+
+
+def _page_rates(page: dict, start_ns: int, end_ns: int, offset_ns: int) -> dict:
+    """The page's frames (requestAnimationFrame) and renders per second within [start, end] (monotonic ns)."""
+    def per_s(times):
+        t = np.array([x * 1e6 - offset_ns for x in times])
+        t = t[(t >= start_ns) & (t <= end_ns)]
+        return round(float((len(t) - 1) / ((t[-1] - t[0]) * 1e-9)), 1) if len(t) > 1 else None
+
+    return {"frames_per_s": per_s(page["rafs"]), "renders_per_s": per_s(page["renders"])}
+
+
+def pixel_latency(cases: list[str], seconds: float, warmup: float) -> dict:
+    """Every case: the tutorial's stages and the bare replay's, in the same run."""
+    offset = clock_offset_ns()
+    out = {}
+    for case in cases:
+        with tempfile.TemporaryDirectory() as d:
+            run = tutorial_run(case, seconds, Path(d))
+        samples, sent = bare_run(run["tape"])
+        out[case] = {"tutorial": analyse_tutorial(run, offset, warmup), "bare": analyse_bare(samples, sent, offset, warmup)}
+    return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--seconds", type=float, default=8.0, help="simulated seconds per case (default 8)")
+    p.add_argument("--warmup", type=float, default=2.0, help="s left out at the start of each run (default 2)")
+    p.add_argument("--cases", nargs="+", choices=list(CASES), default=list(CASES))
+    args = p.parse_args(argv)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
+    r = pixel_latency(args.cases, args.seconds, args.warmup)
+    print(json.dumps(r, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
