@@ -41,7 +41,7 @@ import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from benchmarks.run import pct  # noqa: E402
+from benchmarks.stats import pct  # noqa: E402
 
 import mujoco  # noqa: E402
 
