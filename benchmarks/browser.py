@@ -50,7 +50,9 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.run import ROOT, arm_projects, pct, py, start, tanks_projects
+from benchmarks.procs import py, start
+from benchmarks.scale_projects import arm_projects, tanks_projects
+from benchmarks.stats import pct
 
 FRAME_MS = 1000.0 / 60.0
 CASES = {  # name: (kind, size, publisher rate Hz)
@@ -196,7 +198,8 @@ def tutorial_run(case: str, seconds: float, directory: Path) -> dict:
     sim_project, view_project = (tanks_projects if kind == "tanks" else arm_projects)(size, directory)
     sim_probe, view_probe, tape = directory / "sim.json", directory / "view.json", directory / "tape.json"
     viewer = start(
-        py("benchmarks.viewer_proc", str(view_project), "--duration", str(seconds + 12.0)) + ["--record-meshcat", str(tape)],
+        py("benchmarks.viewer_proc", str(view_project), "--duration", str(seconds + 12.0))
+        + ["--record-meshcat", str(tape)],
         view_probe,
     )
     procs = [viewer]
@@ -210,7 +213,9 @@ def tutorial_run(case: str, seconds: float, directory: Path) -> dict:
             sim_probe,
         )
         procs.append(sim)
-        joystick = start(py("tutorial.tools.rtt_joy", "--demo", "--duration", str(seconds + 6.0))) if kind == "tanks" else None
+        joystick = (
+            start(py("tutorial.tools.rtt_joy", "--demo", "--duration", str(seconds + 6.0))) if kind == "tanks" else None
+        )
         if joystick is not None:
             procs.append(joystick)
         _wait(sim, seconds + 40)
@@ -326,8 +331,17 @@ def analyse_tutorial(run: dict, offset_ns: int, warmup: float) -> dict:
     renders = np.array(sorted(page["renders"]))
     to_mono = lambda wall_ms: wall_ms * 1e6 - offset_ns  # noqa: E731 - one line of arithmetic
     start_ns = min(c[0] for c in transforms) + int(warmup * 1e9)
-    stages = {k: [] for k in ("publish_to_callback", "callback_to_applied", "applied_to_sent", "sent_to_page",
-                              "page_to_drawn", "publish_to_drawn")}
+    stages = {
+        k: []
+        for k in (
+            "publish_to_callback",
+            "callback_to_applied",
+            "applied_to_sent",
+            "sent_to_page",
+            "page_to_drawn",
+            "publish_to_drawn",
+        )
+    }
     seen = set()
     for i, k in _match(page["msgs"], crcs):
         sent_ns, _, _, _, body, stamp = transforms[k]
@@ -342,9 +356,14 @@ def analyse_tutorial(run: dict, offset_ns: int, warmup: float) -> dict:
         seen.add((body, stamp))
         arrived, done = arrived_done
         drawn = to_mono(drawn)
-        for key, value in (("publish_to_callback", arrived - step), ("callback_to_applied", done - arrived),
-                           ("applied_to_sent", sent_ns - done), ("sent_to_page", received - sent_ns),
-                           ("page_to_drawn", drawn - received), ("publish_to_drawn", drawn - step)):
+        for key, value in (
+            ("publish_to_callback", arrived - step),
+            ("callback_to_applied", done - arrived),
+            ("applied_to_sent", sent_ns - done),
+            ("sent_to_page", received - sent_ns),
+            ("page_to_drawn", drawn - received),
+            ("publish_to_drawn", drawn - step),
+        ):
             stages[key].append(value)
     out = {k: pct(v, 1e-6) for k, v in stages.items()}
     out.update(_page_rates(page, start_ns, end_ns, offset_ns), states_drawn=len(seen))
@@ -374,6 +393,7 @@ def analyse_bare(samples: dict, sent: list, offset_ns: int, warmup: float) -> di
 
 def _page_rates(page: dict, start_ns: int, end_ns: int, offset_ns: int) -> dict:
     """The page's frames (requestAnimationFrame) and renders per second within [start, end] (monotonic ns)."""
+
     def per_s(times):
         t = np.array([x * 1e6 - offset_ns for x in times])
         t = t[(t >= start_ns) & (t <= end_ns)]
@@ -390,7 +410,10 @@ def pixel_latency(cases: list[str], seconds: float, warmup: float) -> dict:
         with tempfile.TemporaryDirectory() as d:
             run = tutorial_run(case, seconds, Path(d))
         samples, sent = bare_run(run["tape"])
-        out[case] = {"tutorial": analyse_tutorial(run, offset, warmup), "bare": analyse_bare(samples, sent, offset, warmup)}
+        out[case] = {
+            "tutorial": analyse_tutorial(run, offset, warmup),
+            "bare": analyse_bare(samples, sent, offset, warmup),
+        }
     return out
 
 

@@ -43,7 +43,7 @@ from pathlib import Path  # noqa: E402
 
 import mujoco  # noqa: E402
 
-from benchmarks.run import pct  # noqa: E402
+from benchmarks.stats import pct  # noqa: E402
 from tutorial.controllers.camera_image_publisher import RttCameraImagePublisher, render_snapshot  # noqa: E402
 from tutorial.core.simulator import Snapshot  # noqa: E402
 from tutorial.interfaces.image import fill_image  # noqa: E402

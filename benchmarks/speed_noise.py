@@ -2,7 +2,7 @@
 
     python -m benchmarks.speed_noise [--repeats 3] [--seconds 10]
 
-The figure (``benchmarks.run.simulation_speed``) is the median ratio of
+The figure (``benchmarks.experiments.speed.simulation_speed``) is the median ratio of
 interleaved pairs: a run of the tank's simulation with its controllers,
 divided by the mean of the bare ``mj_step`` runs on either side.  This
 prints what limits it:
@@ -26,15 +26,10 @@ import time
 
 import numpy as np
 
-from benchmarks.run import (
-    ROOT,
-    SPEED_PAIRS,
-    bare_steps_per_s,
-    in_thread,
-    interleaved_ratios,
-    run_steps,
-    simulation_speed,
-)
+from benchmarks.experiments.speed import SPEED_PAIRS, bare_steps_per_s, run_steps, simulation_speed
+from benchmarks.paths import ROOT
+from benchmarks.procs import in_thread
+from benchmarks.stats import interleaved_ratios
 
 PROJECT = "project/step2.yaml"
 
@@ -42,7 +37,7 @@ PROJECT = "project/step2.yaml"
 def bare_against_bare(model, steps: int, seconds: float) -> list[float]:
     """Ratios of bare runs to the mean of the bare runs on either side, for ``seconds`` s (any thread).
 
-    Paired exactly as the figure pairs its runs (:func:`benchmarks.run.interleaved_ratios`).
+    Paired exactly as the figure pairs its runs (:func:`benchmarks.stats.interleaved_ratios`).
     """
 
     def bare() -> float:

@@ -1,0 +1,46 @@
+"""meshcat's cost per frame: moving every body pipelined (the library) against a round trip per body."""
+
+from __future__ import annotations
+
+import time
+
+from benchmarks.paths import ROOT
+from benchmarks.stats import pct
+
+
+def scene_update_cost(model_file: str, frames: int) -> dict:
+    """ms per frame to move every body of a model in meshcat: pipelined (the library) vs a round trip per body.
+
+    The baseline is meshcat-python's own ``set_transform``, which waits for
+    the server's reply after each command; both run against one server, interleaved.
+    """
+    import mujoco
+
+    from tutorial.core.world import ModelEntry, build_world
+    from tutorial.view.meshcat_server import start_server
+    from tutorial.view.scene import Scene
+
+    model = build_world([ModelEntry("M", ROOT / model_file)])
+    data = mujoco.MjData(model)
+    server = start_server()
+    try:
+        scene = Scene(server.visualizer(), model)
+        scene.build(data)
+        pipe = scene._pipe
+        times = {"pipelined": [], "round_trip_per_body": []}
+        for i in range(frames):
+            for label, p in (("pipelined", pipe), ("round_trip_per_body", None)):
+                scene._pipe = p
+                data.qpos[:] = 0.001 * (2 * i + (p is None))
+                mujoco.mj_kinematics(model, data)
+                t0 = time.perf_counter()
+                scene.update(data)
+                times[label].append(time.perf_counter() - t0)
+        scene._pipe = pipe
+        scene.close()
+    finally:
+        server.close()
+    out = {k: pct(v, 1000.0) for k, v in times.items()}
+    out["transforms"] = len(scene.moving_bodies)  # per frame, all moving (a tank: chassis, turret, barrel)
+    out["speedup_p50"] = round(out["round_trip_per_body"]["p50"] / out["pipelined"]["p50"], 2)
+    return out

@@ -1,0 +1,117 @@
+"""The plots of a run: the scale curves and the 1 kHz latency distributions, as PNG files for the book."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.scale_projects import SCALE_JOINTS, SCALE_RATE, SCALE_TANKS
+from benchmarks.targets import SCALE_AGE, SCALE_CPU, SCALE_FRAMES, SCALE_REAL_TIME
+
+
+def plot_scale(r: dict, path: Path) -> Path:
+    """The scale curves, one column per kind of growth (tanks, joints), a row per figure, as a PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scale = r["scale"]
+    age_limit = SCALE_AGE.limit + SCALE_AGE.baseline(r)  # ms: the limit plus the bare pair's p99 at 50 Hz
+    fig, axes = plt.subplots(5, 2, figsize=(10, 15), constrained_layout=True)  # legible at book width
+    columns = (
+        ("tanks", "tanks in one world (each: Step 1 controller, Step 2 publisher)", SCALE_TANKS),
+        ("joints", "joints of one arm", SCALE_JOINTS),
+    )
+    for col, (kind, xlabel, sizes) in enumerate(columns):
+        data = [scale[kind][str(n)] for n in sizes]
+        ax = axes[0, col]
+        ax.plot(
+            sizes,
+            [d["simulation_speed"]["publisher_50Hz_ratio"] for d in data],
+            "o-",
+            label="steps/s / bare mj_step's (as fast as possible)",
+        )
+        ax.plot(sizes, [d["real_time_factor"] for d in data], "s-", label="real-time factor (lowest run)")
+        ax.axhline(SCALE_REAL_TIME.limit if kind == "tanks" else 1.0, color="grey", ls=":", lw=1)  # joints: real time
+        ax.set_ylim(0, 1.1)
+        ax.set_title("simulation")
+        ax.legend(fontsize=7, loc="lower left")
+        ax = axes[1, col]
+        ax.plot(sizes, [d["frames_per_s"] for d in data], "o-")
+        ax.axhline(SCALE_FRAMES.limit, color="grey", ls=":", lw=1)
+        ax.set_ylim(0, 65)
+        ax.set_title("viewer: frames/s")
+        ax = axes[2, col]
+        ax.plot(sizes, [d["scene_update_ms"]["p50"] for d in data], "o-", label="p50")
+        ax.plot(sizes, [d["scene_update_ms"]["p99"] for d in data], "s--", label="p99")
+        ax.set_ylim(bottom=0)
+        ax.set_title("viewer: scene update, ms per frame")
+        ax.legend(fontsize=7)
+        ax = axes[3, col]
+        ax.plot(sizes, [d["first_shown_age_ms"]["p50"] for d in data], "o-", label="p50")
+        ax.plot(sizes, [d["first_shown_age_ms"]["p99"] for d in data], "s--", label="p99")
+        ax.axhline(age_limit, color="grey", ls=":", lw=1, label=f"{SCALE_AGE.limit_text} ms + bare pair p99")
+        ax.set_ylim(bottom=0)
+        ax.set_title("displayed-state age, ms")
+        ax.legend(fontsize=7)
+        ax = axes[4, col]
+        for proc in data[0]["cpu_cores"]:
+            ax.plot(sizes, [d["cpu_cores"][proc] for d in data], "o-" if proc == "total" else ".--", label=proc)
+        if kind == "tanks":
+            ax.axhline(SCALE_CPU.limit, color="grey", ls=":", lw=1)
+        ax.set_ylim(bottom=0)
+        ax.set_title("CPU cores per process")
+        ax.legend(fontsize=7)
+        for ax in axes[:, col]:
+            ax.set_title(f"{kind}: {ax.get_title()}")
+            ax.set_xscale("log", base=2)
+            ax.set_xticks(sizes, [str(n) for n in sizes])
+            ax.set_xlabel(xlabel)
+            ax.grid(alpha=0.3)
+    fig.suptitle(
+        f"Scale: {SCALE_RATE:g} Hz publishers, one viewer mirroring every body "
+        f"(make bench, {r['when']}; dotted lines: targets)",
+        fontsize=11,
+    )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return path
+
+
+def plot_latency(r: dict, path: Path) -> Path:
+    """End-to-end latency at 1 kHz as distributions: the tutorial (both executors) and the bare pair."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    series = [
+        ("bare rclpy pair (baseline)", r["bare"]["tank_1kHz"]),
+        ("bare pair, subscriber on the EventsExecutor", r.get("bare_events_executor", {}).get("tank_1kHz")),
+        ("tutorial (default: SingleThreadedExecutor)", r["pipeline"]["tank_1kHz"]),
+        ("tutorial, RTT_EXECUTOR=events", r.get("pipeline_events_executor", {}).get("tank_1kHz")),
+    ]
+    fig, ax = plt.subplots(figsize=(8, 4.2), constrained_layout=True)
+    for label, s in series:
+        if not s:
+            continue
+        x = np.asarray(s["latency_samples_ms"])
+        y = 1.0 - np.arange(x.size) / x.size
+        ax.plot(x, y, label=f"{label}: p50 {s['latency_ms']['p50']:.3f}, p99 {s['latency_ms']['p99']:.2f} ms")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(1e-4, 1.05)
+    ax.set_xlabel("end-to-end latency at 1 kHz, ms (tutorial: step -> applied on the viewer's main thread)")
+    ax.set_ylabel("fraction of states slower")
+    ax.axhline(0.5, color="grey", ls=":", lw=1)
+    ax.axhline(0.01, color="grey", ls=":", lw=1)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    ax.set_title(f"1 kHz hand-off, {r['rounds']} interleaved rounds pooled (make bench, {r['when']})", fontsize=10)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return path

@@ -1,0 +1,150 @@
+"""The report of a run: the printed summary, and the targets as Markdown (one run, or several saved runs)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+
+def targets_markdown(r: dict) -> str:
+    """The targets as a Markdown table (the book's first table)."""
+    lines = ["| target | measured | baseline, same run | ratio | |", "|---|---|---|---|---|"]
+    for t in r["targets"]:
+        lines.append(
+            f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | "
+            f"{'pass' if t['pass'] else '**FAIL**'} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def runs_table(paths: list[str]) -> str:
+    """The targets of several saved runs (``latest.json`` files) as one Markdown table.
+
+    The measured figure, baseline and ratio are the last run's; the last
+    column gives every run's ratio (or figure) and verdict, in order.
+    """
+    runs = [json.loads(Path(p).read_text()) for p in paths]
+    last = runs[-1]
+    numbers = ", ".join(str(i + 1) for i in range(len(runs)))
+    lines = [f"| target | measured | baseline, same run | ratio | runs {numbers} |", "|---|---|---|---|---|"]
+    for i, t in enumerate(last["targets"]):
+        each = []
+        for r in runs:
+            u = r["targets"][i]
+            each.append(f"{u['ratio'] or u['measured']} {'pass' if u['pass'] else '**FAIL**'}")
+        lines.append(f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | {'; '.join(each)} |")
+    return "\n".join(lines) + "\n"
+
+
+def print_report(r: dict) -> None:
+    """Print a run's figures, section by section (times in ms unless marked), then its targets."""
+    sim = r["simulation_speed"]
+    print("\n== simulation speed (steps/s, as fast as possible; ratio to bare mj_step on the same model, same run)")
+    for name, s in sim.items():
+        parts = [f"bare {s['bare_steps_per_s']}"]
+        for k in s:
+            if k.endswith("_steps_per_s") and k != "bare_steps_per_s":
+                label = k[: -len("_steps_per_s")]
+                q1, q3 = s[label + "_ratio_quartiles"]
+                lo, hi = s.get(label + "_ratio_ci95", (float("nan"),) * 2)
+                parts.append(
+                    f"{label} {s[k]} ({s[label + '_ratio']:.3f}x, 95% CI {lo:.3f}-{hi:.3f}, "
+                    f"quartiles {q1:.2f}-{q3:.2f})"
+                )
+        print(f"  {name:5s} " + ", ".join(parts) + f"  [{s['pairs']} interleaved pairs of {s['steps_per_run']} steps]")
+    rt = r["realtime"]
+    print(
+        f"  real-time mode (tank, all controllers): real-time factor {rt['real_time_factor']}, "
+        f"step overrun p50 {rt['overrun_ms']['p50']} ms, p99 {rt['overrun_ms']['p99']} ms, "
+        f"max {rt['overrun_ms']['max']} ms"
+    )
+    print(
+        f"\n== end-to-end latency across processes (ms): step -> applied on the viewer's main thread; bare pair: "
+        f"publish -> callback ({r['rounds']} interleaved rounds of {r['seconds_per_run']:g} s each, samples pooled)"
+    )
+    print(
+        f"  {'run':14s} {'p50':>7s} {'p90':>7s} {'p99':>7s} {'max':>8s}   {'bare p50':>8s} {'bare p99':>8s}  "
+        "ratio p50/p99"
+    )
+    for key, run in r["pipeline"].items():
+        bare = r["bare"][key]["latency_ms"]
+        lat = run["latency_ms"]
+        print(
+            f"  {key:14s} {lat['p50']:7.3f} {lat['p90']:7.3f} {lat['p99']:7.3f} {lat['max']:8.3f}   "
+            f"{bare['p50']:8.3f} {bare['p99']:8.3f}  {lat['p50'] / bare['p50']:.2f} / {lat['p99'] / bare['p99']:.2f}"
+        )
+    for key, bare in r.get("bare_events_executor", {}).items():
+        lat, tutorial = bare["latency_ms"], r["pipeline"][key]["latency_ms"]
+        print(
+            f"  (not a target: {key} bare pair with its subscriber on the EventsExecutor: p50 {lat['p50']:.3f}, "
+            f"p99 {lat['p99']:.3f}; the tutorial's p50/p99 are {tutorial['p50'] / lat['p50']:.2f}x"
+            f" / {tutorial['p99'] / lat['p99']:.2f}x these)"
+        )
+    for key, run in r.get("pipeline_events_executor", {}).items():
+        lat, cpu = run["latency_ms"], run["cpu_cores"]
+        print(
+            f"  (not a target: {key} pipeline with RTT_EXECUTOR=events: p50 {lat['p50']:.3f}, "
+            f"p99 {lat['p99']:.3f} ({lat['p50'] / r['bare'][key]['latency_ms']['p50']:.2f}x / "
+            f"{lat['p99'] / r['bare'][key]['latency_ms']['p99']:.2f}x the bare pair); callback -> applied p50 "
+            f"{run['callback_to_applied_ms']['p50']:.3f}; CPU cores sim {cpu['simulation']}, viewer "
+            f"{cpu['viewer']}, total {cpu['total']})"
+        )
+    print("  where it goes (p50 / p99 ms): step -> viewer's callback | callback -> applied on the main thread")
+    for key, run in r["pipeline"].items():
+        a, b = run["step_to_callback_ms"], run["callback_to_applied_ms"]
+        print(f"  {key:14s} {a['p50']:.3f} / {a['p99']:.3f} | {b['p50']:.3f} / {b['p99']:.3f}")
+    print("\n== the viewer (meshcat on), per run")
+    for key, run in r["pipeline"].items():
+        m, age, update, cpu = run["messages"], run["displayed_age_ms"], run["scene_update_ms"], run["cpu_cores"]
+        print(
+            f"  {key:14s} displayed age p50 {age['p50']:.2f} ms, p99 {age['p99']:.2f} ms "
+            f"(first half {run['displayed_age_p99_ms_first_half']}, "
+            f"second half {run['displayed_age_p99_ms_second_half']}); "
+            f"{run['frames_per_s']} frames/s; scene update p50 {update['p50']:.3f} ms, "
+            f"p99 {update['p99']:.3f} ms; messages applied {m['applied']}, coalesced {m['coalesced']}, "
+            f"max pending {m['max_pending']}, spin thread stepped aside {m['yields']} times "
+            f"({m['yield_timeouts']} gave up); CPU cores sim {cpu['simulation']}, viewer "
+            f"{cpu['viewer']}, total {cpu['total']} (bare pair {r['bare'][key]['cpu_cores']})"
+        )
+    print(
+        "\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, same server, "
+        "interleaved"
+    )
+    for name, u in r["scene_update"].items():
+        pipelined, round_trip = u["pipelined"], u["round_trip_per_body"]
+        print(
+            f"  {name:6s} {u['transforms']} transforms: pipelined p50 {pipelined['p50']:.3f} "
+            f"p99 {pipelined['p99']:.3f}; round trip per body p50 {round_trip['p50']:.3f} "
+            f"p99 {round_trip['p99']:.3f} ({u['speedup_p50']}x)"
+        )
+    print(
+        f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, "
+        f"median {r['startup']['median_s']} s"
+    )
+    scale = r.get("scale")
+    if scale:
+        print(
+            f"\n== scale ({scale['rate_hz']:g} Hz publishers, {scale['rounds']} rounds of "
+            f"{scale['seconds_per_run']:g} s, pooled): simulation speed vs bare mj_step (as fast as possible) and "
+            "real-time factor (lowest run); the viewer; displayed-state age at first display p99; CPU cores"
+        )
+        for kind in ("tanks", "joints"):
+            for n, s in scale[kind].items():
+                sp, cpu = s["simulation_speed"], s["cpu_cores"]
+                parts = ", ".join(f"{k} {v:.2f}" for k, v in cpu.items())
+                print(
+                    f"  {n:>2s} {kind:6s}: {sp['publisher_50Hz_ratio']:.3f}x bare "
+                    f"({sp['publisher_50Hz_steps_per_s']:,} vs {sp['bare_steps_per_s']:,} steps/s), "
+                    f"RTF {s['real_time_factor']}; {s['frames_per_s']} frames/s, "
+                    f"scene update p50 {s['scene_update_ms']['p50']:.2f} p99 {s['scene_update_ms']['p99']:.2f} ms; "
+                    f"age p99 {s['first_shown_age_ms']['p99']:.2f} ms "
+                    f"(every frame: {s['displayed_age_ms']['p99']:.2f}); CPU {parts}"
+                )
+    print("\n== targets")
+    for t in r["targets"]:
+        figure = (
+            t["measured"]
+            + (f" vs {t['baseline']}" if t["baseline"] else "")
+            + (f" ({t['ratio']})" if t["ratio"] else "")
+        )
+        print(f"  [{'PASS' if t['pass'] else 'FAIL'}] {t['target']}: {figure}")

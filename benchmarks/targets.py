@@ -1,0 +1,204 @@
+"""The targets of ``make bench`` as data: each limit is written once, and makes both the target's words and its verdict.
+
+A target holds one figure of a run (``latest.json``'s dict) against its
+limit, and writes the table's row: target, measured, baseline (same run),
+ratio, pass.  Adding one is an entry in :data:`TARGETS`.
+"""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import reduce
+
+from benchmarks.scale_projects import SCALE_RATE, SCALE_TANKS
+
+FRAME_60HZ_MS = 1000.0 / 60.0  # ms: one frame of a 60 Hz display
+AT_MOST, AT_LEAST = operator.le, operator.ge
+# What a target's figure (its ratio, for "ratio") is held against, from its limit and its same-run baseline.
+BOUNDS = {
+    "limit": lambda limit, baseline: limit,
+    "ratio": lambda limit, baseline: limit,
+    "times": lambda limit, baseline: limit * baseline,
+    "plus": lambda limit, baseline: limit + baseline,
+}
+
+
+def read(*keys: str) -> Callable[[dict], object]:
+    """A reader of run results: ``read("a", "b")(r)`` is ``r["a"]["b"]``."""
+    return lambda r: reduce(operator.getitem, keys, r)
+
+
+@dataclass(frozen=True)
+class Target:
+    """One target: a figure of a run, its limit, and how the two are compared and written.
+
+    ``text`` holds ``{limit}`` where the limit goes, written with
+    ``limit_fmt``; the verdict uses the same ``limit``.  ``against`` says
+    what the figure is held against: ``"limit"`` (the limit itself; a
+    baseline, if given, is shown for reference), ``"times"`` (the limit
+    times the baseline), ``"plus"`` (the limit plus the baseline), or
+    ``"ratio"`` (not the figure: ``ratio(r)`` is held against the limit).
+    A figure, baseline or ratio that is None was not measured: "n/a", a fail.
+    """
+
+    text: str
+    limit: float
+    compare: Callable[[float, float], bool]  # AT_MOST or AT_LEAST: compare(figure, what it is held against)
+    figure: Callable[[dict], float | None]  # run results -> the measured figure
+    fmt: str  # the figure written, e.g. "{:.3f} ms"
+    against: str = "limit"  # "limit", "times", "plus" or "ratio" (see above)
+    baseline: Callable[[dict], float | None] | None = None  # run results -> the same-run baseline, same unit
+    baseline_fmt: str | None = None  # the baseline written (None: as `fmt`)
+    ratio: Callable[[dict], float | None] | None = None  # run results -> the ratio (None: figure / baseline)
+    ratio_fmt: str = "{:.2f}x"
+    limit_fmt: str = "{:g}"
+    needs: str | None = None  # a key of the run results without which the target is left out ("scale")
+
+    @property
+    def limit_text(self) -> str:
+        """The limit as the target's words write it."""
+        return self.limit_fmt.format(self.limit)
+
+    @property
+    def label(self) -> str:
+        """The target's words, its limit written in."""
+        return self.text.format(limit=self.limit_text)
+
+    def row(self, r: dict) -> dict:
+        """The table's row for run results ``r``: target, measured, baseline, ratio (text) and pass (bool)."""
+        value = self.figure(r)
+        base = None if self.baseline is None else self.baseline(r)
+        if self.ratio is not None:
+            ratio = self.ratio(r)
+        elif value is None or base is None:
+            ratio = None
+        else:  # the figure to its baseline, or to its bound when that is the limit plus the baseline
+            ratio = value / (self.limit + base if self.against == "plus" else base)
+        held = ratio if self.against == "ratio" else value
+        if base is None and self.against in ("times", "plus"):
+            held = None
+        if self.baseline is None:
+            baseline = ""
+        elif base is None:
+            baseline = "n/a"
+        else:
+            baseline = (self.baseline_fmt or self.fmt).format(base)
+            if self.against == "plus":
+                baseline = f"{self.limit_text} + {baseline}"
+        return {
+            "target": self.label,
+            "measured": "n/a" if value is None else self.fmt.format(value),
+            "baseline": baseline,
+            "ratio": "" if ratio is None else self.ratio_fmt.format(ratio),
+            "pass": held is not None and bool(self.compare(held, BOUNDS[self.against](self.limit, base))),
+        }
+
+
+_TANK_1KHZ, _BARE_1KHZ = ("pipeline", "tank_1kHz"), ("bare", "tank_1kHz")
+_SPEED = ("simulation_speed", "tank")
+_MOST_TANKS = ("scale", "tanks", str(max(SCALE_TANKS)))
+
+# The scale targets, by name: the scale plot draws their limits.
+SCALE_REAL_TIME = Target(
+    "8 tanks simulate in real time (real-time factor >= {limit}, the lowest run)",
+    0.99,
+    AT_LEAST,
+    read(*_MOST_TANKS, "real_time_factor"),
+    "{:.3f}",
+    baseline=lambda r: 1.0,
+    baseline_fmt="{:.3f} (wall clock)",
+    ratio_fmt="{:.3f}x",
+    needs="scale",
+)
+SCALE_FRAMES = Target(
+    "the viewer mirrors all 8 at >= {limit} frames/s",
+    50.0,
+    AT_LEAST,
+    read(*_MOST_TANKS, "frames_per_s"),
+    "{:.1f} frames/s",
+    baseline=lambda r: SCALE_RATE,
+    baseline_fmt="{:.0f} states/s per tank (cap 60)",
+    needs="scale",
+)
+SCALE_AGE = Target(
+    "8 tanks: displayed-state age p99 <= {limit} ms + the bare pair's p99 (50 Hz)",
+    FRAME_60HZ_MS,
+    AT_MOST,
+    read(*_MOST_TANKS, "first_shown_age_ms", "p99"),
+    "{:.2f} ms",
+    against="plus",
+    baseline=read("bare", "tank_50Hz", "latency_ms", "p99"),
+    limit_fmt="{:.1f}",
+    needs="scale",
+)
+SCALE_CPU = Target(
+    "8 tanks: the whole pipeline <= {limit} CPU cores",
+    1.5,
+    AT_MOST,
+    read(*_MOST_TANKS, "cpu_cores", "total"),
+    "{:.2f} cores",
+    needs="scale",
+)
+
+TARGETS = (
+    Target(
+        "simulation with the 50 Hz publisher >= {limit}x bare mj_step (steps/s)",
+        0.8,
+        AT_LEAST,
+        read(*_SPEED, "publisher_50Hz_steps_per_s"),
+        "{:,} steps/s",
+        against="ratio",
+        baseline=read(*_SPEED, "bare_steps_per_s"),
+        ratio=read(*_SPEED, "publisher_50Hz_ratio"),
+        ratio_fmt="{:.3f}x",
+    ),
+    Target(
+        "end-to-end p50 <= {limit}x the bare rclpy pair at 1 kHz",
+        1.5,
+        AT_MOST,
+        read(*_TANK_1KHZ, "latency_ms", "p50"),
+        "{:.3f} ms",
+        against="times",
+        baseline=read(*_BARE_1KHZ, "latency_ms", "p50"),
+    ),
+    Target(
+        "end-to-end p99 <= {limit}x the bare rclpy pair at 1 kHz",
+        2.0,
+        AT_MOST,
+        read(*_TANK_1KHZ, "latency_ms", "p99"),
+        "{:.3f} ms",
+        against="times",
+        baseline=read(*_BARE_1KHZ, "latency_ms", "p99"),
+    ),
+    Target(
+        "displayed-state age p99 at 1 kHz <= {limit} ms + the bare pair's p99",
+        FRAME_60HZ_MS,
+        AT_MOST,
+        read(*_TANK_1KHZ, "displayed_age_ms", "p99"),
+        "{:.2f} ms",
+        against="plus",
+        baseline=read(*_BARE_1KHZ, "latency_ms", "p99"),
+        limit_fmt="{:.1f}",
+    ),
+    Target(
+        "Step 3 pipeline at 1 kHz <= {limit} CPU core",
+        1.0,
+        AT_MOST,
+        read(*_TANK_1KHZ, "cpu_cores", "total"),
+        "{:.2f} cores",
+        baseline=read(*_BARE_1KHZ, "cpu_cores"),
+        baseline_fmt="bare pair {:.2f} cores",
+    ),
+    Target("first state shown <= {limit} s after launch", 3.0, AT_MOST, read("startup", "median_s"), "{:.2f} s"),
+    SCALE_REAL_TIME,
+    SCALE_FRAMES,
+    SCALE_AGE,
+    SCALE_CPU,
+)
+
+
+def targets(r: dict) -> list[dict]:
+    """Each target's row for run results ``r``: its text, the measured figure, the same-run baseline, ratio, pass."""
+    return [t.row(r) for t in TARGETS if t.needs is None or r.get(t.needs)]
