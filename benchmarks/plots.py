@@ -115,3 +115,51 @@ def plot_latency(r: dict, path: Path) -> Path:
     fig.savefig(path, dpi=80)
     plt.close(fig)
     return path
+
+
+BROWSER_STAGES = (
+    ("publish_to_callback", "ROS delivery"),
+    ("callback_to_applied", "hand-off to the main thread"),
+    ("applied_to_sent", "frame pacing and scene update"),
+    ("sent_to_page", "meshcat server and WebSocket"),
+    ("page_to_drawn", "the page's next render"),
+)
+
+
+def plot_browser(r: dict, path: Path) -> Path:
+    """Publish -> drawn in the browser, stage by stage (p50 bars, p99 marks), each case beside its bare page."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = list(r["browser"])
+    fig, ax = plt.subplots(figsize=(8, 0.9 + 0.75 * len(cases)), constrained_layout=True)
+    colors = plt.cm.tab10.colors
+    for row, case in enumerate(cases):
+        tut, bare = r["browser"][case]["tutorial"], r["browser"][case]["bare"]
+        left = 0.0
+        for i, (key, words) in enumerate(BROWSER_STAGES):
+            width = tut[key]["p50"] or 0.0
+            ax.barh(row + 0.18, width, left=left, height=0.34, color=colors[i], label=words if row == 0 else None)
+            left += width
+        ax.plot([tut["publish_to_drawn"]["p99"]], [row + 0.18], "k|", ms=14, mew=2)
+        ax.barh(
+            row - 0.18,
+            bare["sent_to_drawn"]["p50"] or 0.0,
+            height=0.34,
+            color="lightgrey",
+            label="bare page: send -> drawn" if row == 0 else None,
+        )
+        ax.plot([bare["sent_to_drawn"]["p99"]], [row - 0.18], "|", color="grey", ms=14, mew=2)
+    ax.set_yticks(range(len(cases)), cases)
+    ax.invert_yaxis()
+    ax.axvline(2 * 1000 / 60, color="red", ls=":", lw=1)
+    ax.set_xlabel("ms from publish (tutorial) or send (bare page) to drawn: bars p50 per stage, marks p99")
+    ax.legend(fontsize=7, loc="lower right")
+    ax.grid(alpha=0.3, axis="x")
+    ax.set_title(f"A state's way to the pixel, headless Chromium (make bench, {r['when']})", fontsize=10)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return path

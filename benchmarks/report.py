@@ -140,6 +140,26 @@ def print_report(r: dict) -> None:
                     f"age p99 {s['first_shown_age_ms']['p99']:.2f} ms "
                     f"(every frame: {s['displayed_age_ms']['p99']:.2f}); CPU {parts}"
                 )
+    if r.get("browser"):
+        print("\n== publish -> pixel in headless Chromium (ms, p50/p99 per stage; bare: the same commands replayed)")
+        for case, b in r["browser"].items():
+            tut, bare = b["tutorial"], b["bare"]
+            stages = ", ".join(
+                f"{k} {tut[k]['p50']}/{tut[k]['p99']}"
+                for k in (
+                    "publish_to_callback",
+                    "callback_to_applied",
+                    "applied_to_sent",
+                    "sent_to_page",
+                    "page_to_drawn",
+                )
+            )
+            print(
+                f"  {case}: publish->drawn {tut['publish_to_drawn']['p50']}/{tut['publish_to_drawn']['p99']} "
+                f"({tut['states_drawn']} states drawn; {stages}); page {tut['frames_per_s']} frames/s; "
+                f"bare send->drawn {bare['sent_to_drawn']['p50']}/{bare['sent_to_drawn']['p99']}, "
+                f"{bare['frames_per_s']} frames/s"
+            )
     print("\n== targets")
     for t in r["targets"]:
         figure = (

@@ -47,13 +47,15 @@ import tempfile
 import time
 from pathlib import Path
 
+from benchmarks.experiments.browser import CASES as BROWSER_CASES
+from benchmarks.experiments.browser import pixel_latency
 from benchmarks.experiments.cross_process import latency_rounds
 from benchmarks.experiments.scale import scale_curves
 from benchmarks.experiments.scene_update import scene_update_cost
 from benchmarks.experiments.speed import SPEED_PAIRS, SPEED_PAIRS_OTHER, realtime_mode, simulation_speed
 from benchmarks.experiments.startup import startup
 from benchmarks.paths import BOOK_STATIC, RESULTS, ROOT
-from benchmarks.plots import plot_latency, plot_scale
+from benchmarks.plots import plot_browser, plot_latency, plot_scale
 from benchmarks.report import print_report, runs_table, targets_markdown
 from benchmarks.targets import targets
 
@@ -123,10 +125,15 @@ def main(argv=None) -> int:
         r["scale"] = scale_curves(
             seconds, warmup, 1 if args.quick else args.scale_rounds, 8 if args.quick else 20, Path(d)
         )
+    r["browser"] = pixel_latency(list(BROWSER_CASES), seconds, warmup)
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
     r["targets"] = targets(r)
     print_report(r)
-    r["plots"] = [str(plot_scale(r, plots / "bench_scale.png")), str(plot_latency(r, plots / "bench_latency.png"))]
+    r["plots"] = [
+        str(plot_scale(r, plots / "bench_scale.png")),
+        str(plot_latency(r, plots / "bench_latency.png")),
+        str(plot_browser(r, plots / "bench_browser.png")),
+    ]
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(r, indent=1))

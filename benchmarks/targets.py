@@ -142,6 +142,51 @@ SCALE_CPU = Target(
     needs="scale",
 )
 
+_BROWSER_CASES = {
+    "tank_50Hz": "1 tank at 50 Hz",
+    "tank_1kHz": "1 tank at 1 kHz",
+    "tanks_8": "8 tanks",
+    "arm_48": "the 48-joint arm",
+}
+BROWSER_TARGETS = tuple(
+    target
+    for case, words in _BROWSER_CASES.items()
+    for target in (
+        Target(
+            f"browser, {words}: publish -> drawn p99 <= {{limit}} ms (two 60 Hz frames)",
+            2 * FRAME_60HZ_MS,
+            AT_MOST,
+            read("browser", case, "tutorial", "publish_to_drawn", "p99"),
+            "{:.1f} ms",
+            baseline=read("browser", case, "bare", "sent_to_drawn", "p99"),
+            baseline_fmt="bare page {:.1f} ms",
+            limit_fmt="{:.1f}",
+            needs="browser",
+        ),
+        Target(
+            f"browser, {words}: publish -> drawn p99 <= {{limit}}x the bare page's send -> drawn p99",
+            1.2,
+            AT_MOST,
+            read("browser", case, "tutorial", "publish_to_drawn", "p99"),
+            "{:.1f} ms",
+            against="times",
+            baseline=read("browser", case, "bare", "sent_to_drawn", "p99"),
+            needs="browser",
+        ),
+    )
+) + (
+    Target(
+        "browser, 8 tanks: the page keeps >= {limit} frames/s",
+        55.0,
+        AT_LEAST,
+        read("browser", "tanks_8", "tutorial", "frames_per_s"),
+        "{:.1f} frames/s",
+        baseline=read("browser", "tanks_8", "bare", "frames_per_s"),
+        baseline_fmt="bare page {:.1f} frames/s",
+        needs="browser",
+    ),
+)
+
 TARGETS = (
     Target(
         "simulation with the 50 Hz publisher >= {limit}x bare mj_step (steps/s)",
@@ -196,6 +241,7 @@ TARGETS = (
     SCALE_FRAMES,
     SCALE_AGE,
     SCALE_CPU,
+    *BROWSER_TARGETS,
 )
 
 

@@ -10,7 +10,7 @@ tapped before the scene is built), prints ``{"event": "meshcat_url", ...}``
 as a JSON line, and writes every command the viewer sent to meshcat to FILE:
 each with its send time (``time.monotonic_ns()``), its type, path and bytes
 (hex), and for a transform the body it moves and the stamp of the state the
-body showed (``benchmarks.browser`` replays and joins them).
+body showed (``benchmarks.experiments.browser`` replays and joins them).
 """
 
 from __future__ import annotations

@@ -4,5 +4,6 @@
 * :mod:`.cross_process`: simulation and viewer as two processes against the bare rclpy pair;
 * :mod:`.scene_update`: meshcat's cost per frame, pipelined against a round trip per body;
 * :mod:`.startup`: from the launch command to the first state shown;
-* :mod:`.scale`: the pipeline as the tanks and the joints grow.
+* :mod:`.scale`: the pipeline as the tanks and the joints grow;
+* :mod:`.browser`: from a published state to the pixel in a real browser, against a bare meshcat page.
 """

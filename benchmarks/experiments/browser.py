@@ -1,6 +1,6 @@
 """From a published state to the pixel: the viewer's meshcat page in a real browser, stage by stage.
 
-    python -m benchmarks.browser [--seconds 8] [--cases tank_50Hz tank_1kHz tanks_8 arm_48]
+    python -m benchmarks.experiments.browser [--seconds 8] [--cases tank_50Hz tank_1kHz tanks_8 arm_48]
 
 Each case runs the simulation and the Step 3 viewer as two processes, as
 ``make bench``'s pipeline runs do, but the viewer draws in meshcat, and
