@@ -1,0 +1,551 @@
+"""A body of a MuJoCo model as a URDF: what ``rtt-urdf`` writes and the simulation publishes.
+
+:func:`export_body` reads a :class:`tutorial.core.body.Body` (the compiled
+``MjModel``, never the MJCF text) and builds a ``yourdfpy.Robot``, which
+``yourdfpy`` writes as URDF XML.  Names are the body's own: a link per MuJoCo
+body, named as the body is (without the world's ``Tank/`` prefix; unnamed
+ones by :func:`tutorial.core.world.name_unnamed_elements`'s rule), a joint per
+MuJoCo joint, named as the joint is, so a ``JointState`` of the body moves
+the URDF's joints by name (``robot_state_publisher``).
+
+What it maps, exactly (a URDF link's pose equals MuJoCo's body pose for any
+values of the numbered joints; ``tests/test_urdf.py`` checks it with
+``yourdfpy``'s own forward kinematics on the tank and on third-party models):
+
+==========================  ==============================================================
+MuJoCo                      URDF
+==========================  ==============================================================
+the body's root             the *root link*: the one top-level body, when its joint is a
+                            free joint (the tank's ``CHASSIS``: its pose is the body's
+                            odometry, ``/<body>/odom``) or when it has no joint (welded to
+                            the world); otherwise a link ``<robot>_world`` standing for
+                            the world frame the model is placed in (its odometry is the
+                            identity), with the top-level bodies hanging from it
+hinge, numbered             ``revolute`` with ``lower``/``upper`` when limited, else
+                            ``continuous``; the axis; MuJoCo's reference angle (``ref``,
+                            ``qpos0``) is folded into the joint's origin, so the URDF joint
+                            takes the same value JointState carries
+slide, numbered             ``prismatic``, axis, ``lower``/``upper`` when limited (an
+                            unlimited slide gets +-1e6 m: URDF has no unlimited prismatic
+                            joint)
+a joint off the body's      a joint turns or slides about an anchor (``pos``) that need not
+origin, several joints      be the body's origin, and a MuJoCo body may have several joints:
+on one body                 each becomes a URDF joint whose child is a link
+                            ``<joint>_frame``, and a fixed joint ``<body>_offset`` carries
+                            the rest to the body's own link, so every link is the body's frame
+a body with no joint        a ``fixed`` joint ``<parent>_to_<body>``
+joint group 3, ball joint   ``fixed`` at the reference position (``qpos0``): JointState does
+                            not carry them (``Body.skipped_joints``), so
+                            ``robot_state_publisher`` could not move them, and a moving joint
+                            without a state leaves its links with no transform (RViz2:
+                            "No transform from ..."); the Step 3 viewer shows them there too.
+                            The tank's road wheels turn about their own axes: as drawn,
+                            cylinders, they look the same at any angle
+a free joint off the root   ``floating`` at its reference pose (no topic carries its pose;
+                            ``robot_state_publisher`` moves no floating joint either)
+mass, centre of mass,       ``<inertial>``: mass, origin at the centre of mass turned to the
+inertia                     principal axes, the diagonal principal inertia
+box, cylinder, sphere       ``<box>`` (full sizes), ``<cylinder>`` (radius, full length),
+                            ``<sphere>``: exact
+capsule                     a cylinder and two spheres: the same shape, exactly
+ellipsoid                   a unit-sphere mesh (``ellipsoid.stl``, 642 vertices) scaled by
+                            the radii: an approximation of the surface
+plane                       a box 2 mm thick under the plane (20 m wide where MuJoCo's
+                            size is 0, infinite)
+mesh                        the compiled mesh (MuJoCo's vertices and faces, in the frame
+                            the compiler moved it to) as a binary STL file beside the URDF
+colours                     each visual's ``<material>``: the geom's rgba, or its MuJoCo
+                            material's (as the meshcat viewer draws it)
+visual / collision          a geom in groups 0-2 is a ``<visual>`` (groups 3 and up are
+                            hidden, as in MuJoCo's viewer and ours); a geom that collides
+                            (``contype`` or ``conaffinity`` not 0) is a ``<collision>``
+==========================  ==============================================================
+
+What it cannot map, and leaves out (each is listed in the file's opening
+comment and in :attr:`UrdfExport.notes`): height fields and SDF geoms;
+geoms the model fixes to the world when the root is free (a floor is not
+part of a robot that drives on it); sites, cameras and lights; tendons,
+actuators (transmissions) and equality constraints (the tank's wheels turning
+together); joint damping, friction and armature; contact parameters;
+velocity limits (URDF's ``velocity`` is written 0: MuJoCo has none) and an
+effort limit the model does not give (``effort`` 0).  A floating joint's
+motion.
+
+Any thread may call these functions: they only read the model.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from tutorial.core.body import Body
+
+ROOT_FREE, ROOT_FIXED, ROOT_WORLD = "free", "fixed", "world"
+HIDDEN_GEOM_GROUP = 3  # as tutorial.view.scene: groups 3 and up are not drawn
+PLANE_THICKNESS = 0.002  # m
+INFINITE_PLANE = 10.0  # m, the half size given to a plane MuJoCo makes infinite
+UNLIMITED_SLIDE = 1e6  # m
+ELLIPSOID_MESH = "ellipsoid.stl"
+_IDENTITY_TOL = 1e-12
+
+_T = mujoco.mjtGeom
+_JNT = mujoco.mjtJoint
+
+
+@dataclass
+class UrdfExport:
+    """A body as a URDF, before it is written.
+
+    Attributes:
+        robot: the ``yourdfpy.Robot`` (mesh file names bare, e.g. ``foot.stl``).
+        root_link: the name of the URDF's root link.
+        root_kind: ``free`` (the root body's free joint: its pose is the odometry),
+            ``fixed`` (the root body is welded to the world) or ``world`` (a link
+            for the world frame, see the module text).
+        links: MuJoCo body id (in the world model) -> its link's name.
+        moving_joints: the URDF's revolute, continuous and prismatic joints, in
+            model order: the body's numbered joints (``Body.joint_names``).
+        root_body: the MuJoCo id of the root link's body; None when the root
+            link stands for the world frame (``root_kind`` ``world``).
+        meshes: STL file name -> ``(vertices (n, 3) m, faces (k, 3))`` to write beside the URDF.
+        notes: what was approximated or left out, one line each.
+    """
+
+    robot: object
+    root_link: str
+    root_kind: str
+    links: dict[int, str]
+    moving_joints: list[str]
+    root_body: int | None = None
+    meshes: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    def xml(self, mesh_prefix: str = "", source: str = "") -> str:
+        """The URDF as text, mesh files named ``mesh_prefix + name`` (e.g. ``tank_meshes/``).
+
+        ``source`` is named in the opening comment (e.g. the model file).
+        """
+        from lxml import etree
+        from yourdfpy import URDF, filename_handler_null
+
+        robot = copy.deepcopy(self.robot)
+        for link in robot.links:
+            for element in (*link.visuals, *link.collisions):
+                if element.geometry.mesh is not None:
+                    element.geometry.mesh.filename = mesh_prefix + element.geometry.mesh.filename
+        tree = URDF(
+            robot, build_scene_graph=False, load_meshes=False, filename_handler=filename_handler_null
+        ).write_xml()
+        root = tree.getroot()
+        root.insert(0, etree.Comment(self.comment(source)))
+        return etree.tostring(tree, xml_declaration=True, pretty_print=True, encoding="utf-8").decode()
+
+    def comment(self, source: str = "") -> str:
+        """The file's opening comment: where it came from, its root, what was left out."""
+        lines = [
+            f" Written by rtt-urdf (ros-tank-tutorial) from {source or 'a MuJoCo model'}: robot {self.robot.name}. ",
+            f" Root link {self.root_link} ({_ROOT_TEXT[self.root_kind]}). ",
+            f" Joints moved by /{self.robot.name}/joint_state: {', '.join(self.moving_joints) or 'none'}. ",
+        ]
+        if self.notes:
+            lines.append(" Approximated or left out: ")
+            lines += [f"   {n} " for n in self.notes]
+        return "\n" + "\n".join(lines).replace("--", "- -") + "\n"
+
+    def description(self, mesh_folder=None, source: str = "") -> str:
+        """The URDF as a robot description to publish: mesh files named by ``file://`` URIs.
+
+        A description travels as text, without its files: a reader on this
+        machine finds the meshes by absolute URI (RViz2 and Foxglove read
+        ``file://``).  The meshes are written into ``mesh_folder`` (a new
+        temporary folder when None and the body has meshes).
+        """
+        if not self.meshes:
+            return self.xml(source=source)
+        import tempfile
+
+        folder = Path(mesh_folder) if mesh_folder is not None else Path(tempfile.mkdtemp(prefix="rtt-urdf-meshes-"))
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, (vertices, faces) in self.meshes.items():
+            write_stl(folder / name, vertices, faces)
+        return self.xml(folder.resolve().as_uri() + "/", source)
+
+    def write(self, path, mesh_uri: str = "relative", source: str = "") -> list[Path]:
+        """Write the URDF to ``path`` and its meshes to ``<stem>_meshes/`` beside it; the files written.
+
+        Args:
+            path: the ``.urdf`` file.
+            mesh_uri: how the URDF names the mesh files: ``relative`` (to the
+                URDF's folder, which ``yourdfpy`` and MuJoCo read) or ``file``
+                (``file:///absolute/path``, which RViz2 and Foxglove read).
+            source: named in the file's opening comment.
+
+        Raises:
+            ValueError: an unknown ``mesh_uri``.
+            OSError: a file cannot be written.
+        """
+        if mesh_uri not in ("relative", "file"):
+            raise ValueError(f"mesh_uri {mesh_uri!r}: use 'relative' or 'file'")
+        path = Path(path)
+        folder = path.with_name(path.stem + "_meshes")
+        written = []
+        if self.meshes:
+            folder.mkdir(parents=True, exist_ok=True)
+            for name, (vertices, faces) in self.meshes.items():
+                written.append(write_stl(folder / name, vertices, faces))
+        prefix = f"{folder.name}/" if mesh_uri == "relative" else folder.resolve().as_uri() + "/"
+        path.write_text(self.xml(prefix, source), encoding="utf-8")
+        return [path, *written]
+
+
+_ROOT_TEXT = {
+    ROOT_FREE: "the body's free joint: its pose in the world is the odometry",
+    ROOT_FIXED: "welded to the world",
+    ROOT_WORLD: "the world frame the model is placed in",
+}
+
+
+# ---- transforms (4x4, m) -------------------------------------------------------------
+
+
+def pose_matrix(pos, quat) -> np.ndarray:
+    """A 4x4 transform from a position (3,) m and a quaternion (4,) w, x, y, z (normalised here)."""
+    q = np.asarray(quat, dtype=float)
+    q = q / np.linalg.norm(q)
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, q)
+    out = np.eye(4)
+    out[:3, :3] = mat.reshape(3, 3)
+    out[:3, 3] = pos
+    return out
+
+
+def _translation(v) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, 3] = v
+    return out
+
+
+def _rotation(axis, angle: float) -> np.ndarray:
+    q = np.zeros(4)
+    mujoco.mju_axisAngle2Quat(q, np.asarray(axis, dtype=float), float(angle))
+    return pose_matrix((0.0, 0.0, 0.0), q)
+
+
+def _is_identity(t: np.ndarray) -> bool:
+    return bool(np.abs(t - np.eye(4)).max() <= _IDENTITY_TOL)
+
+
+# ---- the export ----------------------------------------------------------------------
+
+
+def export_body(body: Body, robot_name: str | None = None) -> UrdfExport:
+    """The body as a URDF (see the module text for the mapping).
+
+    Args:
+        body: the body, in a world from :func:`tutorial.core.world.build_world`.
+        robot_name: the URDF's robot name; the body's name by default.
+
+    Returns:
+        The :class:`UrdfExport`; :meth:`UrdfExport.xml` or :meth:`UrdfExport.write` writes it.
+
+    Raises:
+        ValueError: the body has no link (a model of static geoms only, a room).
+    """
+    import yourdfpy as y
+
+    if not body.root_ids:
+        raise ValueError(
+            f"body {body.name} has no link (its model only fixes geoms to the world): no robot to describe"
+        )
+    b = _Builder(body, robot_name or body.name, y)
+    return b.build()
+
+
+class _Builder:
+    def __init__(self, body: Body, name: str, y):
+        self.body, self.m, self.y, self.name = body, body.model, y, name
+        self.links: dict[int, str] = {}
+        self.link_objects: dict[str, object] = {}
+        self.joints: list = []
+        self.joint_names: set[str] = set()
+        self.meshes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.notes: list[str] = []
+        self.numbered = {info.joint_id: info for info in body.joint_infos}
+
+    # names
+    def local(self, obj, i: int) -> str:
+        full = mujoco.mj_id2name(self.m, obj, i) or ""
+        return full[len(self.body.prefix) :] if full.startswith(self.body.prefix) else full
+
+    def unique_link(self, name: str) -> str:
+        taken = set(self.link_objects) | {self.local(mujoco.mjtObj.mjOBJ_BODY, b) for b in self.body.body_ids}
+        out, n = name, 0
+        while out in taken:
+            n += 1
+            out = f"{name}_{n}"
+        return out
+
+    def unique_joint(self, name: str, own: bool = False) -> str:
+        """``name`` for a joint: a MuJoCo joint's own name (``own``) as it is, any other made unique."""
+        if own:
+            self.joint_names.add(name)
+            return name
+        reserved = {self.local(mujoco.mjtObj.mjOBJ_JOINT, j) for j in self.body.joint_ids}
+        out, n = name, 0
+        while out in self.joint_names or out in reserved:
+            n += 1
+            out = f"{name}_{n}"
+        self.joint_names.add(out)
+        return out
+
+    def add_link(self, name: str) -> object:
+        link = self.y.Link(name=name)
+        self.link_objects[name] = link
+        return link
+
+    def add_joint(self, name, kind, parent, child, origin, axis=None, limit=None) -> None:
+        self.joints.append(
+            self.y.Joint(
+                name=name,
+                type=kind,
+                parent=parent,
+                child=child,
+                origin=origin,
+                axis=None if axis is None else np.asarray(axis, dtype=float),
+                limit=limit,
+            )
+        )
+
+    # the tree
+    def build(self) -> UrdfExport:
+        m, body = self.m, self.body
+        roots = body.root_ids
+        first_joint = int(m.body_jntadr[roots[0]]) if m.body_jntnum[roots[0]] else -1
+        root_body = None
+        if len(roots) == 1 and first_joint >= 0 and m.jnt_type[first_joint] == _JNT.mjJNT_FREE:
+            kind, root_body = ROOT_FREE, roots[0]
+        elif len(roots) == 1 and first_joint < 0:
+            kind, root_body = ROOT_FIXED, roots[0]
+        else:
+            kind = ROOT_WORLD
+        if root_body is not None:
+            root_link = self.local(mujoco.mjtObj.mjOBJ_BODY, root_body)
+            self.links[root_body] = root_link
+            for j in range(int(m.body_jntadr[root_body]) + 1, int(m.body_jntadr[root_body] + m.body_jntnum[root_body])):
+                self.notes.append(f"joint {self.local(mujoco.mjtObj.mjOBJ_JOINT, j)}: after the root's free joint")
+        else:
+            root_link = self.unique_link(f"{self.name}_world")
+        self.add_link(root_link)
+        if root_body is not None:
+            self.fill_link(root_body, root_link)
+        for b in sorted(body.body_ids):
+            if b != root_body:
+                self.add_body(b, root_link)
+        self.world_geoms(kind, root_body, root_link)
+        robot = self.y.Robot(name=self.name, links=list(self.link_objects.values()), joints=self.joints)
+        moving = [j.name for j in self.joints if j.type in ("revolute", "continuous", "prismatic")]
+        return UrdfExport(robot, root_link, kind, dict(self.links), moving, root_body, self.meshes, self.notes)
+
+    def add_body(self, b: int, root_link: str) -> None:
+        m = self.m
+        link = self.local(mujoco.mjtObj.mjOBJ_BODY, b)
+        self.links[b] = link
+        parent = int(m.body_parentid[b])
+        parent_link = root_link if parent == 0 else self.links[parent]
+        offset = pose_matrix(m.body_pos[b], m.body_quat[b])  # MuJoCo's frame = current link frame @ offset
+        steps = []  # (name, urdf type, axis, limit, origin)
+        folded = []  # joints fixed at their reference position
+        for j in range(int(m.body_jntadr[b]), int(m.body_jntadr[b] + m.body_jntnum[b])):
+            jname = self.local(mujoco.mjtObj.mjOBJ_JOINT, j)
+            jtype = int(m.jnt_type[j])
+            anchor, axis = np.array(m.jnt_pos[j]), np.array(m.jnt_axis[j])
+            ref = float(m.qpos0[m.jnt_qposadr[j]])
+            info = self.numbered.get(j)
+            if info is not None and jtype == _JNT.mjJNT_HINGE:
+                origin = offset @ _translation(anchor) @ _rotation(axis, -ref)
+                steps.append((jname, "revolute" if info.limited else "continuous", axis, self.limit(info), origin))
+                offset = _translation(-anchor)
+            elif info is not None:  # a numbered slide
+                origin = offset @ _translation(-axis * ref)
+                steps.append((jname, "prismatic", axis, self.limit(info), origin))
+                offset = np.eye(4)
+            elif jtype == _JNT.mjJNT_FREE:
+                steps.append((jname, "floating", None, None, offset))
+                offset = np.eye(4)
+                self.notes.append(f"joint {jname}: a free joint below the root, floating at its reference pose")
+            else:
+                if jtype == _JNT.mjJNT_BALL:
+                    adr = int(m.jnt_qposadr[j])
+                    turn = pose_matrix((0.0, 0.0, 0.0), m.qpos0[adr : adr + 4])
+                    offset = offset @ _translation(anchor) @ turn @ _translation(-anchor)
+                # a hinge or slide at its reference position does not move the body
+                folded.append(jname)
+                why = self.body.skipped_joints.get(jname, "not numbered")
+                self.notes.append(f"joint {jname}: fixed at its reference position ({why})")
+        if not steps:
+            name = self.unique_joint(folded[0], own=True) if folded else self.unique_joint(f"{parent_link}_to_{link}")
+            self.add_link(link)
+            self.add_joint(name, "fixed", parent_link, link, offset)
+        else:
+            current = parent_link
+            for i, (jname, kind, axis, limit, origin) in enumerate(steps):
+                last = i == len(steps) - 1
+                child = link if last and _is_identity(offset) else self.unique_link(f"{jname}_frame")
+                self.add_link(child)
+                self.add_joint(self.unique_joint(jname, own=True), kind, current, child, origin, axis, limit)
+                current = child
+            if current != link:
+                self.add_link(link)
+                self.add_joint(self.unique_joint(f"{link}_offset"), "fixed", current, link, offset)
+        self.fill_link(b, link)
+
+    def limit(self, info):
+        effort = 0.0
+        a = info.motor
+        m = self.m
+        if a >= 0:
+            if m.actuator_forcelimited[a]:
+                effort = float(np.abs(m.actuator_forcerange[a]).max())
+            elif m.actuator_ctrllimited[a]:
+                effort = float(np.abs(m.actuator_ctrlrange[a]).max() * abs(info.gear))
+        if info.kind == "hinge" and not info.limited:
+            return self.y.Limit(effort=effort, velocity=0.0)
+        lower, upper = (info.lower, info.upper) if info.limited else (-UNLIMITED_SLIDE, UNLIMITED_SLIDE)
+        return self.y.Limit(effort=effort, velocity=0.0, lower=float(lower), upper=float(upper))
+
+    # what hangs on a link
+    def fill_link(self, b: int, link: str) -> None:
+        m, y = self.m, self.y
+        obj = self.link_objects[link]
+        if m.body_mass[b] > 0:
+            obj.inertial = y.Inertial(
+                origin=pose_matrix(m.body_ipos[b], m.body_iquat[b]),
+                mass=float(m.body_mass[b]),
+                inertia=np.diag(np.array(m.body_inertia[b], dtype=float)),
+            )
+        for g in range(m.ngeom):
+            if m.geom_bodyid[g] == b:
+                self.add_geom(obj, g, np.eye(4))
+
+    def world_geoms(self, kind: str, root_body, root_link: str) -> None:
+        m = self.m
+        on_world = [g for g in sorted(self.body.geom_ids) if m.geom_bodyid[g] == 0]
+        if not on_world:
+            return
+        if kind == ROOT_FREE:
+            names = ", ".join(self.local(mujoco.mjtObj.mjOBJ_GEOM, g) for g in on_world)
+            self.notes.append(f"geoms fixed to the world, not part of a free robot: {names}")
+            return
+        world_to_root = np.eye(4)
+        if kind == ROOT_FIXED:
+            world_to_root = np.linalg.inv(pose_matrix(m.body_pos[root_body], m.body_quat[root_body]))
+        for g in on_world:
+            self.add_geom(self.link_objects[root_link], g, world_to_root)
+
+    def add_geom(self, link, g: int, frame: np.ndarray) -> None:
+        m, y = self.m, self.y
+        name = self.local(mujoco.mjtObj.mjOBJ_GEOM, g)
+        pose = frame @ pose_matrix(m.geom_pos[g], m.geom_quat[g])
+        size = np.array(m.geom_size[g], dtype=float)
+        kind = int(m.geom_type[g])
+        shapes: list[tuple[str, object, np.ndarray]] = []  # (name, Geometry, origin)
+        if kind == _T.mjGEOM_BOX:
+            shapes.append((name, y.Geometry(box=y.Box(size=2 * size)), pose))
+        elif kind == _T.mjGEOM_CYLINDER:
+            shapes.append((name, y.Geometry(cylinder=y.Cylinder(radius=size[0], length=2 * size[1])), pose))
+        elif kind == _T.mjGEOM_SPHERE:
+            shapes.append((name, y.Geometry(sphere=y.Sphere(radius=size[0])), pose))
+        elif kind == _T.mjGEOM_CAPSULE:
+            shapes.append((name, y.Geometry(cylinder=y.Cylinder(radius=size[0], length=2 * size[1])), pose))
+            for i, sign in enumerate((-1.0, 1.0)):
+                cap = pose @ _translation((0.0, 0.0, sign * size[1]))
+                shapes.append((f"{name}_cap{i}", y.Geometry(sphere=y.Sphere(radius=size[0])), cap))
+        elif kind == _T.mjGEOM_ELLIPSOID:
+            if ELLIPSOID_MESH not in self.meshes:
+                self.meshes[ELLIPSOID_MESH] = _unit_sphere()
+                self.notes.append(f"ellipsoids: the unit-sphere mesh {ELLIPSOID_MESH}, scaled")
+            shapes.append((name, y.Geometry(mesh=y.Mesh(filename=ELLIPSOID_MESH, scale=size.copy())), pose))
+        elif kind == _T.mjGEOM_PLANE:
+            half = [s if s > 0 else INFINITE_PLANE for s in size[:2]]
+            box = y.Box(size=np.array([2 * half[0], 2 * half[1], PLANE_THICKNESS]))
+            shapes.append((name, y.Geometry(box=box), pose @ _translation((0.0, 0.0, -PLANE_THICKNESS / 2))))
+            self.notes.append(f"geom {name}: a plane, as a box {PLANE_THICKNESS * 1000:g} mm thick")
+        elif kind == _T.mjGEOM_MESH:
+            mesh_id = int(m.geom_dataid[g])
+            file_name = f"{self.local(mujoco.mjtObj.mjOBJ_MESH, mesh_id) or f'mesh{mesh_id}'}.stl"
+            if file_name not in self.meshes:
+                self.meshes[file_name] = _compiled_mesh(m, mesh_id)
+            shapes.append((name, y.Geometry(mesh=y.Mesh(filename=file_name)), pose))
+        else:
+            what = {int(_T.mjGEOM_HFIELD): "a height field", int(_T.mjGEOM_SDF): "an SDF"}.get(kind, f"type {kind}")
+            self.notes.append(f"geom {name}: {what}, left out")
+            return
+        visual = m.geom_group[g] < HIDDEN_GEOM_GROUP
+        collides = bool(m.geom_contype[g] or m.geom_conaffinity[g])
+        rgba = m.mat_rgba[m.geom_matid[g]] if m.geom_matid[g] >= 0 else m.geom_rgba[g]
+        for shape_name, geometry, origin in shapes:
+            if visual:
+                # float32 in MjModel: written as its shortest text (0.36, not 0.36000001430511475)
+                color = y.Color(rgba=np.array([float(str(np.float32(c))) for c in rgba]))
+                material = y.Material(name=shape_name, color=color)
+                link.visuals.append(y.Visual(name=shape_name, origin=origin, geometry=geometry, material=material))
+            if collides:
+                link.collisions.append(y.Collision(name=shape_name, origin=origin, geometry=copy.deepcopy(geometry)))
+
+
+def _compiled_mesh(m: mujoco.MjModel, mesh_id: int) -> tuple[np.ndarray, np.ndarray]:
+    v0, nv = int(m.mesh_vertadr[mesh_id]), int(m.mesh_vertnum[mesh_id])
+    f0, nf = int(m.mesh_faceadr[mesh_id]), int(m.mesh_facenum[mesh_id])
+    return np.array(m.mesh_vert[v0 : v0 + nv], dtype=float), np.array(m.mesh_face[f0 : f0 + nf], dtype=np.int64)
+
+
+def _unit_sphere() -> tuple[np.ndarray, np.ndarray]:
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
+    return np.array(sphere.vertices), np.array(sphere.faces)
+
+
+def write_stl(path, vertices: np.ndarray, faces: np.ndarray) -> Path:
+    """Write a triangle mesh as a binary STL file (m); the path.  Any thread."""
+    import trimesh
+
+    path = Path(path)
+    trimesh.Trimesh(vertices=vertices, faces=faces, process=False).export(path, file_type="stl")
+    return path
+
+
+def export_model_file(path, body_name: str | None = None) -> tuple[Body, UrdfExport]:
+    """The model file ``path`` alone in a world, as body ``body_name``, and its URDF.
+
+    Args:
+        path: an MJCF (or URDF) file MuJoCo loads.
+        body_name: the body's (and robot's) name; the model's own name by
+            default (``<mujoco model="Tank">``), else the file's stem.
+
+    Raises:
+        ValueError: the file does not load, or the name is not a valid body name.
+    """
+    from tutorial.core.project import NAME_PATTERN
+    from tutorial.core.world import ModelEntry, build_world
+
+    path = Path(path)
+    if body_name is None:
+        try:
+            spec = mujoco.MjSpec.from_file(str(path))
+        except Exception as exc:  # mujoco raises ValueError with the parser's text
+            raise ValueError(f"{path}: {exc}") from None
+        body_name = spec.modelname if NAME_PATTERN.match(spec.modelname or "") else path.stem
+        if not NAME_PATTERN.match(body_name):
+            body_name = "robot"
+    if not NAME_PATTERN.match(body_name):
+        raise ValueError(f"body name {body_name!r}: use letters, digits and _, starting with a letter")
+    world = build_world([ModelEntry(body_name, path)])
+    body = Body(world, mujoco.MjData(world), body_name)
+    return body, export_body(body)
