@@ -122,3 +122,22 @@ def test_the_step3_monitor_draws_the_published_description(procs):
     shown = view.summary()["controllers"]["RttJointStateMonitor"]
     assert shown["rejected"] == {}
     assert shown["last_positions"] == pytest.approx(final, abs=1e-9)
+
+
+@pytest.mark.unit
+def test_the_rviz_config_draws_the_tank_from_our_topics():
+    """rviz/tank.rviz (not run here: no RViz2): YAML with the displays the README's commands rely on."""
+    import yaml
+
+    from conftest import ROOT
+
+    config = yaml.safe_load((ROOT / "rviz" / "tank.rviz").read_text())
+    manager = config["Visualization Manager"]
+    displays = {d["Class"]: d for d in manager["Displays"]}
+    model = displays["rviz_default_plugins/RobotModel"]
+    assert model["Description Source"] == "Topic"
+    assert model["Description Topic"]["Value"] == "/robot_description"
+    assert model["Description Topic"]["Durability Policy"] == "Transient Local"  # what robot_state_publisher offers
+    assert displays["rviz_default_plugins/Odometry"]["Topic"]["Value"] == "/Tank/odom"
+    assert "rviz_default_plugins/TF" in displays
+    assert manager["Global Options"]["Fixed Frame"] == "world"

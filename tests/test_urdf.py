@@ -79,7 +79,7 @@ def mujoco_link_poses(body, urdf) -> dict[str, np.ndarray]:
         else pose_matrix(data.xpos[urdf.root_body], data.xquat[urdf.root_body])
     )
     inverse = np.linalg.inv(root)
-    return {link: inverse @ pose_matrix(data.xpos[b], data.xquat[b]) for b, link in urdf.links.items()}
+    return {link: inverse @ pose_matrix(data.xpos[b], data.xquat[b]) for b, link in urdf.body_links.items()}
 
 
 @pytest.mark.parametrize("name, case", MODELS, ids=[n for n, _ in MODELS])
@@ -91,7 +91,7 @@ def test_yourdfpy_and_mujoco_agree_on_every_link(name, case, exported):
     assert parsed.base_link == urdf.root_link
     moving = [j.name for j in parsed.robot.joints if j.type in ("revolute", "continuous", "prismatic")]
     assert sorted(moving) == sorted(body.joint_names)  # JointState moves the URDF by name
-    assert len(urdf.links) == len(body.body_ids)  # a link for every MuJoCo body
+    assert len(urdf.body_links) == len(body.body_ids)  # a link for every MuJoCo body
     rng = np.random.default_rng(27)
     worst = 0.0
     for _ in range(POSTURES):
@@ -116,15 +116,18 @@ def test_our_kinematics_is_yourdfpys(name, case, exported):
         values = random_posture(body, urdf, rng)
         parsed.update_cfg(values)
         poses = ours.link_poses(ours.joint_values(list(values), list(values.values())))
-        for link in urdf.links.values():
+        for link in urdf.body_links.values():
             assert np.abs(poses[link] - parsed.get_transform(link, urdf.root_link)).max() <= TOLERANCE
 
 
 def test_the_tank_urdf(exported):
-    """Names, joint types, limits, inertials, shapes and colours as the MJCF gives them."""
+    """Names, joint types, limits, inertials, shapes and colours as the MJCF gives them, read back by yourdfpy."""
+    import yourdfpy
+
     body, urdf, path = exported("Tank", None)
-    robot = urdf.robot
-    assert robot.name == "Tank" and urdf.root_link == "CHASSIS" and urdf.root_kind == ROOT_FREE
+    assert urdf.root_link == "CHASSIS" and urdf.root_kind == ROOT_FREE
+    robot = yourdfpy.URDF.load(str(path), load_meshes=False).robot
+    assert robot.name == "Tank"
     joints = {j.name: j for j in robot.joints}
     links = {link.name: link for link in robot.links}
     assert joints["TURRET_Y"].type == "revolute" and list(joints["TURRET_Y"].axis) == [0.0, 0.0, -1.0]
@@ -149,6 +152,28 @@ def test_the_tank_urdf(exported):
     text = path.read_text()
     assert "Joints moved by /Tank/joint_state: TURRET_Y, TURRET_P." in text
     assert "joint TRACK_L_W0: fixed at its reference position (joint group 3: drive mechanism)" in text
+    # The turret's armature is not mapped, and it has no damping: no <dynamics>.
+    assert "<dynamics" not in text
+
+
+def test_damping_and_friction_are_written(tmp_path):
+    """A hinge with damping and friction loss: <dynamics damping friction>, read back by yourdfpy."""
+    import yourdfpy
+
+    (tmp_path / "arm.xml").write_text(
+        "<mujoco><worldbody><body name='base'><body name='arm'>"
+        "<joint name='shoulder' axis='0 1 0' pos='0 0 0.1' ref='0.3' damping='2.5' frictionloss='0.25'/>"
+        "<geom type='capsule' size='0.02 0.1'/></body></body></worldbody></mujoco>"
+    )
+    body, urdf = export_model_file(tmp_path / "arm.xml", "Arm")
+    urdf.write(tmp_path / "arm.urdf")
+    parsed = yourdfpy.URDF.load(str(tmp_path / "arm.urdf"), load_meshes=False)
+    [joint] = [j for j in parsed.robot.joints if j.name == "shoulder"]
+    assert joint.type == "continuous"
+    assert (float(joint.dynamics.damping), float(joint.dynamics.friction)) == (2.5, 0.25)
+    # The anchor (pos) is off the body's origin: a joint frame link, and a fixed joint to the body.
+    assert {link.name for link in parsed.robot.links} == {"base", "shoulder_frame", "arm"}
+    assert urdf.root_kind == "fixed"
 
 
 def test_capsules_ellipsoids_planes_and_meshes(exported, tmp_path):
@@ -162,13 +187,13 @@ def test_capsules_ellipsoids_planes_and_meshes(exported, tmp_path):
     m = body.model
     capsule = next(g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE)
     name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, capsule).split("/", 1)[1]
-    elements = [v for link in urdf.robot.links for v in link.visuals if v.name.startswith(name)]
+    elements = [v for link in urdf.links for v in link.visuals if v.name.startswith(name)]
     assert sorted(v.name for v in elements) == [name, f"{name}_cap0", f"{name}_cap1"]
     # The scene yourdfpy builds from the file (meshes loaded) holds every visual.
     scene = yourdfpy.URDF.load(str(path), load_meshes=True).scene
     assert f"{name}_cap1" in scene.geometry
-    ellipsoids = [v for link in urdf.robot.links for v in link.visuals if v.geometry.mesh is not None]
-    assert any(v.geometry.mesh.filename == "ellipsoid.stl" for v in ellipsoids)
+    ellipsoids = [v for link in urdf.links for v in link.visuals if v.geometry.kind == "mesh"]
+    assert any(v.geometry.filename == "ellipsoid.stl" for v in ellipsoids)
     assert (path.parent / "MujocoTest_meshes" / "ellipsoid.stl").is_file()
 
     dog = next(c for c in CASES if c.name == "Dog")
@@ -196,7 +221,7 @@ def test_a_description_mujoco_reads_back(exported):
     names = [model.joint(j).name for j in range(model.njnt)]
     assert names == ["TURRET_Y", "TURRET_P"] and dropped == 0
     assert model.jnt_range[1] == pytest.approx([np.radians(-10), np.radians(45)])
-    assert model.ngeom == sum(len(link.visuals) for link in urdf.robot.links)  # visuals only
+    assert model.ngeom == sum(len(link.visuals) for link in urdf.links)  # visuals only
 
 
 def test_rtt_urdf_command_line(tmp_path):

@@ -179,9 +179,11 @@ class BagRecorder:
             return self.writer.stats()
         stats = self.writer.close()
         per_topic = ", ".join(f"{t} {n}" for t, n in stats.per_topic.items()) or "no topics"
+        computed = sum(self.tf.written.values()) if self.tf is not None else 0
         self._say(
-            f"wrote {stats.messages} of {sum(self.received.values())} messages received ({per_topic}) "
-            f"to {self.path}, {stats.size_bytes} bytes"
+            f"wrote {stats.messages - computed} of {sum(self.received.values())} messages received"
+            + (f" and {computed} computed for TF" if computed else "")
+            + f" ({per_topic}) to {self.path}, {stats.size_bytes} bytes"
         )
         return stats
 

@@ -69,9 +69,9 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(str(exc))
     except OSError as exc:
         return _fail(f"cannot write {args.output}: {exc.strerror or exc}")
-    links, joints = len(urdf.robot.links), len(urdf.robot.joints)
+    links, joints = len(urdf.links), len(urdf.joints)
     print(
-        f"wrote {written[0]}: robot {urdf.robot.name}, {links} links, {joints} joints "
+        f"wrote {written[0]}: robot {urdf.name}, {links} links, {joints} joints "
         f"({len(urdf.moving_joints)} moving: {', '.join(urdf.moving_joints) or 'none'}), root link {urdf.root_link}"
         + (f", {len(written) - 1} mesh files" if len(written) > 1 else ""),
         flush=True,

@@ -80,6 +80,8 @@ class TfRecording:
     """
 
     def __init__(self, writer, say=print):
+        # Imported here, on the owner's thread: not in the first callback (yourdfpy takes about 1 s).
+        import yourdfpy  # noqa: F401
         from rclpy.qos import QoSProfile  # noqa: F401 - fail here, not in a callback, without rclpy
 
         self.writer = writer
