@@ -1,17 +1,12 @@
-"""A ROS 2 installation sourced in the same shell as this environment is detected, with a clear message."""
+"""A ROS 2 installation sourced in the same shell as this environment is detected, with a clear message.
+
+Unit tier, but for the last test (a program of ours in a process of its own: cross-process)."""
 
 from __future__ import annotations
 
-import subprocess
 import sys
 
-import pytest
-
 from tutorial.ros.env import sourced_ros_installation
-
-from conftest import ROOT
-
-pytestmark = pytest.mark.unit
 
 VENV = "/home/me/ros-tank-tutorial/.venv"
 OURS = f"{VENV}/lib/python3.11/site-packages/rclpy/__init__.py"
@@ -48,19 +43,14 @@ def test_a_workspace_in_ament_prefix_path_counts_too():
     assert level == "error"
 
 
-def test_a_program_stops_with_the_message_and_no_traceback(tmp_path):
+def test_a_program_stops_with_the_message_and_no_traceback(procs, tmp_path):
     """A fake installation whose rclpy shadows ours: rtt-urdf stops at import, exit status 2."""
     fake = tmp_path / "opt_ros" / "lib"
     (fake / "rclpy").mkdir(parents=True)
     (fake / "rclpy" / "__init__.py").write_text("raise ImportError('the wrong rclpy')\n")
     env = {"PATH": "/usr/bin:/bin", "AMENT_PREFIX_PATH": str(tmp_path / "opt_ros"), "PYTHONPATH": str(fake)}
-    done = subprocess.run(
-        [sys.executable, "-m", "tutorial.tools.rtt_urdf", "model/tank.xml", "-o", str(tmp_path / "t.urdf")],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        env=env,
-    )
-    assert done.returncode == 2
-    assert done.stderr.startswith("rtt: ERROR: a ROS 2 installation is sourced in this shell")
-    assert "Traceback" not in done.stderr
+    cmd = [sys.executable, "-m", "tutorial.tools.rtt_urdf", "model/tank.xml", "-o", str(tmp_path / "t.urdf")]
+    done = procs(cmd, env=env)
+    assert done.wait(60) == 2
+    assert done.err.startswith("rtt: ERROR: a ROS 2 installation is sourced in this shell")
+    assert "Traceback" not in done.err

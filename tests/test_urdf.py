@@ -1,5 +1,7 @@
 """The URDF of a body (tutorial/urdf): checked by a parser we did not write.
 
+Unit tier, but for ``rtt-urdf``'s command line (a process of its own: cross-process).
+
 ``yourdfpy`` reads each written URDF back and computes every link's pose for
 random joint values with its own forward kinematics; MuJoCo computes the
 body poses for the same values.  They must agree within 1e-9 m and rad for
@@ -13,7 +15,6 @@ against ``yourdfpy``, and a description MuJoCo reads back.
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
@@ -26,8 +27,6 @@ from tutorial.urdf.export import ROOT_FREE, ROOT_WORLD, export_model_file, pose_
 from tutorial.urdf.kinematics import UrdfKinematics
 
 from conftest import MODEL, ROOT
-
-pytestmark = pytest.mark.unit
 
 MODELS = [("Tank", None), *((c.name, c) for c in CASES)]
 POSTURES = 40  # random joint configurations per model
@@ -224,15 +223,14 @@ def test_a_description_mujoco_reads_back(exported):
     assert model.ngeom == sum(len(link.visuals) for link in urdf.links)  # visuals only
 
 
-def test_rtt_urdf_command_line(tmp_path):
+def test_rtt_urdf_command_line(procs, tmp_path):
     def run(*args):
-        return subprocess.run(
-            [sys.executable, "-m", "tutorial.tools.rtt_urdf", *args], capture_output=True, text=True, cwd=ROOT
-        )
+        proc = procs([sys.executable, "-m", "tutorial.tools.rtt_urdf", *args])
+        return proc.wait(60), proc
 
-    ok = run("project/step2.yaml", "--body", "Tank", "-o", str(tmp_path / "tank.urdf"))
-    assert ok.returncode == 0, ok.stderr
-    assert "robot Tank, 13 links, 12 joints (2 moving: TURRET_Y, TURRET_P), root link CHASSIS" in ok.stdout
+    status, ok = run("project/step2.yaml", "--body", "Tank", "-o", str(tmp_path / "tank.urdf"))
+    assert status == 0, ok.err
+    assert "robot Tank, 13 links, 12 joints (2 moving: TURRET_Y, TURRET_P), root link CHASSIS" in ok.out
     assert UrdfKinematics((tmp_path / "tank.urdf").read_text()).root == "CHASSIS"
     for args, says in (
         (["project/step2.yaml"], "name the body with --body"),
@@ -240,8 +238,8 @@ def test_rtt_urdf_command_line(tmp_path):
         (["model/room.xml"], "has no link"),
         (["model/nothing.xml"], "no such model file"),
     ):
-        bad = run(*args, "-o", str(tmp_path / "x.urdf"))
-        assert bad.returncode == 2 and says in bad.stderr and "Traceback" not in bad.stderr, (args, bad.stderr)
+        status, bad = run(*args, "-o", str(tmp_path / "x.urdf"))
+        assert status == 2 and says in bad.err and "Traceback" not in bad.err, (args, bad.err)
 
 
 def test_our_kinematics_leaves_out_what_robot_state_publisher_does():
