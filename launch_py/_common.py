@@ -24,6 +24,9 @@ def simulation_node(args, project: str) -> Node:
 def record_nodes(args, topics: list[str]) -> list[Node]:
     """With ``--record FILE.mcap``: ``rtt-bag record`` of the step's ``topics`` as node ``rtt_bag``; else none.
 
+    With ``--tf`` too, it also records what Foxglove and RViz2 need to draw the
+    robot (``rtt-bag record --tf``).
+
     Put it first in the launch description: started before the publishers,
     it has joined the ROS graph when they appear, and records from their
     first message (a recorder that joins later can take up to one of Fast
@@ -33,4 +36,5 @@ def record_nodes(args, topics: list[str]) -> list[Node]:
     """
     if not args.record:
         return []
-    return [Node("rtt_bag", "tutorial.bag", ["record", *topics, "-o", args.record])]
+    tf = ["--tf"] if getattr(args, "tf", False) else []  # and the robot description, odometry, /tf
+    return [Node("rtt_bag", "tutorial.bag", ["record", *topics, *tf, "-o", args.record])]

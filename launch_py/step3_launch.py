@@ -3,6 +3,7 @@ separately named viewer process (``rtt_viewer``) showing the joint state.
 
     python launch_py/step3_launch.py --demo
     python launch_py/step3_launch.py --demo --record drive.mcap   # also record /joy, /Tank/joint_state
+    python launch_py/step3_launch.py --demo --record drive.mcap --tf   # and TF: Foxglove replays it in 3D
 """
 
 import sys

@@ -25,6 +25,7 @@ MODULES = {
     "05": "imu_state_subscriber",
     "06": "camera_image_publisher",
     "07": None,
+    "09": "robot_model_publisher",
 }
 
 
@@ -64,7 +65,7 @@ def grade(ex: dict, *sources: str):
     return check(namespace[ex["target"]])
 
 
-EXERCISES = ["1.1", "1.2", "2.1", "2.2", "3.1", "3.2", "7.1", "7.2", "4.1", "4.2", "5.1", "5.2", "6.1", "6.2"]
+EXERCISES = ["1.1", "1.2", "2.1", "2.2", "3.1", "3.2", "7.1", "7.2", "4.1", "4.2", "5.1", "5.2", "6.1", "6.2", "9.1"]
 
 
 @pytest.mark.parametrize("number", EXERCISES)
@@ -279,6 +280,21 @@ MISTAKES = [
         "self.info.p = [fx, 0.0, 0.0, cx, 0.0, fy, 0.0, cy, 0.0, 0.0, 1.0, 0.0]",
         "p, k with a fourth column",
     ),
+    ("9.1", "pose_matrix(t.translation, (w, x, y, z))", "pose_matrix(t.translation, t.rotation)", "moved only"),
+    (
+        "9.1",
+        "pose = pose_matrix(t.translation, (w, x, y, z)) @ pose",
+        "pose = pose @ pose_matrix(t.translation, (w, x, y, z))",
+        "world -> CHASSIS -> TURRET",
+    ),
+    ("9.1", "newest = {t.child: t for t in transforms}", "newest = {t.child: t for t in transforms[::-1]}", "twice"),
+    (
+        "9.1",
+        "        pose = pose_matrix(t.translation, (w, x, y, z)) @ pose\n",
+        "        pose[:3, 3] += t.translation\n",
+        "turned 90 degrees",
+    ),
+    ("9.1", "        raise KeyError(frame)\n", "        return np.eye(4)\n", "'GUN'"),
 ]
 
 

@@ -97,8 +97,14 @@ def test_a_failing_node_fails_the_launch_and_stops_the_others():
 
 
 def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
-    """``--record FILE.mcap`` adds ``rtt-bag record`` (node ``rtt_bag``); the launch's stop closes the file whole."""
+    """``--record FILE.mcap`` adds ``rtt-bag record`` (node ``rtt_bag``); the launch's stop closes the file whole.
+
+    With ``--tf`` it also holds what Foxglove draws the tank from: the URDF on
+    ``/robot_description``, ``/tf_static`` and ``/tf`` (read back with the ``mcap`` reader
+    and ``mcap-ros2-support``'s decoder, as Foxglove reads them).
+    """
     from tutorial.bag.info import bag_info
+    from tutorial.bag.reader import read_messages
 
     bag = tmp_path / "launch.mcap"
     launch = procs(
@@ -112,15 +118,28 @@ def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
             "5",
             "--record",
             str(bag),
+            "--tf",
         ]
     )
     assert launch.wait(60) == 0, launch.out
     assert "[launch] all nodes stopped cleanly" in launch.out
     assert "Traceback" not in launch.out + launch.err
-    assert "[rtt_bag] [/rtt_bag] recording /joy /Tank/joint_state to" in launch.out
+    assert "[rtt_bag] [/rtt_bag] recording /joy /Tank/joint_state, and TF from every robot description to" in launch.out
     info = bag_info(bag)  # raises unless the file is a whole MCAP file
-    assert [(t.topic, t.type) for t in info.topics] == [
+    assert sorted((t.topic, t.type) for t in info.topics) == [
         ("/Tank/joint_state", "sensor_msgs/msg/JointState"),
+        ("/Tank/odom", "nav_msgs/msg/Odometry"),
+        ("/Tank/robot_description", "std_msgs/msg/String"),
         ("/joy", "sensor_msgs/msg/Joy"),
+        ("/robot_description", "std_msgs/msg/String"),
+        ("/tf", "tf2_msgs/msg/TFMessage"),
+        ("/tf_static", "tf2_msgs/msg/TFMessage"),
     ]
     assert all(t.count > 0 for t in info.topics), launch.out
+    frames = set()
+    for topic, _, msg in read_messages(bag, topics=["/tf", "/tf_static", "/robot_description"]):
+        if topic == "/robot_description":
+            assert '<robot name="Tank">' in msg.data
+        else:
+            frames |= {(t.header.frame_id, t.child_frame_id) for t in msg.transforms}
+    assert {("world", "CHASSIS"), ("CHASSIS", "TURRET_Y"), ("TURRET_Y", "TURRET_P"), ("CHASSIS", "TRACK_L")} <= frames

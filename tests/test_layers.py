@@ -89,7 +89,7 @@ def test_each_step_module_reaches_the_interfaces_not_a_sibling():
     """The shared contracts moved out of the steps: every step that publishes or subscribes uses them."""
     modules = library_imports()
     steps = [n for n in modules if n.startswith("tutorial.controllers.") and n != "tutorial.controllers"]
-    assert len(steps) == 6
+    assert len(steps) == 7
     for name in steps:
         assert any(m.startswith("tutorial.interfaces.") for m in modules[name]), name
 

@@ -2,6 +2,7 @@
 
     rtt-bag record /joy /Tank/joint_state -o drive.mcap    # until Ctrl-C or SIGTERM
     rtt-bag record --all -o all.mcap --duration 10
+    rtt-bag record /joy --tf -o drive.mcap                 # and /tf, /tf_static, /robot_description
     rtt-bag info drive.mcap
     rtt-bag play drive.mcap --rate 2 --topics /Tank/joint_state --start-offset 1.5
     rtt-bag play drive.mcap --loop
@@ -63,6 +64,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--compression", choices=["zstd", "lz4", "none"], default="zstd", help="chunk compression (default zstd)"
     )
     r.add_argument("--overwrite", action="store_true", help="replace FILE if it exists")
+    r.add_argument(
+        "--tf",
+        action="store_true",
+        help="also record every /<body>/robot_description, /<body>/odom and /<body>/joint_state, and write "
+        "/tf, /tf_static and /robot_description computed from them (what Foxglove and RViz2 draw in 3D)",
+    )
 
     i = sub.add_parser("info", help="per topic: type, message count, time span, rate, QoS")
     i.add_argument("file", metavar="FILE.mcap")
@@ -129,14 +136,20 @@ def record(args, argv: list[str]) -> int:
     from tutorial.bag.record import BagRecorder
     from tutorial.bag.writer import BagWriteError
 
-    if not args.topics and not args.all:
-        return _fail("record: name the topics to record, or pass --all")
+    if not args.topics and not args.all and not args.tf:
+        return _fail("record: name the topics to record, or pass --all or --tf")
     if args.duration is not None and not args.duration > 0:
         return _fail("record: --duration must be > 0")
     path = args.output or datetime.datetime.now().strftime("rtt_bag_%Y_%m_%d-%H_%M_%S.mcap")
     try:  # the file first: a name that exists fails before ROS starts
         recorder = BagRecorder(
-            path, args.topics, all_topics=args.all, compression=args.compression, overwrite=args.overwrite, output=_say
+            path,
+            args.topics,
+            all_topics=args.all,
+            compression=args.compression,
+            overwrite=args.overwrite,
+            output=_say,
+            tf=args.tf,
         )
     except (BagWriteError, ValueError) as exc:
         return _fail(f"record: {exc}")

@@ -59,17 +59,21 @@ class UnknownMessageType(LookupError):
     """A message type that is not installed here (no Python class, or no definition file)."""
 
 
+# Definitions no wheel ships (tf2_msgs/msg/TFMessage), kept in the repository as data.
+BUNDLED_SHARE = Path(__file__).resolve().parent.parent / "interfaces" / "share"
+
+
 def share_directories() -> list[Path]:
     """Where packages keep their ``share/<pkg>`` folders, in search order.
 
     ``AMENT_PREFIX_PATH`` (a sourced ROS install) first, then this Python
-    environment's prefix, where the ROS 2 wheels install their data files.
+    environment's prefix, where the ROS 2 wheels install their data files,
+    then :data:`BUNDLED_SHARE`, the definitions no wheel ships.
     """
     prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     prefixes += [sys.prefix, sys.base_prefix]
     seen: list[Path] = []
-    for prefix in prefixes:
-        share = Path(prefix) / "share"
+    for share in [Path(prefix) / "share" for prefix in prefixes] + [BUNDLED_SHARE]:
         if share.is_dir() and share not in seen:
             seen.append(share)
     return seen

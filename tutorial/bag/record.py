@@ -67,9 +67,12 @@ class BagRecorder:
         compression: chunk compression, ``zstd`` (default), ``lz4`` or ``none``.
         overwrite: replace an existing file (default: refuse).
         output: called with each status line (default ``print``).
+        tf: also record every body's robot description, odometry and joint
+            states, and write ``/tf``, ``/tf_static`` and ``/robot_description``
+            computed from them (:mod:`tutorial.urdf.recording`).
 
     Raises:
-        ValueError: neither topics nor ``all_topics``, or a bad ``compression``.
+        ValueError: no topics, ``all_topics`` nor ``tf``, or a bad ``compression``.
         tutorial.bag.writer.BagWriteError: the file cannot be created.
 
     The file is created by the constructor; :meth:`start` subscribes.
@@ -94,14 +97,20 @@ class BagRecorder:
         compression: str = "zstd",
         overwrite: bool = False,
         output=print,
+        tf: bool = False,
     ):
         self.topics_wanted = [normalize_topic(t) for t in topics]
-        if not self.topics_wanted and not all_topics:
+        if not self.topics_wanted and not all_topics and not tf:
             raise ValueError("name the topics to record, or record all topics")
         self.all_topics = all_topics
         self.output = output
         self.writer = BagWriter(path, compression=compression, overwrite=overwrite)
         self.path = self.writer.path
+        self.tf = None
+        if tf:  # the TF computation is its own module's; the recorder only feeds it
+            from tutorial.urdf.recording import TfRecording
+
+            self.tf = TfRecording(self.writer, self._say)
         self._given_node = node
         self.node = node
         self.node_name = node_name
@@ -127,7 +136,8 @@ class BagRecorder:
         if self.node is None:
             self.node = rclpy.create_node(self.node_name)
         self.started_at = time.monotonic()
-        wanted = "all topics" if self.all_topics else " ".join(self.topics_wanted)
+        wanted = "all topics" if self.all_topics else " ".join(self.topics_wanted) or "no topic"
+        wanted += ", and TF from every robot description" if self.tf is not None else ""
         self._say(f"recording {wanted} to {self.path}")
         self._discover()
         self._timer = self.node.create_timer(POLL_PERIOD, self._discover)
@@ -169,9 +179,11 @@ class BagRecorder:
             return self.writer.stats()
         stats = self.writer.close()
         per_topic = ", ".join(f"{t} {n}" for t, n in stats.per_topic.items()) or "no topics"
+        computed = sum(self.tf.written.values()) if self.tf is not None else 0
         self._say(
-            f"wrote {stats.messages} of {sum(self.received.values())} messages received ({per_topic}) "
-            f"to {self.path}, {stats.size_bytes} bytes"
+            f"wrote {stats.messages - computed} of {sum(self.received.values())} messages received"
+            + (f" and {computed} computed for TF" if computed else "")
+            + f" ({per_topic}) to {self.path}, {stats.size_bytes} bytes"
         )
         return stats
 
@@ -195,7 +207,7 @@ class BagRecorder:
             if self.all_topics:
                 if is_hidden(topic):
                     continue
-            elif topic not in self.topics_wanted:
+            elif topic not in self.topics_wanted and not (self.tf is not None and self.tf.wants(topic, types[0])):
                 continue
             if len(types) != 1:
                 self._skip(topic, f"it has {len(types)} types ({', '.join(types)})")
@@ -224,11 +236,15 @@ class BagRecorder:
         request = request_for_offers(offers, SUBSCRIPTION_DEPTH)
         self.received[topic] = 0
 
+        tf = self.tf
+
         def on_message(data: bytes, info: dict, topic=topic) -> None:
             # rmw's receive time (ns since the epoch); 0 where a middleware does not give it.
             received = info.get("received_timestamp") or time.time_ns()
             self.received[topic] += 1
             self.writer.write(topic, received, info.get("source_timestamp") or received, data)
+            if tf is not None:
+                tf.on_message(topic, type_name, data, received)
 
         self._subscriptions[topic] = self.node.create_subscription(
             msg_type, topic, on_message, to_qos_profile(request), raw=True

@@ -35,6 +35,7 @@ FRAME_RATE = 60.0  # Hz, the most often the scene is redrawn
 SETTLE = 0.004  # s: a frame waits this long after a change for more of the same burst (see App.next_frame_due)
 SETTLE_MAX = 0.008  # s: ... and at most this long after the first change it shows
 GRAPH_CHECK_PERIOD = 2.0  # s, how often the node graph is checked for a twin name
+DESCRIPTION_TIMEOUT = 10.0  # s a viewer waits for a robot description it takes its model from
 
 
 class ControllerError(RuntimeError):
@@ -60,6 +61,8 @@ class App:
             to attach in code, before the project's own (as adding a
             controller item in Choreonoid's GUI).
         record_timing: keep each step's lateness in ``sim.lateness`` (benchmarks).
+        description_timeout: how long :meth:`open` waits for the robot
+            description of a model that names a topic instead of a file, s.
 
     Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
     becomes the owner of everything the main thread owns.
@@ -77,6 +80,7 @@ class App:
         vis=None,
         attach=(),
         record_timing: bool = False,
+        description_timeout: float = DESCRIPTION_TIMEOUT,
     ):
         self.project = project
         self.node = node
@@ -88,6 +92,7 @@ class App:
         self.vis = vis
         self.attach = list(attach)
         self.record_timing = record_timing
+        self.description_timeout = description_timeout
         self.loop = MainLoop()
         self.log = logging.getLogger("rtt")
         self.server = None
@@ -115,21 +120,24 @@ class App:
         """Build the world, configure the controllers, start simulation and view.
 
         Raises:
-            ValueError: a model does not load.
+            ValueError: a model does not load, or a robot description it
+                takes its model from did not come (or is not a URDF).
             ControllerError: a controller refused to configure or to start.
         """
         settings = self.project.simulator
         kwargs = {} if settings is None else {"time_step": settings.time_step, "gravity": settings.gravity}
+        if self.node is None:
+            from rclpy.node import Node
+
+            self.node = Node(self.node_name)
+        self._receive_descriptions()
         self.model = build_world(self.project.models, **kwargs)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self.bodies = {m.name: Body(self.model, self.data, m.name) for m in self.project.models}
-        if self.node is None:
-            from rclpy.node import Node
-
+        if self._own_node:
             from tutorial.ros.env import SpinThread
 
-            self.node = Node(self.node_name)
             self.spin = SpinThread(self.node, hand_over_to=self.loop)
         for body_name, name, controller in self.attach:
             self._configure_instance(body_name, name, controller, {})
@@ -158,6 +166,51 @@ class App:
             ).start()
         self._started = time.monotonic()
         return self
+
+    def _receive_descriptions(self) -> None:
+        """Take each model that names a description topic from the URDF published there (owner thread).
+
+        Waits up to ``description_timeout`` s for each (the publisher keeps
+        it, transient local: a simulation already running answers at once),
+        and says where the model came from.  Before the spin thread starts.
+
+        Raises:
+            tutorial.interfaces.robot_description.DescriptionError: none came, or not a URDF.
+        """
+        import dataclasses
+
+        waiting = [m for m in self.project.models if m.description is not None and m.text is None]
+        if not waiting:
+            return
+        from tutorial.interfaces.robot_description import DescriptionError, receive_robot_description
+        from tutorial.urdf.kinematics import UrdfKinematics
+        from tutorial.urdf.mujoco_load import mujoco_text
+
+        models = list(self.project.models)
+        fqn = self.node.get_fully_qualified_name()
+        for entry in waiting:
+            urdf = receive_robot_description(self.node, entry.description, self.description_timeout)
+            try:
+                tree = UrdfKinematics(urdf)
+                text, dropped = mujoco_text(urdf)
+            except ValueError as exc:
+                raise DescriptionError(f"{entry.description}: {exc}") from None
+            models[models.index(entry)] = dataclasses.replace(entry, text=text)
+            note = f"; {dropped} mesh visuals left out (package:// names need ROS)" if dropped else ""
+            self.output(
+                {
+                    "event": "description",
+                    "node": fqn,
+                    "body": entry.name,
+                    "topic": entry.description,
+                    "links": len(tree.links),
+                    "moving_joints": [j.name for j in tree.moving],
+                    "line": f"[{fqn}] {entry.name}: no model file of its own: drawing the robot description "
+                    f"on {entry.description} (robot {tree.name}, {len(tree.links)} links, "
+                    f"{len(tree.moving)} moving joints{note})",
+                }
+            )
+        self.project = dataclasses.replace(self.project, models=models)
 
     def controller(self, name: str):
         """A configured controller by name (any thread, after :meth:`open` has configured it).

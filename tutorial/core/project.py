@@ -17,7 +17,11 @@ which body, and whether (and how) to simulate.  Example (``project/step1.yaml``)
       realtime_sync: true
 
 Paths are relative to the project file.  A project without ``simulator`` only
-loads its models and configures their controllers (Step 3's viewer).
+loads its models and configures their controllers (Step 3's viewer).  Such a
+viewer project may name a robot-description topic instead of a model file
+(``description: /Tank/robot_description``): the model is then the URDF the
+simulation publishes there (:mod:`tutorial.interfaces.robot_description`),
+received when the project is opened.
 
 Every mistake raises one :class:`ProjectError` naming the file and the key,
 e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``.
@@ -39,6 +43,8 @@ from tutorial.core.controller import SimpleController
 from tutorial.core.world import ModelEntry
 
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+# An absolute ROS 2 topic name: /part/part, each part letters, digits and _, not starting with a digit.
+TOPIC_PATTERN = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
 
 
 class ProjectError(ValueError):
@@ -194,21 +200,39 @@ def load_project(path: str | Path) -> Project:
     seen: set[str] = set()
     for i, m in enumerate(models_doc):
         key = f"models[{i}]"
-        r.mapping(m, key, {"name": True, "file": True, "position": False, "yaw": False, "controllers": False})
+        r.mapping(
+            m,
+            key,
+            {"name": True, "file": False, "description": False, "position": False, "yaw": False, "controllers": False},
+        )
         mname = r.name(m["name"], f"{key}.name")
         if mname in seen:
             raise r.fail(f"{key}.name", f"{mname!r} is used twice; model names must be unique")
         seen.add(mname)
-        if not isinstance(m["file"], str):
-            raise r.fail(f"{key}.file", f"expected a path, got {m['file']!r}")
-        mfile = (path.parent / m["file"]).resolve()
-        if not mfile.is_file():
-            raise r.fail(f"{key}.file", f"no such model file: {mfile}")
+        mfile, description = None, None
+        if "file" in m and "description" in m:
+            raise r.fail(key, "give either file (a model file) or description (a robot-description topic), not both")
+        if "description" in m:
+            description = m["description"]
+            if not isinstance(description, str) or not TOPIC_PATTERN.match(description):
+                raise r.fail(
+                    f"{key}.description",
+                    f"expected a topic name like /{mname}/robot_description, got {description!r}",
+                )
+        elif "file" not in m:
+            raise r.fail(f"{key}.file", "missing: give file (a model file) or description (a robot-description topic)")
+        else:
+            if not isinstance(m["file"], str):
+                raise r.fail(f"{key}.file", f"expected a path, got {m['file']!r}")
+            mfile = (path.parent / m["file"]).resolve()
+            if not mfile.is_file():
+                raise r.fail(f"{key}.file", f"no such model file: {mfile}")
         entry = ModelEntry(
             name=mname,
             file=mfile,
             position=r.vector(m.get("position", [0, 0, 0]), f"{key}.position", 3),
             yaw=r.number(m.get("yaw", 0.0), f"{key}.yaw"),
+            description=description,
         )
         controllers = m.get("controllers", [])
         if not isinstance(controllers, list):
@@ -237,6 +261,13 @@ def load_project(path: str | Path) -> Project:
             realtime_sync=rt,
             gravity=r.vector(s.get("gravity", [0, 0, -9.80665]), "simulator.gravity", 3),
         )
+        for i, m in enumerate(models):
+            if m.description is not None:
+                raise r.fail(
+                    f"models[{i}].description",
+                    "a simulated model needs a model file (physics: masses, contacts, actuators); "
+                    "a robot-description topic is for a viewer project (no simulator)",
+                )
     return Project(path=path, name=name, models=models, simulator=simulator)
 
 

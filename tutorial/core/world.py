@@ -37,16 +37,22 @@ class ModelEntry:
     Attributes:
         name: the body name, e.g. ``Tank``; also the prefix of its elements and
             the first part of its ROS topics (``/Tank/joint_state``).
-        file: path of the MJCF file.
+        file: path of the MJCF file; None when the model comes from ``text``.
         position: (3,) placement of the model's frame in the world, m.
         yaw: rotation of the model's frame about +Z, rad.
+        description: a robot-description topic to take the model from instead
+            of a file (a viewer project); whoever receives it sets ``text``.
+        text: the model as text (MJCF, or URDF prepared by
+            :func:`tutorial.urdf.mujoco_load.mujoco_text`), used instead of ``file``.
     """
 
     name: str
-    file: Path
+    file: Path | None
     position: Sequence[float] = (0.0, 0.0, 0.0)
     yaw: float = 0.0
     controllers: list = field(default_factory=list)
+    description: str | None = None
+    text: str | None = None
 
 
 def build_world(
@@ -81,10 +87,16 @@ def build_world(
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.compiler.degree = False
     for entry in entries:
+        source = entry.file if entry.text is None else f"model {entry.name} ({entry.description or 'text'})"
+        if entry.text is None and entry.file is None:
+            raise ValueError(f"model {entry.name}: no model file, and its description {entry.description} not received")
         try:
-            child = mujoco.MjSpec.from_file(str(entry.file))
+            if entry.text is not None:
+                child = mujoco.MjSpec.from_string(entry.text)
+            else:
+                child = mujoco.MjSpec.from_file(str(entry.file))
         except Exception as exc:  # mujoco raises ValueError with the parser's text
-            raise ValueError(f"{entry.file}: {exc}") from exc
+            raise ValueError(f"{source}: {exc}") from exc
         name_unnamed_elements(child)
         half = entry.yaw / 2.0
         frame = spec.worldbody.add_frame(pos=list(entry.position), quat=[math.cos(half), 0.0, 0.0, math.sin(half)])

@@ -10,18 +10,112 @@ robot: ``export ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`` before starting.
 The variables are read by the middleware when ``rclpy.init`` creates a context,
 so :func:`use_localhost_by_default` must run before that; importing
 :mod:`tutorial` does it.
+
+A ROS 2 installation sourced in the same shell (``source /opt/ros/jazzy/setup.bash``)
+puts a second build of rclpy and its libraries on the paths: ``PYTHONPATH``
+comes before this environment's ``site-packages``, so ``import rclpy`` would
+load the installation's rclpy (built for the system's Python) with this
+environment's libraries, or the other way round.  Importing this module
+checks for it (:func:`sourced_ros_installation`) and stops the program with
+a clear message when rclpy would come from elsewhere; it only warns when a
+ROS installation is sourced but this environment's rclpy still comes first.
+``RTT_ALLOW_SOURCED_ROS=1`` skips the check.
 """
 
 from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 import weakref
-from collections.abc import MutableMapping, Sequence
+from collections.abc import Mapping, MutableMapping, Sequence
 
 DISCOVERY_RANGE_VARIABLE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 DEFAULT_DISCOVERY_RANGE = "LOCALHOST"
+ALLOW_SOURCED_ROS_VARIABLE = "RTT_ALLOW_SOURCED_ROS"
+ROS_PATH_VARIABLES = ("AMENT_PREFIX_PATH", "PYTHONPATH", "LD_LIBRARY_PATH")
+
+
+def sourced_ros_installation(
+    environ: Mapping[str, str] | None = None, rclpy_origin: str | None = "find", prefix: str = sys.prefix
+) -> tuple[str, str] | None:
+    """Whether a ROS 2 installation is sourced into this environment: ``(level, message)`` or None.
+
+    Args:
+        environ: the environment to look at (``os.environ`` by default).
+        rclpy_origin: where ``import rclpy`` would load it from (found
+            without importing it by default; None: not found).
+        prefix: this environment's prefix (``sys.prefix``).
+
+    Returns:
+        None when nothing is sourced; ``("error", message)`` when rclpy would
+        be imported from a ``PYTHONPATH`` entry outside ``prefix`` (two rclpy
+        builds: it fails, or mixes libraries); ``("warning", message)`` when a ROS installation is
+        on the paths (``AMENT_PREFIX_PATH``, ``PYTHONPATH``,
+        ``LD_LIBRARY_PATH`` entries outside ``prefix`` that belong to one) but
+        this environment's rclpy is still the one imported.
+
+    Any thread may call it; it changes nothing.
+    """
+    env = os.environ if environ is None else environ
+    if rclpy_origin == "find":
+        import importlib.util
+
+        spec = importlib.util.find_spec("rclpy")
+        rclpy_origin = spec.origin if spec is not None else None
+    home = os.path.realpath(prefix)
+
+    def outside(path: str) -> bool:
+        real = os.path.realpath(path)
+        return real != home and not real.startswith(home + os.sep)
+
+    installs = [p for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p and outside(p)]
+    roots = [os.path.realpath(p) for p in installs] + ["/opt/ros"]
+    found = [
+        f"{name} has {path}"
+        for name in ROS_PATH_VARIABLES
+        for path in env.get(name, "").split(os.pathsep)
+        if path and outside(path) and any(os.path.realpath(path).startswith(r) for r in roots)
+    ]
+    # PYTHONPATH comes before site-packages: an rclpy under one of its entries shadows ours.
+    shadowing = [
+        p
+        for p in env.get("PYTHONPATH", "").split(os.pathsep)
+        if p and outside(p) and rclpy_origin is not None
+        if os.path.realpath(rclpy_origin).startswith(os.path.realpath(p) + os.sep)
+    ]
+    if shadowing:
+        level = "error"
+        what = f"rclpy would be imported from {os.path.dirname(rclpy_origin)}, not from this environment ({prefix})"
+    elif found:
+        level = "warning"
+        what = "this environment's rclpy comes first, but the installation's libraries and messages are on the paths"
+    else:
+        return None
+    return level, (
+        f"a ROS 2 installation is sourced in this shell ({'; '.join(found) or 'PYTHONPATH'}): {what}. "
+        "Two builds of rclpy on one path fail in confusing ways. Run the rtt-* programs and notebooks in a "
+        "shell that has not sourced /opt/ros/<distro>/setup.bash (open a new terminal, or `env -u PYTHONPATH "
+        "-u AMENT_PREFIX_PATH -u LD_LIBRARY_PATH ...`), and ros2, RViz2 and robot_state_publisher in another "
+        f"(see the README, 'With ROS 2 installed'). {ALLOW_SOURCED_ROS_VARIABLE}=1 skips this check."
+    )
+
+
+def _check_sourced_ros() -> None:
+    """At import: stop with the message of an ``error``, print a ``warning`` (see :func:`sourced_ros_installation`)."""
+    if os.environ.get(ALLOW_SOURCED_ROS_VARIABLE) == "1":
+        return
+    found = sourced_ros_installation()
+    if found is None:
+        return
+    level, message = found
+    print(f"rtt: {'ERROR' if level == 'error' else 'WARNING'}: {message}", file=sys.stderr, flush=True)
+    if level == "error":
+        raise SystemExit(2)
+
+
+_check_sourced_ros()
 
 
 def use_localhost_by_default(environ: MutableMapping[str, str] | None = None) -> str:

@@ -233,6 +233,12 @@ def launch_parser(description: str) -> argparse.ArgumentParser:
         metavar="FILE.mcap",
         help="also record the step's topics to FILE.mcap (rtt-bag record, node rtt_bag)",
     )
+    p.add_argument(
+        "--tf",
+        action="store_true",
+        help="with --record: also record the robot description and odometry, and write /tf, /tf_static and "
+        "/robot_description, so Foxglove and RViz2 replay the robot in 3D (rtt-bag record --tf)",
+    )
     return p
 
 

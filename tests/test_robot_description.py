@@ -1,0 +1,143 @@
+"""``/<body>/robot_description``: checked when received, named by a viewer project instead of a
+model file, and the Step 3 monitor drawing the tank from it (and saying so)."""
+
+from __future__ import annotations
+
+import json
+import signal
+
+import pytest
+
+from tutorial.core.project import ProjectError, load_project
+from tutorial.interfaces.robot_description import DescriptionError, check_robot_description
+
+from conftest import PROJECT, module_command
+
+VIEW = """name: v
+models:
+  - name: Tank
+{model}
+    controllers:
+      - name: RttJointStateMonitor
+        class: tutorial.controllers.joint_state_subscriber:RttJointStateMonitor
+{simulator}"""
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize(
+    "model, simulator, says",
+    [
+        ("    description: Tank/robot_description", "", "models[0].description: expected a topic name like /Tank/"),
+        ("    description: 12", "", "models[0].description: expected a topic name"),
+        ("    description: /Tank/robot description", "", "models[0].description: expected a topic name"),
+        (
+            "    file: ../model/tank.xml\n    description: /Tank/robot_description",
+            "",
+            "models[0]: give either file (a model file) or description",
+        ),
+        ("    yaw: 0", "", "models[0].file: missing: give file (a model file) or description"),
+        (
+            "    description: /Tank/robot_description",
+            "simulator:\n  time_step: 0.001",
+            "models[0].description: a simulated model needs a model file",
+        ),
+    ],
+)
+def test_a_project_names_a_description_topic_or_says_what_is_wrong(tmp_path, model, simulator, says):
+    path = tmp_path / "p.yaml"
+    path.write_text(VIEW.format(model=model, simulator=simulator))
+    with pytest.raises(ProjectError) as caught:
+        load_project(path)
+    assert str(caught.value).startswith(f"{path}: {says}"), str(caught.value)
+
+
+@pytest.mark.unit
+def test_the_description_project_loads():
+    project = load_project(PROJECT / "step3_description.yaml")
+    [tank] = project.models
+    assert tank.file is None and tank.description == "/Tank/robot_description" and project.simulator is None
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize(
+    "text, says",
+    [
+        ("", "empty"),
+        (None, "empty"),
+        ("<robot", "not XML"),
+        ("<mujoco model='x'/>", "not <robot>"),
+        ("<robot><link name='a'/></robot>", "has no name"),
+        ("<robot name='r'/>", "has no <link>"),
+        ("<robot name='r'><link name='a'/>" + " " * (17 * 1024 * 1024) + "</robot>", "larger than 16 MiB"),
+    ],
+)
+def test_a_received_description_is_checked(text, says):
+    with pytest.raises(DescriptionError, match=says):
+        check_robot_description(text, "/Tank/robot_description")
+
+
+def test_a_viewer_with_no_description_to_read_says_so(ros, tmp_path):
+    """No simulation: the viewer waits its timeout, then fails with one clear line."""
+    from tutorial.core.app import App
+
+    app = App(
+        load_project(PROJECT / "step3_description.yaml"),
+        node_name="no_description_viewer",
+        headless=True,
+        output=lambda record: None,
+        description_timeout=0.5,
+    )
+    try:
+        with pytest.raises(DescriptionError, match=r"no robot description on /Tank/robot_description within 0.5 s"):
+            app.open()
+    finally:
+        app.close()
+
+
+def test_the_step3_monitor_draws_the_published_description(procs):
+    """rtt-run step3_description.yaml beside a Step 2 simulation: the monitor takes its model from
+    /Tank/robot_description, says so, and mirrors the simulation's final joint state by name."""
+    sim = procs(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json"))
+    view = procs(
+        module_command(
+            "tutorial.tools.rtt_run",
+            "project/step3_description.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-r",
+            "__node:=rtt_viewer",
+        )
+    )
+    said = json.loads(view.wait_for_line(lambda line: '"event": "description"' in line, timeout=30))
+    assert said["topic"] == "/Tank/robot_description" and said["moving_joints"] == ["TURRET_Y", "TURRET_P"]
+    assert "no model file of its own: drawing the robot description on /Tank/robot_description" in said["line"]
+    view.wait_for_line(lambda line: '"event": "first_state"' in line, timeout=30)
+    sim.p.send_signal(signal.SIGINT)
+    assert sim.wait(30) == 0, sim.err
+    final = sim.summary()["bodies"]["Tank"]["joint_positions"]
+    view.wait_for_line(lambda line: '"event": "stale"' in line, timeout=30)  # silent since the sim ended
+    view.p.send_signal(signal.SIGINT)
+    assert view.wait(30) == 0, view.err
+    shown = view.summary()["controllers"]["RttJointStateMonitor"]
+    assert shown["rejected"] == {}
+    assert shown["last_positions"] == pytest.approx(final, abs=1e-9)
+
+
+@pytest.mark.unit
+def test_the_rviz_config_draws_the_tank_from_our_topics():
+    """rviz/tank.rviz (not run here: no RViz2): YAML with the displays the README's commands rely on."""
+    import yaml
+
+    from conftest import ROOT
+
+    config = yaml.safe_load((ROOT / "rviz" / "tank.rviz").read_text())
+    manager = config["Visualization Manager"]
+    displays = {d["Class"]: d for d in manager["Displays"]}
+    model = displays["rviz_default_plugins/RobotModel"]
+    assert model["Description Source"] == "Topic"
+    assert model["Description Topic"]["Value"] == "/robot_description"
+    assert model["Description Topic"]["Durability Policy"] == "Transient Local"  # what robot_state_publisher offers
+    assert displays["rviz_default_plugins/Odometry"]["Topic"]["Value"] == "/Tank/odom"
+    assert "rviz_default_plugins/TF" in displays
+    assert manager["Global Options"]["Fixed Frame"] == "world"

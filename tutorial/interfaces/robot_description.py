@@ -1,0 +1,121 @@
+"""``/<body>/robot_description`` (``std_msgs/String``): the body's URDF, for the stock ROS 2 tools.
+
+``robot_state_publisher`` publishes a robot's URDF on ``/robot_description``
+so that RViz2's RobotModel display, Foxglove and any monitor started at any
+time can draw the robot.  The simulation does the same for each body, on a
+topic named after it (:func:`robot_description_topic`), with the same QoS
+(:func:`robot_description_qos`): published once, kept for late joiners.
+
+The text is the URDF of :mod:`tutorial.urdf.export`.  A received description
+is checked by :func:`check_robot_description` before anything is built from
+it: it may come from any publisher on the network.
+"""
+
+from __future__ import annotations
+
+import time
+
+MAX_DESCRIPTION_BYTES = 16 * 1024 * 1024  # a URDF is text: far larger is not a robot description
+
+
+class DescriptionError(ValueError):
+    """A robot description that cannot be used, or none arrived; the message says which (one line)."""
+
+
+def robot_description_topic(body_name: str) -> str:
+    """``/<body name>/robot_description``, e.g. ``/Tank/robot_description``."""
+    return f"/{body_name}/robot_description"
+
+
+def robot_description_qos():
+    """The description's QoS, as ``robot_state_publisher`` offers it: reliable, keep last 1, transient local.
+
+    * transient local: published once, when the publisher starts; the
+      publisher keeps it for every subscriber that joins later (RViz2
+      opened an hour after the simulation still gets it);
+    * reliable, keep last 1: one message that must arrive, and only the
+      newest matters.
+
+    A subscriber must ask for transient local too, or it gets only
+    descriptions published after it joined (none).
+    """
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+    return QoSProfile(
+        depth=1,
+        history=HistoryPolicy.KEEP_LAST,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+
+def check_robot_description(text, source: str = "the robot description") -> str:
+    """The URDF text, if ``text`` is one that can be used (any thread).
+
+    Args:
+        text: the received ``std_msgs/String.data``.
+        source: named in the error (e.g. the topic).
+
+    Returns:
+        ``text``, unchanged.
+
+    Raises:
+        DescriptionError: not a string, empty, larger than
+            :data:`MAX_DESCRIPTION_BYTES`, not XML, or not a ``<robot>`` with
+            a name and at least one link.
+    """
+    from lxml import etree
+
+    if not isinstance(text, str) or not text.strip():
+        raise DescriptionError(f"{source}: empty")
+    if len(text.encode("utf-8", errors="replace")) > MAX_DESCRIPTION_BYTES:
+        raise DescriptionError(f"{source}: larger than {MAX_DESCRIPTION_BYTES // (1024 * 1024)} MiB")
+    try:
+        root = etree.fromstring(text.encode("utf-8"), parser=etree.XMLParser(resolve_entities=False))
+    except etree.XMLSyntaxError as exc:
+        raise DescriptionError(f"{source}: not XML ({exc})") from None
+    if root.tag != "robot":
+        raise DescriptionError(f"{source}: the root element is <{root.tag}>, not <robot> (not a URDF)")
+    if not root.get("name"):
+        raise DescriptionError(f"{source}: the <robot> has no name")
+    if root.find("link") is None:
+        raise DescriptionError(f"{source}: the <robot> has no <link>")
+    return text
+
+
+def receive_robot_description(node, topic: str, timeout: float) -> str:
+    """Wait for the description on ``topic`` and return it, checked (owner thread of ``node``).
+
+    Subscribes with :func:`robot_description_qos`, so the message a
+    transient-local publisher kept arrives at once, and spins ``node`` on an
+    executor of its own until it has come or ``timeout`` s have passed.  The
+    node must not be spinning elsewhere yet (the App calls this before its
+    spin thread starts).
+
+    Raises:
+        DescriptionError: nothing arrived within ``timeout`` s (with a hint),
+            or what arrived is not a usable URDF (:func:`check_robot_description`).
+    """
+    from rclpy.executors import SingleThreadedExecutor
+    from std_msgs.msg import String
+
+    received: list[str] = []
+    subscription = node.create_subscription(
+        String, topic, lambda msg: received.append(msg.data), robot_description_qos()
+    )
+    executor = SingleThreadedExecutor(context=node.context)
+    executor.add_node(node)
+    try:
+        deadline = time.monotonic() + timeout
+        while not received and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=min(0.1, max(0.0, deadline - time.monotonic())))
+    finally:
+        executor.remove_node(node)
+        executor.shutdown(timeout_sec=0)
+        node.destroy_subscription(subscription)
+    if not received:
+        raise DescriptionError(
+            f"no robot description on {topic} within {timeout:g} s: start the simulation first "
+            "(its RttRobotModelPublisher publishes it), or name a model file instead"
+        )
+    return check_robot_description(received[-1], topic)

@@ -1,0 +1,17 @@
+"""URDF: a MuJoCo body as the stock ROS 2 tools describe a robot, and its transforms.
+
+RViz2, Foxglove and ``robot_state_publisher`` know a robot from its URDF and
+show it from TF.  One job per module:
+
+=================================  ===============================================================
+:mod:`tutorial.urdf.export`        a :class:`tutorial.core.body.Body` as a URDF (``rtt-urdf``),
+                                   written with ``yourdfpy``; what it maps and what it cannot
+:mod:`tutorial.urdf.kinematics`    a URDF's joints as transforms, as ``robot_state_publisher``
+                                   computes them: fixed ones once, moving ones from a JointState
+:mod:`tutorial.urdf.recording`     ``rtt-bag record --tf``: ``/tf``, ``/tf_static`` and
+                                   ``/robot_description`` computed while recording
+:mod:`tutorial.urdf.mujoco_load`   a URDF (a robot description received over ROS) as a MuJoCo model
+=================================  ===============================================================
+
+No ROS import at module level here: the URDF and its kinematics are plain files and numbers.
+"""
