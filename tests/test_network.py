@@ -10,6 +10,7 @@ measures them.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import time
 
@@ -182,3 +183,25 @@ def test_no_multicast_discovery_server(procs, net):  # noqa: F811 - the fixture
     wait_states(view, 25)
     assert wait_until(lambda: publishers_seen(view) == 1, timeout=10), view.out
     assert sim.p.poll() is None
+
+
+def test_on_a_5_mbit_link_the_compressed_camera_and_the_states_arrive(procs, net):  # noqa: F811 - the fixture
+    """The issue's case: a thin link, the camera on. The compressed pictures fit, the states stay live."""
+    robot, operator = net["robot"], net["operator"]
+    robot.limit_rate(5.0)
+    view = monitor(procs, operator)
+    image = on(procs, operator, "tutorial.tools.rtt_image", "--transport", "compressed", "--no-window",
+               "--output", str(net["operator"].shm_dir) + "/view.png")  # fmt: skip
+    simulation(procs, robot, "project/step6.yaml")
+    wait_states(view, 25)
+    rate = re.compile(r"\] ([\d.]+) img/s, 320x240 rgb8; jpeg compressed bgr8 \(([\d.]+) kB\) frame Kinect")
+    # Three status lines at >= 10 pictures/s (30 are sent), the last three all so: the camera fits the link.
+    image.wait_for_count(lambda line: bool(rate.search(line)) and float(rate.search(line).group(1)) >= 10, 3, 30)
+    rates = [float(m.group(1)) for m in map(rate.search, image.out.splitlines()) if m]
+    assert min(rates[-3:]) >= 10, rates
+    assert all(float(m.group(2)) < 20 for m in map(rate.search, image.out.splitlines()) if m)  # kB a picture
+    first = len(view.records("status"))
+    view.wait_for_count(is_event("status"), first + 2, timeout=10)
+    statuses = view.records("status")[first:]
+    assert all(not s["stale"] and s["rate_hz"] >= 40 for s in statuses), statuses
+    assert robot.rate_mbit == 5.0
