@@ -51,7 +51,6 @@ import numpy as np
 from ..core.call_later import MainLoop
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
 from ..core.simulator import Snapshot
-from ..interfaces.image import camera_image_qos, camera_image_topic, fill_image
 from tutorial.interfaces.compressed_image import (
     CODECS,
     DEFAULT_JPEG_QUALITY,
@@ -59,6 +58,7 @@ from tutorial.interfaces.compressed_image import (
     compressed_image_topic,
     fill_compressed_image,
 )
+from ..interfaces.image import camera_image_qos, camera_image_topic, fill_image
 from ..interfaces.timing import PeriodAccumulator
 
 DEFAULT_RATE = 30.0  # pictures per second of simulated time
