@@ -1,4 +1,4 @@
-"""nbval: a cell that needs its own network hosts is skipped, saying why, where none exist.
+"""nbval: a cell that needs network hosts is skipped, saying why, where none exist.
 
 Notebook 08 runs programs on two hosts made of network namespaces
 (:mod:`tutorial.network.hosts`), which needs root.  Its cells that need them
