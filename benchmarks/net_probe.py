@@ -58,7 +58,7 @@ def main(argv=None) -> int:
     p.add_argument("--topic", default="/Tank/camera/image")
     p.add_argument("--duration", type=float, required=True)
     p.add_argument("--out", required=True)
-    args = p.parse_args(argv)
+    args = p.parse_intermixed_args(argv)
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("bench_net_probe")
@@ -99,3 +99,35 @@ def main(argv=None) -> int:
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def _best_effort_monitor():
+    from rclpy.qos import ReliabilityPolicy
+
+    import tutorial.controllers.joint_state_subscriber as step3
+    from benchmarks.probes import ProbedJointStateSubscriber
+
+    class BestEffortMonitor(ProbedJointStateSubscriber):
+        """The probed monitor, its live subscription best effort, keep last 1, volatile."""
+
+        def configure(self, config) -> bool:
+            viewer_qos = step3.joint_state_viewer_qos
+
+            def best_effort():
+                qos = viewer_qos()
+                qos.reliability = ReliabilityPolicy.BEST_EFFORT
+                return qos
+
+            step3.joint_state_viewer_qos = best_effort  # this process only: the benchmark's own monitor
+            try:
+                return super().configure(config)
+            finally:
+                step3.joint_state_viewer_qos = viewer_qos
+
+    return BestEffortMonitor
+
+
+def __getattr__(name: str):
+    if name == "BestEffortMonitor":
+        return _best_effort_monitor()
+    raise AttributeError(name)

@@ -299,9 +299,9 @@ MISTAKES = [
     ),
     (
         "8.1",
-        "ReliabilityPolicy.BEST_EFFORT,  # never",
-        "ReliabilityPolicy.RELIABLE,  # never",
-        "a best-effort publisher",
+        "ReliabilityPolicy.RELIABLE,  # the last",
+        "ReliabilityPolicy.BEST_EFFORT,  # the last",
+        "the final state arrives",
     ),
     ("8.1", "depth=1,  # the newest", "depth=10,  # the newest", "keep last 1"),
     (

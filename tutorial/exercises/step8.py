@@ -3,8 +3,8 @@
 Exercise 8.1, a QoS for the monitor on a lossy link: ``lossy_link_qos()``
 returns the QoS of the monitor's live subscription to the joint states
 when the link to the robot loses packets: it must match the Step 2
-publisher (and ordinary volatile ones), keep only the newest state, and
-never hold a newer state back while a lost one is resent.
+publisher and ordinary volatile ones, keep only the newest state, and make
+sure the last state arrives.
 Exercise 8.2, a camera that fits 0.5 Mbit/s: ``camera_settings()`` returns
 ``(rate, jpeg_quality)`` for 0.5 Mbit/s; the check renders the tank's camera along a
 scripted turret swing, encodes every picture as the publisher would, and
@@ -26,7 +26,15 @@ PICTURES = 12  # rendered for the check, along the turret's swing
 
 
 def check_lossy_link_qos(func) -> Result:
-    """Check ``func() -> QoSProfile`` for the monitor's live joint-state subscription on a lossy link."""
+    """Check ``func() -> QoSProfile`` for the monitor's live joint-state subscription on a lossy link.
+
+    What ``python -m benchmarks.network`` measured at 20 % loss: a reliable
+    monitor applied 39.4 states/s, a best-effort one 39.9 (50 are sent; 40
+    get through): the Step 2 publisher keeps only its newest state, so
+    reliability cannot bring lost states back, and costs nothing either;
+    what it does is make the *last* state arrive (best effort loses it as
+    often as any other).  So: reliable, keep last 1, volatile.
+    """
     from rclpy.qos import (
         DurabilityPolicy,
         HistoryPolicy,
@@ -61,24 +69,22 @@ def check_lossy_link_qos(func) -> Result:
 
         return Case(call, run, hint)
 
-    volatile_reliable = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-    volatile_best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
-
     def newest_only():
         qos = profile()
         if qos.history != HistoryPolicy.KEEP_LAST or qos.depth != 1:
             raise CaseFailed(
                 f"lossy_link_qos() keeps {qos.history.name.lower()} depth {qos.depth}, expected keep last 1.",
-                "a monitor shows the newest state; older ones queued behind it only make the view late.",
+                "a monitor shows the newest state; after a partition a queue would replay old ones first.",
             )
 
-    def never_waits():
+    def last_state_arrives():
         qos = profile()
-        if qos.reliability != ReliabilityPolicy.BEST_EFFORT:
+        if qos.reliability != ReliabilityPolicy.RELIABLE:
             raise CaseFailed(
-                f"lossy_link_qos() is {qos.reliability.name.lower()}, expected best effort.",
-                "a reliable reader hands states over in order: a newer state that arrived waits until a lost "
-                "one is resent or given up, while the view grows older.",
+                f"lossy_link_qos() is {qos.reliability.name.lower()}: at 20 % loss the final state is lost "
+                "1 time in 5, and the monitor ends showing a pose the robot has left.",
+                "reliable costs nothing here (measured: 39.4 states/s against best effort's 39.9) and makes "
+                "the last state arrive.",
             )
 
     return grade(
@@ -87,20 +93,15 @@ def check_lossy_link_qos(func) -> Result:
             matches(
                 "the Step 2 publisher (reliable, keep last 1, transient local)",
                 joint_state_qos(),
-                "any reliability and a volatile durability match it.",
+                "a reliable or best-effort, volatile subscription matches it.",
             ),
             matches(
                 "an ordinary volatile publisher (reliable, keep last 10)",
-                volatile_reliable,
+                QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE),
                 "a transient-local subscription does not match a volatile publisher: ask for volatile.",
             ),
-            matches(
-                "a best-effort publisher (a camera-like sensor)",
-                volatile_best_effort,
-                "a reliable subscription does not match a best-effort publisher.",
-            ),
             Case("lossy_link_qos(): keep last 1", newest_only),
-            Case("lossy_link_qos(): a lost state is not waited for", never_waits),
+            Case("lossy_link_qos(): the final state arrives", last_state_arrives),
             Case(
                 "lossy_link_qos(): durability volatile",
                 lambda: _expect(

@@ -61,6 +61,8 @@ TABLE = "rttnet"  # the nftables table (family inet) in each host's namespace
 COMMAND_TIMEOUT = 20.0  # s for one ip/nft/tc command
 STOP_GRACE = 5.0  # s between SIGINT and SIGKILL for a program still running when the network closes
 
+HOSTS_VARIABLE = "RTT_NETWORK_HOSTS"  # "off": behave as where no hosts can be made
+
 _counter = itertools.count()
 
 
@@ -90,8 +92,12 @@ def why_unavailable() -> str | None:
 
     Checks that this process is root, that ``ip``, ``nft`` and ``tc`` exist,
     and that a namespace can really be made (a container may forbid it).
+    ``RTT_NETWORK_HOSTS=off`` says no on purpose: what a computer without
+    root shows (notebook 08 and the network tier skip, saying so).
     Any thread may call it; it makes and removes one namespace.
     """
+    if os.environ.get(HOSTS_VARIABLE, "").lower() == "off":
+        return f"{HOSTS_VARIABLE}=off"
     if os.geteuid() != 0:
         return "making network namespaces needs root (this process is not)"
     for tool, package in (("ip", "iproute2"), ("nft", "nftables"), ("tc", "iproute2")):

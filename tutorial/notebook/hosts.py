@@ -135,6 +135,12 @@ class TwoHosts:
             for host in self.net.hosts.values():
                 host.clear_faults()
 
+    def renew(self) -> None:
+        """Stop every program and make both hosts afresh (as if both computers had restarted)."""
+        self.close()
+        if self.problem is None:
+            self.net = Network(("robot", "operator")).open()
+
     def close(self) -> None:
         """Stop the programs and remove the hosts (safe to call twice, and without hosts)."""
         self.stop_all()
