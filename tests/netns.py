@@ -50,10 +50,6 @@ def on(procs, host: Host, module: str, *args: str, **env: str) -> Proc:
     return procs(host.command(module_command(module, *args)), env=host.env(**env))
 
 
-def events(proc: Proc, event: str) -> list[dict]:
-    return proc.records(event)
-
-
 def is_event(event: str):
     """A line predicate: a JSON record of this event."""
     tag = f'"event": "{event}"'
