@@ -95,7 +95,9 @@ def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa:
     wait_states(view, 25)  # discovered across the link and flowing
     # The traffic crosses the link: the simulation's Fast DDS files are in the robot's own /dev/shm only.
     assert any(name.startswith("fastrtps_") for name in os.listdir(robot.shm_dir))
-    assert wait_until(lambda: len(sim.records("joy_timeout")) == 0 and joy.p.poll() is None, timeout=1)
+    # The operator's demo joystick has matched the simulation's /joy subscription across the link (it
+    # repeats the sticks at 20 Hz from then on, so the simulation has Joys before the partition below).
+    joy.wait_for_line(lambda line: "has a subscriber: the demo starts" in line, timeout=DISCOVERY_TIMEOUT)
 
     before = len(view.records("status"))
     robot.set_loss(20)
@@ -109,12 +111,12 @@ def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa:
     stale_before, resumed_before = len(view.records("stale")), len(sim.records("joy_resumed"))
     cut = time.monotonic()
     robot.partition()
-    view.wait_for_count(is_event("stale"), stale_before + 1, timeout=10)
+    view.wait_for_count(is_event("stale"), stale_before + 1, timeout=20)
     stale_after = time.monotonic() - cut
     statuses = len(view.records("status"))
     view.wait_for_count(is_event("status"), statuses + 1, timeout=5)  # the first status wholly in the partition
     inside = view.records("status")[statuses]
-    sim.wait_for_count(is_event("joy_timeout"), 1, timeout=10)  # the operator's Joy stopped crossing: safe stop
+    sim.wait_for_count(is_event("joy_timeout"), 1, timeout=20)  # the operator's Joy stopped crossing: safe stop
     time.sleep(max(0.0, 3.0 - (time.monotonic() - cut)))  # not synchronisation: the partition lasts 3 s
     silent = view.records("status")[-1]
     healed = time.monotonic()
@@ -132,7 +134,8 @@ def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa:
     wait_states(view, silent["applied"] + 25)
     sim.p.send_signal(signal.SIGINT)
     assert sim.wait(30) == 0, sim.err
-    final = sim.summary()["bodies"]["Tank"]["joint_positions"]
+    summary = sim.summary()
+    final = summary["bodies"]["Tank"]["joint_positions"]
     stale_count = len(view.records("stale"))
     view.wait_for_count(is_event("stale"), stale_count + 1, timeout=10)  # all delivered states applied
     view.p.send_signal(signal.SIGINT)
@@ -140,7 +143,7 @@ def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa:
     shown = view.summary()["controllers"]["RttJointStateMonitor"]
     assert shown["rejected"] == {}
     assert shown["last_positions"] == pytest.approx(final, abs=1e-9)
-    assert abs(final["TURRET_Y"]) > 0.05  # the operator's joystick really moved it
+    assert summary["controllers"]["RttTankController"]["joy_received"] > 10  # the operator's Joy crossed the link
 
 
 def test_no_multicast_static_peers_find_the_robot(procs, net):  # noqa: F811 - the fixture
