@@ -466,6 +466,7 @@ def bandwidth(seconds: float = 8.0) -> dict:
 # ---------------------------------------------------------------- the encoders
 def encoders(repeat: int = 500) -> dict:
     """JPEG encode and decode times of Pillow and simplejpeg (if installed) on one camera picture, ms."""
+    os.environ.setdefault("MUJOCO_GL", "egl")  # before mujoco is imported: render without a display
     import io
 
     import mujoco
