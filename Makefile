@@ -27,6 +27,7 @@ demo: $(VENV)/.installed
 # Every tier (tests/conftest.py lists them), the notebooks under nbval, after the lint gate.
 test: $(VENV)/.installed lint
 	bash scripts/ensure-chromium.sh
+	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
 
 # The unit tier only: no ROS, no process, no browser.

@@ -61,8 +61,32 @@ def pytest_configure(config):
         config.addinivalue_line("markers", f"{tier}: the {tier.replace('_', '-')} tier (see tests/conftest.py)")
 
 
+NEEDS_HOSTS = "# NEEDS_HOSTS"  # the first line of a notebook cell that runs programs on network hosts
+
+
+def skip_cells_needing_hosts(items) -> None:
+    """Skip, saying why, the notebook cells that need network hosts where none can be made.
+
+    Notebook 08 runs programs on two hosts made of network namespaces
+    (:mod:`tutorial.network.hosts`, root only).  Its cells that need them begin
+    with ``# NEEDS_HOSTS``; without hosts they print ``no hosts here: <why>``,
+    not their saved outputs (from a run that had hosts), so nbval skips
+    exactly those cells.  Every other cell, the exercises too, is checked.
+    """
+    needing = [i for i in items if NEEDS_HOSTS in getattr(getattr(i, "cell", None), "source", "")]
+    if not needing:
+        return
+    from tutorial.network.hosts import why_unavailable
+
+    problem = why_unavailable()
+    if problem is not None:
+        for item in needing:
+            item.add_marker(pytest.mark.skip(reason=f"this cell needs its own network hosts: {problem}"))
+
+
 def pytest_collection_modifyitems(config, items):
-    """Give every test exactly one tier marker (see the module's docstring)."""
+    """Give every test exactly one tier marker (see the module's docstring); skip cells that need absent hosts."""
+    skip_cells_needing_hosts(items)
     for item in items:
         marked = {m.name for m in item.iter_markers() if m.name in TIERS}
         if len(marked) > 1:

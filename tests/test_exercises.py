@@ -25,6 +25,7 @@ MODULES = {
     "05": "imu_state_subscriber",
     "06": "camera_image_publisher",
     "07": None,
+    "08": None,
     "09": "robot_model_publisher",
 }
 
@@ -65,7 +66,7 @@ def grade(ex: dict, *sources: str):
     return check(namespace[ex["target"]])
 
 
-EXERCISES = ["1.1", "1.2", "2.1", "2.2", "3.1", "3.2", "7.1", "7.2", "4.1", "4.2", "5.1", "5.2", "6.1", "6.2", "9.1"]
+EXERCISES = ["1.1", "1.2", "2.1", "2.2", "3.1", "3.2", "7.1", "7.2", "4.1", "4.2", "5.1", "5.2", "6.1", "6.2", "8.1", "8.2", "9.1"]
 
 
 @pytest.mark.parametrize("number", EXERCISES)
@@ -280,6 +281,22 @@ MISTAKES = [
         "self.info.p = [fx, 0.0, 0.0, cx, 0.0, fy, 0.0, cy, 0.0, 0.0, 1.0, 0.0]",
         "p, k with a fourth column",
     ),
+    (
+        "8.1",
+        "ReliabilityPolicy.RELIABLE,  # the last",
+        "ReliabilityPolicy.BEST_EFFORT,  # the last",
+        "the final state arrives",
+    ),
+    ("8.1", "depth=1,  # the newest", "depth=10,  # the newest", "keep last 1"),
+    (
+        "8.1",
+        "DurabilityPolicy.VOLATILE,  # matches",
+        "DurabilityPolicy.TRANSIENT_LOCAL,  # matches",
+        "an ordinary volatile publisher",
+    ),
+    ("8.2", "return 15.0, 70", "return 30.0, 80", "within 0.5 Mbit/s"),
+    ("8.2", "return 15.0, 70", "return 5.0, 80", "at least 10 pictures/s"),
+    ("8.2", "return 15.0, 70", "return 30.0, 10", "a picture you can recognise"),
     ("9.1", "pose_matrix(t.translation, (w, x, y, z))", "pose_matrix(t.translation, t.rotation)", "moved only"),
     (
         "9.1",

@@ -5,6 +5,7 @@ import threading
 import numpy as np
 import pytest
 
+from tutorial.interfaces.compressed_image import compressed_image_qos, compressed_to_array
 from tutorial.interfaces.image import camera_image_qos, image_to_array
 from tutorial.ros import env as ros_env
 
@@ -16,10 +17,22 @@ DURATION = 8.0  # s of simulated time
 
 
 def test_pictures_arrive_stamped_with_simulation_time_at_the_rate_asked(procs, node, egl):  # noqa: F811
-    from sensor_msgs.msg import Image
+    from sensor_msgs.msg import CompressedImage, Image
 
     lock = threading.Lock()
     received: list[dict] = []
+    compressed: list[dict] = []
+
+    def on_compressed(msg):
+        record = {
+            "stamp": msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9,
+            "frame_id": msg.header.frame_id,
+            "format": msg.format,
+            "bytes": len(msg.data),
+            "pixels": compressed_to_array(msg),
+        }
+        with lock:
+            compressed.append(record)
 
     def on_image(msg):
         record = {
@@ -32,6 +45,7 @@ def test_pictures_arrive_stamped_with_simulation_time_at_the_rate_asked(procs, n
             received.append(record)
 
     node.create_subscription(Image, "/Tank/camera/image", on_image, camera_image_qos())
+    node.create_subscription(CompressedImage, "/Tank/camera/image/compressed", on_compressed, compressed_image_qos())
     spin = ros_env.SpinThread(node).start()
     try:
         sim = procs(
@@ -73,3 +87,15 @@ def test_pictures_arrive_stamped_with_simulation_time_at_the_rate_asked(procs, n
         assert r["frame_id"] == "Kinect"
         assert r["fields"] == ("rgb8", 240, 320, 960, 0, 240 * 960)
     assert max(float(np.std(r["pixels"])) for r in got) > 20  # pictures, not blank frames
+    # The same pictures, JPEG-compressed (image_transport's compressed transport), while subscribed.
+    with lock:
+        small = {r["stamp"]: r for r in compressed}
+    assert camera["compressed"]["format"] == "rgb8; jpeg compressed bgr8"
+    assert len(small) >= 0.9 * sent and camera["compressed"]["published"] >= len(small)
+    both = [r for r in got if r["stamp"] in small]
+    assert len(both) >= 0.8 * len(got)
+    for r in both:
+        c = small[r["stamp"]]
+        assert (c["frame_id"], c["format"]) == ("Kinect", "rgb8; jpeg compressed bgr8")
+        assert c["bytes"] < 240 * 960 / 20  # twenty times smaller at least
+        assert np.abs(c["pixels"].astype(int) - r["pixels"]).mean() < 4  # the same picture, within JPEG's loss

@@ -1,6 +1,7 @@
 """``rtt-image``: show the pictures of a ``sensor_msgs/Image`` topic (rqt_image_view's stand-in).
 
     rtt-image                                   # /Tank/camera/image: a window, or camera_image.png
+    rtt-image --transport compressed            # /Tank/camera/image/compressed (JPEG or PNG)
     rtt-image /Tank/camera/image --output view.png --every 0.5
     rtt-image --output 'frames/image_{n:04d}.png' --max-files 50 --duration 10
 
@@ -14,11 +15,18 @@ files instead, bounded on disk:
   numbered file each time, at most ``--max-files`` of them (100 by default);
   after that no more are written.
 
+``--transport compressed`` (image_transport's name) subscribes
+``<topic>/compressed``, a ``sensor_msgs/CompressedImage``, instead of the
+raw Image: the one to use across a thin link (a topic ending in
+``/compressed`` is taken as compressed anyway).
+
 Each file is written whole before it replaces the old one, so a reader
 never sees half a PNG.  Once a second it prints a status line: pictures per
 second, size, encoding, frame, the newest stamp (simulation time) and the
 messages it rejected.  Every message is checked by
-:func:`tutorial.interfaces.image.image_to_array`; a bad one is counted and skipped.
+:func:`tutorial.interfaces.image.image_to_array` (raw) or
+:func:`tutorial.interfaces.compressed_image.compressed_to_array`; a bad one
+is counted and skipped.
 
 It stops on Ctrl-C, SIGTERM, a closed window, or after ``--duration`` s of
 wall-clock time.  Node name ``rtt_image``.  QoS: best effort, keep last 1
@@ -35,7 +43,7 @@ import sys
 import time
 
 from tutorial.ros import env as ros_env
-from tutorial.view.images import DEFAULT_TOPIC, ImageReceiver, PngWriter, format_image_status
+from tutorial.view.images import DEFAULT_TOPIC, TRANSPORTS, ImageReceiver, PngWriter, format_image_status
 
 NODE_NAME = "rtt_image"
 STATUS_PERIOD = 1.0  # s
@@ -47,8 +55,14 @@ def has_display() -> bool:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="rtt-image", description="Show the pictures of a sensor_msgs/Image topic.")
-    p.add_argument("topic", nargs="?", default=DEFAULT_TOPIC, help=f"the Image topic (default {DEFAULT_TOPIC})")
+    p = argparse.ArgumentParser(prog="rtt-image", description="Show the pictures of a camera topic, raw or compressed.")
+    p.add_argument("topic", nargs="?", default=DEFAULT_TOPIC, help=f"the camera topic (default {DEFAULT_TOPIC})")
+    p.add_argument(
+        "--transport",
+        choices=TRANSPORTS,
+        default="raw",
+        help="raw: the sensor_msgs/Image topic; compressed: TOPIC/compressed, a CompressedImage (default raw)",
+    )
     p.add_argument(
         "--output",
         default="camera_image.png",
@@ -171,7 +185,7 @@ def main(argv: list[str] | None = None) -> int:
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node(NODE_NAME)
-    receiver = ImageReceiver(node, args.topic)
+    receiver = ImageReceiver(node, args.topic, args.transport)
     viewer = _Viewer(receiver, args, writer)
 
     def request_stop(signum, frame):
@@ -182,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     spin = ros_env.SpinThread(node).start()
     viewer.prefix = f"[{node.get_fully_qualified_name()}]"
     viewer.say(
-        f"subscribed to {args.topic} (best effort, keep last 1); "
+        f"subscribed to {receiver.topic} (best effort, keep last 1); "
         + ("showing a window" if live else f"writing {args.output}")
     )
     deadline = time.monotonic() + (args.duration if args.duration is not None else float("inf"))

@@ -1,8 +1,11 @@
 """Camera pictures received over ROS 2: the newest one kept, checked, and written as PNG.
 
-:class:`ImageReceiver` subscribes an Image topic and keeps the newest
-picture that :func:`tutorial.interfaces.image.image_to_array` accepts,
-counting the rest; ``rtt-image`` and the notebooks' live picture
+:class:`ImageReceiver` subscribes a camera topic in one of image_transport's
+two transports: ``raw`` (``sensor_msgs/Image``, checked by
+:func:`tutorial.interfaces.image.image_to_array`) or ``compressed``
+(``sensor_msgs/CompressedImage`` on ``<topic>/compressed``, decoded by
+:func:`tutorial.interfaces.compressed_image.compressed_to_array`); it keeps
+the newest picture accepted, counting the rest; ``rtt-image`` and the notebooks' live picture
 (:mod:`tutorial.notebook.live_image`) show what it holds.
 :class:`PngWriter` writes pictures to files, whole or not at all.
 """
@@ -12,15 +15,18 @@ from __future__ import annotations
 import io
 import os
 import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from tutorial.interfaces.compressed_image import compressed_image_qos, compressed_to_array
 from tutorial.interfaces.image import ImageError, camera_image_qos, image_to_array
 from tutorial.interfaces.timing import stamp_seconds
 
 DEFAULT_TOPIC = "/Tank/camera/image"
+TRANSPORTS = ("raw", "compressed")  # image_transport's names
 
 
 @dataclass(frozen=True)
@@ -31,8 +37,12 @@ class ReceivedImage:
         pixels: ``(height, width, 3)`` uint8 RGB; nobody writes to it after it is made.
         stamp: the message's stamp, s (simulation time for the tutorial's camera).
         frame_id: the message's frame.
-        encoding: the message's encoding (``pixels`` is RGB whatever it was).
+        encoding: the message's encoding, or a compressed message's format
+            (``pixels`` is RGB whatever it was).
         number: how many pictures were accepted up to this one (1 for the first).
+        arrival: when its callback ran, ``time.monotonic()`` s (one clock for
+            every process on the machine).
+        size: the message's data, bytes.
     """
 
     pixels: np.ndarray
@@ -40,14 +50,38 @@ class ReceivedImage:
     frame_id: str
     encoding: str
     number: int
+    arrival: float = 0.0
+    size: int = 0
+
+
+def transport_topic(topic: str, transport: str) -> str:
+    """The topic a transport is published on: ``topic`` for raw, ``topic/compressed`` for compressed.
+
+    A topic that already ends in ``/compressed`` is taken as it is.
+
+    Raises:
+        ValueError: an unknown transport.
+    """
+    if transport not in TRANSPORTS:
+        raise ValueError(f"transport {transport!r}: use one of {', '.join(TRANSPORTS)}")
+    if transport == "raw" or topic.endswith("/compressed"):
+        return topic
+    return topic.rstrip("/") + "/compressed"
 
 
 class ImageReceiver:
-    """Subscribes an Image topic and keeps the newest valid picture.
+    """Subscribes a camera topic and keeps the newest valid picture.
 
     Args:
         node: the ``rclpy`` node; its callbacks must be spun by the caller.
         topic: e.g. ``/Tank/camera/image``.
+        transport: ``raw`` (an Image topic) or ``compressed`` (a
+            CompressedImage topic: ``topic/compressed``, or ``topic`` itself
+            when it ends in ``/compressed``).  A topic ending in
+            ``/compressed`` is compressed whatever is given.
+
+    Raises:
+        ValueError: an unknown transport.
 
     The subscription callback (spin thread) converts and checks each message
     and swaps the newest picture in under a lock; :meth:`newest` and
@@ -56,21 +90,32 @@ class ImageReceiver:
     with its reason, and the newest picture stays what it was.
     """
 
-    def __init__(self, node, topic: str = DEFAULT_TOPIC):
-        from sensor_msgs.msg import Image
+    def __init__(self, node, topic: str = DEFAULT_TOPIC, transport: str = "raw"):
+        from sensor_msgs.msg import CompressedImage, Image
 
-        self.topic = topic
+        if topic.endswith("/compressed"):
+            transport = "compressed"
+        self.transport = transport
+        self.topic = transport_topic(topic, transport)
         self._lock = threading.Lock()
         self._newest: ReceivedImage | None = None
         self._accepted = 0
         self._rejected = 0
         self._last_error: str | None = None
-        self.subscription = node.create_subscription(Image, topic, self.on_image, camera_image_qos())
+        if transport == "raw":
+            self._convert, self._describe = image_to_array, lambda msg: str(msg.encoding)
+            self.subscription = node.create_subscription(Image, self.topic, self.on_image, camera_image_qos())
+        else:
+            self._convert, self._describe = compressed_to_array, lambda msg: str(msg.format)
+            self.subscription = node.create_subscription(
+                CompressedImage, self.topic, self.on_image, compressed_image_qos()
+            )
 
     def on_image(self, msg) -> None:
         """Subscription callback (spin thread): check, convert, keep the newest."""
+        arrival = time.monotonic()
         try:
-            pixels = image_to_array(msg)
+            pixels = self._convert(msg)
         except ImageError as exc:
             with self._lock:
                 self._rejected += 1
@@ -79,7 +124,15 @@ class ImageReceiver:
         stamp = stamp_seconds(msg.header.stamp)
         with self._lock:
             self._accepted += 1
-            self._newest = ReceivedImage(pixels, stamp, str(msg.header.frame_id), str(msg.encoding), self._accepted)
+            self._newest = ReceivedImage(
+                pixels,
+                stamp,
+                str(msg.header.frame_id),
+                self._describe(msg)[:80],
+                self._accepted,
+                arrival,
+                len(msg.data),
+            )
 
     def newest(self) -> ReceivedImage | None:
         """The newest accepted picture, or None before the first (any thread)."""
@@ -139,8 +192,9 @@ def format_image_status(received: dict, rate: float, newest: ReceivedImage | Non
     if newest is None:
         return f"{rate:.1f} img/s, no picture yet, rejected: {reject_text}"
     h, w, _ = newest.pixels.shape
+    size = f" ({newest.size / 1000:.1f} kB)" if "compressed" in newest.encoding else ""
     return (
-        f"{rate:.1f} img/s, {w}x{h} {newest.encoding} frame {newest.frame_id or '(none)'}, "
+        f"{rate:.1f} img/s, {w}x{h} {newest.encoding}{size} frame {newest.frame_id or '(none)'}, "
         f"newest stamp {newest.stamp:.3f} s, {received['accepted']} accepted, rejected: {reject_text}"
     )
 
