@@ -51,7 +51,8 @@ def _qos(depth: int):
 
 
 def _wait_for(path: Path, timeout: float, busy: bool) -> None:
-    """Wait (at most ``timeout`` s) until ``path`` exists; with ``busy``, hold the interpreter lock in chunks meanwhile."""
+    """Wait (at most ``timeout`` s) until ``path`` exists; with ``busy``, hold the interpreter lock in chunks
+    meanwhile."""
     end = time.monotonic() + timeout
     while time.monotonic() < end and not path.exists():
         if busy:

@@ -123,7 +123,7 @@ def finish(proc: subprocess.Popen, timeout: float) -> str:
     except subprocess.TimeoutExpired:
         proc.kill()
         out, err = proc.communicate()
-        raise RuntimeError(f"{proc.args} did not finish:\n{out}\n{err}")
+        raise RuntimeError(f"{proc.args} did not finish:\n{out}\n{err}") from None
     if proc.returncode != 0:
         raise RuntimeError(f"{proc.args} exited {proc.returncode}:\n{out}\n{err}")
     return out
@@ -309,7 +309,7 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
                     assert controller.configure(config)
                     attachments.append(Attachment(c.name, controller, m.name))
 
-            def pipeline() -> float:
+            def pipeline(attachments=attachments) -> float:
                 data = mujoco.MjData(model)
                 sim = Simulator(
                     model, data, attachments, node=node, realtime_sync=False, duration=steps * model.opt.timestep
@@ -828,14 +828,16 @@ def print_report(r: dict) -> None:
     rt = r["realtime"]
     print(
         f"  real-time mode (tank, all controllers): real-time factor {rt['real_time_factor']}, "
-        f"step overrun p50 {rt['overrun_ms']['p50']} ms, p99 {rt['overrun_ms']['p99']} ms, max {rt['overrun_ms']['max']} ms"
+        f"step overrun p50 {rt['overrun_ms']['p50']} ms, p99 {rt['overrun_ms']['p99']} ms, "
+        f"max {rt['overrun_ms']['max']} ms"
     )
     print(
         f"\n== end-to-end latency across processes (ms): step -> applied on the viewer's main thread; bare pair: "
         f"publish -> callback ({r['rounds']} interleaved rounds of {r['seconds_per_run']:g} s each, samples pooled)"
     )
     print(
-        f"  {'run':14s} {'p50':>7s} {'p90':>7s} {'p99':>7s} {'max':>8s}   {'bare p50':>8s} {'bare p99':>8s}  ratio p50/p99"
+        f"  {'run':14s} {'p50':>7s} {'p90':>7s} {'p99':>7s} {'max':>8s}   "
+        f"{'bare p50':>8s} {'bare p99':>8s}  ratio p50/p99"
     )
     for key, run in r["pipeline"].items():
         bare = r["bare"][key]["latency_ms"]
@@ -848,7 +850,8 @@ def print_report(r: dict) -> None:
         lat = bare["latency_ms"]
         print(
             f"  (not a target: {key} bare pair with its subscriber on the EventsExecutor: p50 {lat['p50']:.3f}, "
-            f"p99 {lat['p99']:.3f}; the tutorial's p50/p99 are {r['pipeline'][key]['latency_ms']['p50'] / lat['p50']:.2f}x"
+            f"p99 {lat['p99']:.3f}; the tutorial's p50/p99 are "
+            f"{r['pipeline'][key]['latency_ms']['p50'] / lat['p50']:.2f}x"
             f" / {r['pipeline'][key]['latency_ms']['p99'] / lat['p99']:.2f}x these)"
         )
     for key, run in r.get("pipeline_events_executor", {}).items():
@@ -868,8 +871,10 @@ def print_report(r: dict) -> None:
     for key, run in r["pipeline"].items():
         m = run["messages"]
         print(
-            f"  {key:14s} displayed age p50 {run['displayed_age_ms']['p50']:.2f} ms, p99 {run['displayed_age_ms']['p99']:.2f} ms "
-            f"(first half {run['displayed_age_p99_ms_first_half']}, second half {run['displayed_age_p99_ms_second_half']}); "
+            f"  {key:14s} displayed age p50 {run['displayed_age_ms']['p50']:.2f} ms, "
+            f"p99 {run['displayed_age_ms']['p99']:.2f} ms "
+            f"(first half {run['displayed_age_p99_ms_first_half']}, "
+            f"second half {run['displayed_age_p99_ms_second_half']}); "
             f"{run['frames_per_s']} frames/s; scene update p50 {run['scene_update_ms']['p50']:.3f} ms, "
             f"p99 {run['scene_update_ms']['p99']:.3f} ms; messages applied {m['applied']}, coalesced {m['coalesced']}, "
             f"max pending {m['max_pending']}, spin thread stepped aside {m['yields']} times "
@@ -877,21 +882,25 @@ def print_report(r: dict) -> None:
             f"{run['cpu_cores']['viewer']}, total {run['cpu_cores']['total']} (bare pair {r['bare'][key]['cpu_cores']})"
         )
     print(
-        "\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, same server, interleaved"
+        "\n== meshcat cost per frame (ms): pipelined transforms vs meshcat's round trip per body, "
+        "same server, interleaved"
     )
     for name, u in r["scene_update"].items():
         print(
-            f"  {name:6s} {u['transforms']} transforms: pipelined p50 {u['pipelined']['p50']:.3f} p99 {u['pipelined']['p99']:.3f}; "
+            f"  {name:6s} {u['transforms']} transforms: pipelined p50 {u['pipelined']['p50']:.3f} "
+            f"p99 {u['pipelined']['p99']:.3f}; "
             f"round trip per body p50 {u['round_trip_per_body']['p50']:.3f} p99 {u['round_trip_per_body']['p99']:.3f} "
             f"({u['speedup_p50']}x)"
         )
     print(
-        f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, median {r['startup']['median_s']} s"
+        f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, "
+        f"median {r['startup']['median_s']} s"
     )
     scale = r.get("scale")
     if scale:
         print(
-            f"\n== scale ({scale['rate_hz']:g} Hz publishers, {scale['rounds']} rounds of {scale['seconds_per_run']:g} s, "
+            f"\n== scale ({scale['rate_hz']:g} Hz publishers, {scale['rounds']} rounds of "
+            f"{scale['seconds_per_run']:g} s, "
             "pooled): simulation speed vs bare mj_step (as fast as possible) and real-time factor (lowest run); "
             "the viewer; displayed-state age at first display p99; CPU cores"
         )
@@ -900,10 +909,13 @@ def print_report(r: dict) -> None:
                 sp, cpu = s["simulation_speed"], s["cpu_cores"]
                 parts = ", ".join(f"{k} {v:.2f}" for k, v in cpu.items())
                 print(
-                    f"  {n:>2s} {label:6s}: {sp['publisher_50Hz_ratio']:.3f}x bare ({sp['publisher_50Hz_steps_per_s']:,}"
-                    f" vs {sp['bare_steps_per_s']:,} steps/s), RTF {s['real_time_factor']}; {s['frames_per_s']} frames/s,"
+                    f"  {n:>2s} {label:6s}: {sp['publisher_50Hz_ratio']:.3f}x bare "
+                    f"({sp['publisher_50Hz_steps_per_s']:,}"
+                    f" vs {sp['bare_steps_per_s']:,} steps/s), RTF {s['real_time_factor']}; "
+                    f"{s['frames_per_s']} frames/s,"
                     f" scene update p50 {s['scene_update_ms']['p50']:.2f} p99 {s['scene_update_ms']['p99']:.2f} ms; "
-                    f"age p99 {s['first_shown_age_ms']['p99']:.2f} ms (every frame: {s['displayed_age_ms']['p99']:.2f});"
+                    f"age p99 {s['first_shown_age_ms']['p99']:.2f} ms "
+                    f"(every frame: {s['displayed_age_ms']['p99']:.2f});"
                     f" CPU {parts}"
                 )
     print("\n== targets")
