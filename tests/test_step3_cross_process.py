@@ -55,8 +55,43 @@ def test_viewer_ends_on_the_simulations_final_state(procs):
     assert counts["rejected"] == {}
     assert counts["received"] > 100  # 50 Hz for most of 6 s
     assert (
-        sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 300 + 1
-    )  # 50 Hz over 6 s (steps 0, 20, ..., 5980), and the final state
+        sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 1 + 299 + 1
+    )  # the start state, 50 Hz over 6 s (steps 20, ..., 5980), and the final state
+
+
+JOIN_DEADLINE = 3.0  # s from a monitor's start to the posture shown, for a publisher at 0.1 Hz (issue 26)
+
+
+def test_a_monitor_joining_a_slow_publisher_shows_the_posture_at_once(procs, node):
+    """A simulation publishing at 0.1 Hz: a monitor started between two states shows the one its publisher
+    kept (the start state) within 3 s, and its status line says so; before issue 26 it said "no state yet"
+    until the next state, up to 10 s later (6.9 s measured)."""
+    import json
+    import time
+
+    sim = procs(
+        module_command(
+            "tutorial.tools.rtt_run",
+            "project/step2.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-p",
+            "RttJointStatePublisher.rate:=0.1",
+        )
+    )
+    assert wait_until(lambda: node.count_publishers("/Tank/joint_state") >= 1, timeout=60), sim.err
+    started = time.monotonic()
+    view = viewer(procs)
+    late = json.loads(view.wait_for_line(lambda line: '"event": "late_state"' in line, timeout=30))
+    shown_after = time.monotonic() - started
+    is_status = lambda line: '"event": "status"' in line  # noqa: E731
+    status = json.loads(view.wait_for_count(is_status, view.count(is_status) + 1, timeout=5))  # the next one
+    print(f"the monitor showed the posture {shown_after:.2f} s after it started: {late['message']}")
+    assert late["stamp"] == 0.0 and late["matched"] == 2  # the state the simulation started in
+    assert status["matched"] == 2 and status["age_ms"] is not None  # the status line shows it too
+    assert not view.records("first_state")  # no live state yet: the next is 10 s of simulated time away
+    assert shown_after <= JOIN_DEADLINE
 
 
 HOSTILE = [

@@ -21,9 +21,9 @@ get from it is every *chunk* that reached the file (``rtt-bag info`` and
 ``play`` read them, ``rtt-bag recover`` writes a closed copy).  So the
 policy is about chunks:
 
-* a chunk is closed when it holds :data:`CHUNK_SIZE` bytes **or** when its
-  oldest message is :data:`CHUNK_PERIOD` (0.5 s) old, whichever comes
-  first.  The age is checked at every message and, for a topic that went
+* a chunk is closed when its messages reach :data:`CHUNK_SIZE` bytes **or**
+  when its oldest message is :data:`CHUNK_PERIOD` (0.5 s) old, whichever
+  comes first, and either way it is written through.  The age is checked at every message and, for a topic that went
   quiet, by :meth:`BagWriter.write_through_due`, which the recorder calls
   every :data:`WRITE_THROUGH_CHECK` (0.1 s); so a message is in the file at
   most about 0.6 s after it arrived: a crash loses less than 1 s;
@@ -63,7 +63,9 @@ from tutorial.bag.qos import QosFormatError, parse_profiles
 
 BAG_FORMAT_VERSION = 9  # rosbag2's metadata version in Jazzy
 COMPRESSIONS = ("zstd", "lz4", "none")
-CHUNK_SIZE = 1024 * 1024  # bytes: a chunk is closed at this size (the mcap library's default) ...
+CHUNK_SIZE = 1024 * 1024  # bytes of messages: a chunk is closed at this size (the mcap library's default) ...
+_MESSAGE_RECORD = 31  # bytes of a message record besides its data: opcode, length, channel, sequence, two times
+_NEVER = 2**62  # the mcap writer's own size limit when this writer closes chunks itself
 CHUNK_PERIOD = 0.5  # s: ... or when its oldest message is this old (see the module's docstring)
 WRITE_THROUGH_CHECK = 0.1  # s: how often a recorder calls write_through_due()
 
@@ -174,7 +176,9 @@ class BagWriter:
         except ValueError as exc:  # a NUL byte in the name
             raise BagWriteError(f"cannot create {self.path!r}: {exc}") from None
         kind = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4, "none": CompressionType.NONE}[compression]
-        self._writer = Writer(self._stream, chunk_size=CHUNK_SIZE, compression=kind)
+        # With write-through this writer closes each chunk itself (by size or age), so every chunk is
+        # flushed and fsync'ed; without it, the mcap writer closes chunks at CHUNK_SIZE, as before.
+        self._writer = Writer(self._stream, chunk_size=_NEVER if write_through else CHUNK_SIZE, compression=kind)
         self.write_through = write_through
         self._clock = clock
         self._lock = threading.Lock()
@@ -182,6 +186,7 @@ class BagWriter:
         self._topics: dict[str, _Topic] = {}
         self._stats = WriteStats(self.path)
         self._oldest_pending: float | None = None  # clock() when the open chunk got its first message
+        self._pending_bytes = 0  # bytes of the open chunk's messages
         self.closed = False
         self.error: BagWriteError | None = None
         try:
@@ -274,9 +279,10 @@ class BagWriter:
             stats.last_ns = log_time if stats.last_ns is None else max(stats.last_ns, log_time)
             if self.write_through:
                 now = self._clock()
+                self._pending_bytes += len(data) + _MESSAGE_RECORD
                 if self._oldest_pending is None:
                     self._oldest_pending = now
-                elif now - self._oldest_pending >= CHUNK_PERIOD:
+                if self._pending_bytes >= CHUNK_SIZE or now - self._oldest_pending >= CHUNK_PERIOD:
                     self._write_through()
             return True
 
@@ -302,6 +308,7 @@ class BagWriter:
             self._fail(exc)
             return False
         self._oldest_pending = None
+        self._pending_bytes = 0
         self._stats.written_through = self._stats.messages
         self._stats.write_throughs += 1
         return True
