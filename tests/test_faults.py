@@ -459,9 +459,10 @@ def test_recorder_stops_with_one_line_when_the_disk_is_full_and_its_file_stays_r
     import random
 
     from sensor_msgs.msg import JointState
-    from test_bag import recovered_by_stock_readers
 
     from tutorial.bag.info import bag_info
+
+    from test_bag import recovered_by_stock_readers
 
     if fault == "disk-full":
         path = request.getfixturevalue("small_disk") / "full.mcap"

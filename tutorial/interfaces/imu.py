@@ -131,7 +131,9 @@ def check_imu(msg, frame_id: str):
     gyro = np.array([w.x, w.y, w.z], dtype=float)
     if not (np.isfinite(accel).all() and np.isfinite(gyro).all()):
         return None, None, "not_finite"
-    if np.linalg.norm(accel) > ACCEL_LIMIT or np.linalg.norm(gyro) > GYRO_LIMIT:
+    with np.errstate(over="ignore"):  # a norm past 1.8e308 is inf, absurd: no warning printed for it
+        absurd = np.linalg.norm(accel) > ACCEL_LIMIT or np.linalg.norm(gyro) > GYRO_LIMIT
+    if absurd:
         return None, None, "absurd"
     if msg.header.frame_id not in ("", frame_id):
         return None, None, "wrong_frame"
