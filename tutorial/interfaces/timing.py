@@ -47,7 +47,8 @@ class PeriodAccumulator:
         self.step_ns = max(1, round(time_step * 1e9))
         rate_ns = self.step_ns if rate <= 0 else round(1e9 / rate)
         self.period_ns = max(self.step_ns, rate_ns)
-        self.elapsed_ns = self.period_ns if first_due else 0  # due at once, or one period from now
+        # due at once, or (first_due False) one period from now
+        self.elapsed_ns = self.period_ns if first_due else 0
 
     def tick(self) -> bool:
         """One step has passed: True when an output is due now."""
