@@ -351,3 +351,13 @@ def test_rtt_run_command_lines_end_in_a_status(tmp_path_factory, monkeypatch, ar
     monkeypatch.chdir(tmp_path_factory.mktemp("cwd"))
     args = [a for a in args if a not in ("/dev/zero", ".")] + ["missing.yaml"]
     assert exit_status(rtt_run.main, ["rtt-run", *args]) in (0, 2)
+
+
+def test_found_by_fuzzing_a_name_that_is_not_utf8_gives_one_line(tmp_path):
+    """``make fuzz`` found it: MuJoCo loads a name with a byte that is not UTF-8, and Python then fails to
+    read the name back (a UnicodeDecodeError traceback from rtt-run)."""
+    path = tmp_path / "m.xml"
+    path.write_bytes((MODEL / "tank.xml").read_bytes().replace(b'name="TURRET_P"', b'name="\x80TURRET_P"', 1))
+    with pytest.raises(ModelError, match=r"not UTF-8 text \(byte \d+\)") as info:
+        build_world([ModelEntry("M", path)])
+    assert one_line(info.value) and str(info.value).startswith(str(path))

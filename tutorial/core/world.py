@@ -141,10 +141,19 @@ def build_world(
 def _load(entry: ModelEntry) -> mujoco.MjSpec:
     """The model file parsed, its unnamed elements named; :class:`ModelError` if MuJoCo cannot read it."""
     try:
+        # MJCF is XML in UTF-8; a name in another encoding would load, then fail where Python reads it.
+        Path(entry.file).read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ModelError(
+            f"{entry.file}: not UTF-8 text (byte {exc.start}): an MJCF file is XML in UTF-8", entry
+        ) from None
+    except (OSError, ValueError) as exc:
+        raise ModelError(f"{entry.file}: cannot read it: {_reason(exc)}", entry) from None
+    try:
         child = mujoco.MjSpec.from_file(str(entry.file))
+        name_unnamed_elements(child)
     except Exception as exc:  # noqa: BLE001 - mujoco raises ValueError with the parser's text
         raise ModelError(f"{entry.file}: not a model MuJoCo can load: {_reason(exc)}", entry) from None
-    name_unnamed_elements(child)
     return child
 
 
