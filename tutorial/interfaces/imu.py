@@ -131,7 +131,8 @@ def check_imu(msg, frame_id: str):
     gyro = np.array([w.x, w.y, w.z], dtype=float)
     if not (np.isfinite(accel).all() and np.isfinite(gyro).all()):
         return None, None, "not_finite"
-    with np.errstate(over="ignore"):  # a norm past 1.8e308 is inf, absurd: no warning printed for it
+    # A norm past 1.8e308 overflows to inf, which is absurd: no numpy warning for it.
+    with np.errstate(over="ignore"):
         absurd = np.linalg.norm(accel) > ACCEL_LIMIT or np.linalg.norm(gyro) > GYRO_LIMIT
     if absurd:
         return None, None, "absurd"
