@@ -5,6 +5,7 @@
 # More: make test-fast (the unit tier, under a minute: the inner loop), make lint (ruff check and format),
 #       make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test),
+#       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make export (write the controllers from the notebooks that build them),
 #       make run-notebooks (run every notebook and save its outputs, the ones nbval checks).
 
@@ -12,7 +13,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast lint notebooks book bench export run-notebooks venv clean
+.PHONY: demo test test-fast fuzz lint notebooks book bench export run-notebooks venv clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -33,6 +34,12 @@ test: $(VENV)/.installed lint
 # The unit tier only: no ROS, no process, no browser.
 test-fast: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m unit -q
+
+# The property-based tests (hypothesis) of tests/test_fuzz_*.py at length: random examples, 100 times as
+# many as make test's fixed set (RTT_FUZZ_FACTOR=N changes that); failures are kept in .hypothesis/ and
+# tried first next time (tests/fuzzing.py).
+fuzz: $(VENV)/.installed
+	RTT_FUZZ=1 RTT_TEST_MODE=1 $(PY) -m pytest tests/test_fuzz_files.py tests/test_fuzz_messages.py -q
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .

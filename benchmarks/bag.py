@@ -1,23 +1,29 @@
-"""Does ``rtt-bag record`` keep up at 1 kHz?  (Not part of ``make test`` or ``make bench``.)
+"""Does ``rtt-bag record`` keep up at 1 kHz, and what does its write-through cost?  (Not part of ``make test``.)
 
-    python -m benchmarks.bag                      # 1000 Hz for 60 s
-    python -m benchmarks.bag --seconds 10 --compression none
+    python -m benchmarks.bag                      # 1000 Hz for 10 s
+    python -m benchmarks.bag --seconds 60 --compression none
 
 One publisher process sends numbered ``sensor_msgs/JointState`` messages
 (2 joints, as the tank's) at ``--rate`` Hz for ``--seconds`` s, reliable,
-keep last 1000, so the publisher itself drops nothing.  Two processes read
-the same stream at the same time:
+keep last 1000, so the publisher itself drops nothing.  Three processes
+read the same stream at the same time:
 
-* the baseline: a bare raw subscriber that only counts, with the QoS the
-  recorder requests and on the same executor (``SpinThread``);
-* ``rtt-bag record`` writing the stream to an MCAP file.
+* a bare raw subscriber that only counts, with the QoS the recorder
+  requests and on the same executor (``SpinThread``);
+* the recorder with its write-through policy (:mod:`tutorial.bag.writer`:
+  a chunk closed at least every 0.5 s, flushed and fsync'ed): the
+  :class:`tutorial.bag.record.BagRecorder` that ``rtt-bag record`` runs;
+* the same recorder without write-through (``write_through=False``: 1 MiB
+  chunks, no flush, no fsync, the policy before issue 26): the baseline.
 
-It prints messages sent, received and written, how many numbers are
-missing from the file, the file size, and each reader's CPU time over the
-sending window (user + system, from ``psutil``), with the recorder's ratio
-to the baseline.  The publisher starts when it counts both subscribers,
-plus 2 s for their own sides to match it.  Traffic stays on this machine
-(localhost discovery, a ROS_DOMAIN_ID of its own).
+It prints, for each, messages received and written, how many numbers are
+missing from the file, and CPU time over the sending window (user +
+system, from ``psutil``); then the write-through's cost: its CPU against
+the baseline's (measured, baseline, ratio), how many chunks were written
+through and how long the fsyncs took.  The publisher starts when it counts
+the three subscribers, plus 2 s for their own sides to match it.  Traffic
+stays on this machine (localhost discovery, a ROS_DOMAIN_ID of its own).
+Figures on a busy machine are noisy: rerun on a quiet one for the record.
 """
 
 from __future__ import annotations
@@ -120,6 +126,43 @@ def count() -> int:
     return 0
 
 
+def record(path: str, compression: str, write_through: bool) -> int:
+    """A recorder (``BagRecorder``, as ``rtt-bag record`` runs it) until SIGINT; print its stats as one JSON line."""
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    from tutorial.bag.record import BagRecorder
+    from tutorial.ros import env as ros_env
+
+    stop = []
+    signal.signal(signal.SIGINT, lambda *a: stop.append(1))
+    ros_env.use_localhost_by_default()
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    recorder = BagRecorder(
+        path, [TOPIC], compression=compression, overwrite=True, output=None, write_through=write_through
+    ).start()
+    print(json.dumps({"event": "ready"}), flush=True)
+    while not stop and not recorder.failure:
+        time.sleep(0.05)
+    stats = recorder.close()
+    print(
+        json.dumps(
+            {
+                "event": "done",
+                "received": sum(recorder.received.values()),
+                "written": stats.messages,
+                "write_throughs": stats.write_throughs,
+                "sync_s": stats.sync_s,
+                "max_sync_s": stats.max_sync_s,
+                "failure": recorder.failure,
+            }
+        ),
+        flush=True,
+    )
+    rclpy.try_shutdown()
+    return 0
+
+
 # ---------------------------------------------------------------- the run
 def cpu_seconds(pid: int) -> float:
     import psutil
@@ -146,45 +189,49 @@ def wait_line(proc: subprocess.Popen, predicate, timeout: float) -> str:
 
 def run(rate: float, seconds: float, compression: str, keep: str | None) -> dict:
     folder = Path(tempfile.mkdtemp(prefix="rtt_bench_bag_"))
-    bag = Path(keep) if keep else folder / "bench.mcap"
+    bags = {"write_through": folder / "write_through.mcap", "baseline": folder / "baseline.mcap"}
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     popen = dict(cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     counter = subprocess.Popen(py("benchmarks.bag", "count"), **popen)
-    recorder = subprocess.Popen(
-        py("tutorial.bag", "record", TOPIC, "-o", str(bag), "--compression", compression, "--overwrite"), **popen
-    )
-    procs = [counter, recorder]
+    recorders = {
+        name: subprocess.Popen(
+            py("benchmarks.bag", "record", str(path), "--compression", compression, "--write-through", name), **popen
+        )
+        for name, path in bags.items()
+    }
+    readers = [counter, *recorders.values()]
+    procs = list(readers)
     try:
-        wait_line(counter, lambda line: '"ready"' in line, 60)
-        wait_line(recorder, lambda line: "recording" in line, 60)
+        for proc in readers:
+            wait_line(proc, lambda line: '"ready"' in line, 60)
         publisher = subprocess.Popen(
-            py("benchmarks.bag", "pub", "--rate", str(rate), "--seconds", str(seconds)), **popen
+            py("benchmarks.bag", "pub", "--rate", str(rate), "--seconds", str(seconds), "--subscribers", "3"), **popen
         )
         procs.append(publisher)
         wait_line(publisher, lambda line: '"start"' in line, 90)
-        cpu0 = {p.pid: cpu_seconds(p.pid) for p in (counter, recorder)}
+        cpu0 = {p.pid: cpu_seconds(p.pid) for p in readers}
         t0 = time.monotonic()
         done = json.loads(wait_line(publisher, lambda line: '"done"' in line, seconds * 3 + 60))
         time.sleep(1.0)  # what was still queued is taken (the readers' idle polling costs ~nothing)
         wall = time.monotonic() - t0
-        cpu = {p.pid: cpu_seconds(p.pid) - cpu0[p.pid] for p in (counter, recorder)}
-        for p in (counter, recorder):
+        cpu = {p.pid: cpu_seconds(p.pid) - cpu0[p.pid] for p in readers}
+        for p in readers:
             p.send_signal(signal.SIGINT)
-        base_out, _ = counter.communicate(timeout=30)
-        rec_out, rec_err = recorder.communicate(timeout=30)
+        outs = {p.pid: p.communicate(timeout=30) for p in readers}
         publisher.communicate(timeout=30)
     finally:
         for p in procs:
             if p.poll() is None:
                 p.kill()
                 p.wait()
-    baseline = json.loads([line for line in base_out.splitlines() if '"done"' in line][-1])
-    wrote = [line for line in rec_out.splitlines() if "] wrote " in line]
-    if recorder.returncode != 0 or not wrote:
-        raise RuntimeError(f"recorder exited {recorder.returncode}:\n{rec_out}\n{rec_err}")
-    written = int(wrote[-1].split("] wrote ")[1].split()[0])
-    received = int(wrote[-1].split(" of ")[1].split()[0])
-    numbers = file_numbers(bag)
+
+    def last_done(proc) -> dict:
+        out, err = outs[proc.pid]
+        lines = [line for line in out.splitlines() if '"done"' in line]
+        if proc.returncode != 0 or not lines:
+            raise RuntimeError(f"{proc.args} exited {proc.returncode}:\n{out}\n{err}")
+        return json.loads(lines[-1])
+
     sent = done["sent"]
     result = {
         "rate_hz": rate,
@@ -193,22 +240,27 @@ def run(rate: float, seconds: float, compression: str, keep: str | None) -> dict
         "sent": sent,
         "send_seconds": round(done["seconds"], 3),
         "acked": done["acked"],
-        "baseline": {"received": baseline["received"], "cpu_s": round(cpu[counter.pid], 3)},
-        "recorder": {
-            "received": received,
-            "written": written,
+        "bare": {"received": last_done(counter)["received"], "cpu_s": round(cpu[counter.pid], 3)},
+        "window_s": round(wall, 3),
+    }
+    for name, proc in recorders.items():
+        stats = last_done(proc)
+        numbers = file_numbers(bags[name])
+        result[name] = {
+            **stats,
             "in_file": len(numbers),
             "missing_from_file": sent - len(set(numbers) & set(range(sent))),
             "in_order": numbers == sorted(numbers),
-            "cpu_s": round(cpu[recorder.pid], 3),
-        },
-        "window_s": round(wall, 3),
-        "file_bytes": bag.stat().st_size,
-    }
-    result["cpu_ratio"] = round(cpu[recorder.pid] / cpu[counter.pid], 2) if cpu[counter.pid] > 0 else None
-    if not keep:
-        bag.unlink()
-        folder.rmdir()
+            "cpu_s": round(cpu[proc.pid], 3),
+            "file_bytes": bags[name].stat().st_size,
+        }
+    base_cpu = result["baseline"]["cpu_s"]
+    result["cpu_ratio"] = round(result["write_through"]["cpu_s"] / base_cpu, 2) if base_cpu > 0 else None
+    if keep:
+        bags["write_through"].replace(keep)
+    for path in bags.values():
+        path.unlink(missing_ok=True)
+    folder.rmdir()
     return result
 
 
@@ -221,28 +273,46 @@ def file_numbers(path: Path) -> list[int]:
 
 def report(r: dict) -> None:
     w = r["window_s"]
-    b, rec = r["baseline"], r["recorder"]
     print(
         f"\nrtt-bag record at {r['rate_hz']:.0f} Hz for {r['seconds']:.0f} s: sensor_msgs/JointState, 2 joints, "
         f"reliable, keep last {DEPTH}; chunk compression {r['compression']}"
     )
     print(f"sent {r['sent']} messages in {r['send_seconds']:.1f} s (all acknowledged: {r['acked']})")
-    print(f"{'':24}{'received':>10}{'written':>10}{'missing':>9}{'CPU s':>8}{'CPU %':>7}{'us/msg':>8}")
-    for name, x, written, missing in (
-        ("bare raw subscriber", b, "-", r["sent"] - b["received"]),
-        ("rtt-bag record", rec, rec["written"], rec["missing_from_file"]),
-    ):
+    print(f"{'':34}{'received':>10}{'written':>10}{'missing':>9}{'CPU s':>8}{'CPU %':>7}{'us/msg':>8}{'chunks':>8}")
+    rows = (
+        ("bare raw subscriber", r["bare"], "-", r["sent"] - r["bare"]["received"], "-"),
+        ("recorder, write-through (rtt-bag)", r["write_through"], None, None, None),
+        ("recorder, no write-through (old)", r["baseline"], None, None, None),
+    )
+    for name, x, written, missing, chunks in rows:
+        written = x["written"] if written is None else written
+        missing = x["missing_from_file"] if missing is None else missing
+        chunks = x.get("write_throughs", "-") if chunks is None else chunks
+        if name.startswith("recorder, no"):
+            chunks = "1 MiB"
         per = x["cpu_s"] / max(1, x["received"]) * 1e6
         print(
-            f"{name:<24}{x['received']:>10}{written!s:>10}{missing:>9}{x['cpu_s']:>8.2f}"
-            f"{100 * x['cpu_s'] / w:>6.1f}%{per:>8.1f}"
+            f"{name:<34}{x['received']:>10}{written!s:>10}{missing:>9}{x['cpu_s']:>8.2f}"
+            f"{100 * x['cpu_s'] / w:>6.1f}%{per:>8.1f}{chunks!s:>8}"
         )
-    print(f"recorder / baseline CPU: {r['cpu_ratio']}  (CPU over the {w:.1f} s window: sending, then 1 s for the tail)")
-    size = r["file_bytes"]
+    wt, base = r["write_through"], r["baseline"]
+    syncs = max(1, wt["write_throughs"])
     print(
-        f"file: {size / 2**20:.2f} MiB, {size / max(1, rec['written']):.1f} bytes per message; "
-        f"{rec['in_file']} messages in the file, in order: {rec['in_order']}"
+        f"write-through cost, recorder CPU: measured {wt['cpu_s']:.2f} s, baseline {base['cpu_s']:.2f} s, "
+        f"ratio {r['cpu_ratio']}  (over the {w:.1f} s window: sending, then 1 s for the tail)"
     )
+    print(
+        f"write-through: {wt['write_throughs']} chunks flushed and fsync'ed "
+        f"({wt['write_throughs'] / r['send_seconds']:.1f} per s of sending); "
+        f"fsync {1000 * wt['sync_s'] / syncs:.2f} ms each on average, {1000 * wt['max_sync_s']:.2f} ms at most, "
+        f"{1000 * wt['sync_s']:.0f} ms in all"
+    )
+    for name, x in (("write-through", wt), ("baseline", base)):
+        size = x["file_bytes"]
+        print(
+            f"file ({name}): {size / 2**20:.2f} MiB, {size / max(1, x['written']):.1f} bytes per message; "
+            f"{x['in_file']} messages in the file, in order: {x['in_order']}"
+        )
 
 
 def main(argv=None) -> int:
@@ -250,27 +320,35 @@ def main(argv=None) -> int:
     sub = p.add_subparsers(dest="role")
     pub = sub.add_parser("pub")
     pub.add_argument("--rate", type=float, default=1000.0)
-    pub.add_argument("--seconds", type=float, default=60.0)
-    pub.add_argument("--subscribers", type=int, default=2)
+    pub.add_argument("--seconds", type=float, default=10.0)
+    pub.add_argument("--subscribers", type=int, default=3)
     sub.add_parser("count")
+    rec = sub.add_parser("record")
+    rec.add_argument("path")
+    rec.add_argument("--compression", default="zstd")
+    rec.add_argument("--write-through", choices=["write_through", "baseline"], default="write_through")
     p.add_argument("--rate", type=float, default=1000.0, help="messages per second (default 1000)")
-    p.add_argument("--seconds", type=float, default=60.0, help="how long to send (default 60)")
+    p.add_argument("--seconds", type=float, default=10.0, help="how long to send (default 10)")
     p.add_argument("--compression", choices=["zstd", "lz4", "none"], default="zstd")
-    p.add_argument("--keep", metavar="FILE.mcap", help="keep the recording here")
+    p.add_argument("--keep", metavar="FILE.mcap", help="keep the write-through recording here")
     p.add_argument("--json", action="store_true", help="also print the result as one JSON line")
     args = p.parse_args(argv)
     if args.role == "pub":
         return publish(args.rate, args.seconds, args.subscribers)
     if args.role == "count":
         return count()
+    if args.role == "record":
+        return record(args.path, args.compression, args.write_through == "write_through")
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
     result = run(args.rate, args.seconds, args.compression, args.keep)
     report(result)
     if args.json:
         print(json.dumps(result))
-    recorder = result["recorder"]
-    ok = recorder["written"] == recorder["received"] and recorder["missing_from_file"] == 0
+    ok = all(
+        result[name]["written"] == result[name]["received"] and result[name]["missing_from_file"] == 0
+        for name in ("write_through", "baseline")
+    )
     return 0 if ok else 1
 
 

@@ -10,7 +10,7 @@ import yaml
 from tutorial.bag import cli, definitions, qos
 from tutorial.bag.definitions import UnknownMessageType
 from tutorial.bag.info import bag_info, format_info
-from tutorial.bag.reader import check_file, iter_raw, joint_series
+from tutorial.bag.reader import BagError, check_file, iter_raw, joint_series
 from tutorial.bag.writer import BagWriter
 
 from conftest import ROOT, module_command, wait_until
@@ -358,14 +358,21 @@ def test_player_keeps_the_timing_and_honours_rate_offset_topics_and_loop(ros, no
 
 # ------------------------------------------------------------ bad files: one line, exit status 2
 def good_bag(path, type_name="sensor_msgs/msg/JointState", n=2000):
-    """A bag written without ROS: ``n`` JointState messages on /Tank/joint_state."""
+    """A bag written without ROS: ``n`` JointState messages on /Tank/joint_state, 1 ms apart.
+
+    The writer's clock runs 2**-10 s (about 1 ms) a message, exactly in binary, so its
+    write-through closes a chunk after every 512 of them, as a recorder's would:
+    2000 make 4 chunks (see :func:`chunk_ends`).
+    """
     from rclpy.serialization import serialize_message
     from sensor_msgs.msg import JointState
 
-    writer = BagWriter(path, compression="zstd")
+    now = [0.0]
+    writer = BagWriter(path, compression="zstd", clock=lambda: now[0])
     definition = definitions.full_text(type_name) if type_name.startswith("sensor_msgs") else ("ros2msg", "int32 x")
     writer.add_topic("/Tank/joint_state", type_name, definition, EXPECTED_OFFER)
     for i in range(n):
+        now[0] = i * 2**-10
         data = serialize_message(JointState(name=["TURRET_Y"], position=[i * 1e-3]))
         writer.write("/Tank/joint_state", 1_000_000_000 + i * 1_000_000, 1_000_000_000 + i * 1_000_000, data)
     writer.close()
@@ -374,56 +381,190 @@ def good_bag(path, type_name="sensor_msgs/msg/JointState", n=2000):
 
 def bad_bags(tmp_path) -> dict:
     data = good_bag(tmp_path / "good.mcap").read_bytes()
-    files = {"truncated": data[: len(data) // 2], "garbage": b"\x00not an mcap file at all" * 50, "empty": b""}
+    files = {"garbage": b"\x00not an mcap file at all" * 50, "empty": b"", "magic cut short": data[:5]}
     with open(tmp_path / "good.mcap", "rb") as f:
         from mcap.reader import make_reader
 
-        [chunk] = make_reader(f).get_summary().chunk_indexes
+        chunk = make_reader(f).get_summary().chunk_indexes[1]
     corrupt = bytearray(data)
     middle = chunk.chunk_start_offset + chunk.chunk_length // 2  # zstd data: no longer decompresses or matches its CRC
     corrupt[middle : middle + 64] = bytes(64)
     files["corrupt"] = bytes(corrupt)
     paths = {}
     for name, content in files.items():
-        paths[name] = tmp_path / f"{name}.mcap"
+        paths[name] = tmp_path / f"{name.replace(' ', '_')}.mcap"
         paths[name].write_bytes(content)
     paths["missing"] = tmp_path / "missing.mcap"
+    paths["a folder"] = tmp_path
     return paths
 
 
 REASONS = {
-    "truncated": "truncated MCAP file",
     "garbage": "not an MCAP file",
+    "magic cut short": "not an MCAP file",
     "empty": "empty",
     "corrupt": "corrupt MCAP file",
     "missing": "no such file",
+    "a folder": "not a file",
 }
 
 
-@pytest.mark.parametrize("command", ["info", "play"])
+@pytest.mark.parametrize("command", ["info", "play", "recover"])
 def test_a_bad_file_gives_one_clear_line_and_status_2(tmp_path, capsys, command):
     for name, path in bad_bags(tmp_path).items():
-        assert cli.main(["rtt-bag", command, str(path)]) == 2, name
+        if command == "recover" and name == "corrupt":
+            continue  # recover reads around a damaged chunk: below
+        extra = ["-o", str(tmp_path / "out.mcap")] if command == "recover" else []
+        assert cli.main(["rtt-bag", command, str(path), *extra]) == 2, name
         out, err = capsys.readouterr()
         assert out == "", (name, out)
         lines = err.splitlines()
         assert len(lines) == 1 and lines[0].startswith(f"rtt-bag: {command}: {path}: "), (name, err)
         assert REASONS[name] in lines[0], (name, err)
+        assert not (tmp_path / "out.mcap").exists()
 
 
 @pytest.mark.cross_process
 def test_a_bad_file_is_one_line_from_the_real_program_too(tmp_path):
     import subprocess
 
-    path = bad_bags(tmp_path)["truncated"]
+    path = bad_bags(tmp_path)["garbage"]
     done = subprocess.run(
         module_command("tutorial.bag", "info", str(path)), capture_output=True, text=True, timeout=60, cwd=ROOT
     )
     assert done.returncode == 2 and done.stdout == ""
-    assert done.stderr.splitlines() == [
-        f"rtt-bag: info: {path}: truncated MCAP file (no closing magic at its end): "
-        "the recording was not closed, or the copy is incomplete"
+    assert done.stderr.splitlines() == [f"rtt-bag: info: {path}: not an MCAP file (no MCAP magic at its start)"]
+
+
+# ------------------------------------------------------------ files that were not closed: read, not refused
+def cut(path, dest, fraction: float):
+    """A copy of the first ``fraction`` of ``path``'s bytes: what a killed recorder or a full disk leaves."""
+    data = path.read_bytes()
+    dest.write_bytes(data[: int(len(data) * fraction)])
+    return dest
+
+
+def chunk_ends(path) -> list[tuple[int, int]]:
+    """``(byte where the chunk ends, messages up to and including it)`` for each chunk of a closed good_bag file."""
+    from mcap.reader import make_reader
+
+    with open(path, "rb") as f:
+        chunks = sorted(make_reader(f).get_summary().chunk_indexes, key=lambda c: c.chunk_start_offset)
+    return [
+        (c.chunk_start_offset + c.chunk_length, (c.message_end_time - 1_000_000_000) // 1_000_000 + 1) for c in chunks
     ]
+
+
+def whole_chunk_messages(path, size: int, ends=None) -> int:
+    """How many messages the chunks that end within the first ``size`` bytes hold."""
+    return max([n for end, n in (ends or chunk_ends(path)) if end <= size], default=0)
+
+
+def test_write_through_closes_a_chunk_every_half_second_of_messages(tmp_path):
+    """good_bag's writer sees a message every 2**-10 s: a chunk is closed by the message 0.5 s after its first."""
+    path = good_bag(tmp_path / "good.mcap")
+    assert [n for _end, n in chunk_ends(path)] == [513, 1026, 1539, 2000]
+    assert BagWriter(tmp_path / "x.mcap").close().write_throughs == 0  # no message: no chunk
+
+
+def test_a_file_that_was_not_closed_is_read_to_its_last_whole_chunk(tmp_path, capsys):
+    good = good_bag(tmp_path / "good.mcap")
+    killed = cut(good, tmp_path / "killed.mcap", 2 / 3)  # the summary and the last chunks are gone
+    n = whole_chunk_messages(good, killed.stat().st_size)
+    assert n == 1539  # three whole chunks
+    info = bag_info(killed)
+    assert not info.closed and info.recovery.damaged_chunks == 0
+    assert info.count == info.recovery.messages == n
+    assert info.topic("/Tank/joint_state").span_s == pytest.approx((n - 1) * 1e-3)
+    assert "the file ends inside the record at byte" in info.recovery.stop
+    assert [m.log_time for m in iter_raw(killed)] == [1_000_000_000 + i * 1_000_000 for i in range(n)]
+    series = joint_series(killed)
+    assert series.positions["TURRET_Y"].tolist() == [i * 1e-3 for i in range(n)]
+    with pytest.raises(BagError, match="truncated MCAP file"):
+        check_file(killed)  # not whole: who needs a whole file is told
+
+    assert cli.main(["rtt-bag", "info", str(killed)]) == 0
+    out, err = capsys.readouterr()
+    assert err.splitlines() == [
+        f"rtt-bag: info: {killed}: not closed (the recording was cut short: killed, or the disk filled): "
+        f"{n} messages recovered from its complete records ({info.recovery.stop}); rtt-bag recover writes a closed copy"
+    ]
+    assert f"Messages:          {n}" in out and "Not closed:" in out
+    assert cli.main(["rtt-bag", "info", str(killed), "--json"]) == 0
+    reported = json.loads(capsys.readouterr().out)
+    assert reported["closed"] is False and reported["recovery"]["messages"] == n
+
+
+def test_a_file_cut_anywhere_gives_its_whole_chunks_never_an_error(tmp_path):
+    good = good_bag(tmp_path / "good.mcap", n=1200)
+    data, ends = good.read_bytes(), chunk_ends(good)
+    for size in range(9, len(data) - 8, len(data) // 60):  # 60 cuts, header to summary
+        (tmp_path / "cut.mcap").write_bytes(data[:size])
+        n = whole_chunk_messages(good, size, ends)
+        assert bag_info(tmp_path / "cut.mcap").count == n, size
+        assert [m.log_time for m in iter_raw(tmp_path / "cut.mcap")] == [
+            1_000_000_000 + i * 1_000_000 for i in range(n)
+        ], size
+
+
+def recovered_by_stock_readers(path) -> dict[str, int]:
+    """Messages per topic as ``mcap`` (its summary and its messages) and ``rosbags`` read ``path``; all must agree."""
+    from mcap.reader import make_reader
+    from rosbags.highlevel import AnyReader
+
+    with open(path, "rb") as f:
+        reader = make_reader(f, validate_crcs=True)
+        summary = reader.get_summary()
+        by_summary = {summary.channels[c].topic: n for c, n in summary.statistics.channel_message_counts.items()}
+        by_reading: dict[str, int] = {}
+        for _s, channel, _m in reader.iter_messages():
+            by_reading[channel.topic] = by_reading.get(channel.topic, 0) + 1
+    with AnyReader([path]) as other:
+        by_rosbags = {c.topic: c.msgcount for c in other.connections}
+        read = sum(1 for _ in other.messages())
+    assert by_summary == by_reading == by_rosbags, (by_summary, by_reading, by_rosbags)
+    assert read == sum(by_rosbags.values())
+    return by_summary
+
+
+def test_recover_writes_a_whole_indexed_file_of_what_could_be_read(tmp_path, capsys):
+    good = good_bag(tmp_path / "good.mcap")
+    killed = cut(good, tmp_path / "killed.mcap", 2 / 3)
+    before = killed.read_bytes()
+    out = tmp_path / "whole.mcap"
+    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(out)]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.startswith(f"[rtt-bag] {killed} (not closed): 1539 messages recovered") and "closed and indexed" in line
+    assert killed.read_bytes() == before  # the input is only read
+    check_file(out)
+    assert recovered_by_stock_readers(out) == {"/Tank/joint_state": 1539}
+    assert [m.data for m in iter_raw(out)] == [m.data for m in iter_raw(good)][:1539]
+    with open(out, "rb") as f:
+        from mcap.reader import make_reader
+
+        reader = make_reader(f)
+        [meta] = list(reader.iter_metadata())
+        [channel] = reader.get_summary().channels.values()
+    bag = yaml.safe_load(meta.metadata["serialized_metadata"])  # rosbag2's own record counts what was recovered
+    assert bag["message_count"] == 1539 and bag["topics_with_message_count"][0]["message_count"] == 1539
+    assert channel.metadata["offered_qos_profiles"] == EXPECTED_OFFER  # the channel's QoS kept
+    # Once more over an existing file: refused, then allowed.
+    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(out)]) == 2
+    assert "exists already" in capsys.readouterr().err
+    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(killed)]) == 2
+    assert "the copy must go to another file" in capsys.readouterr().err
+    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(out), "--overwrite"]) == 0
+
+
+def test_recover_skips_a_damaged_chunk_and_keeps_the_rest(tmp_path, capsys):
+    corrupt = bad_bags(tmp_path)["corrupt"]  # the second of four chunks is damaged
+    assert cli.main(["rtt-bag", "info", str(corrupt)]) == 2  # a closed file that lies is refused ...
+    assert "rtt-bag recover copies what can still be read" in capsys.readouterr().err
+    out = tmp_path / "whole.mcap"
+    assert cli.main(["rtt-bag", "recover", str(corrupt), "-o", str(out)]) == 0  # ... and recovered
+    assert "1 damaged chunk skipped" in capsys.readouterr().out
+    assert recovered_by_stock_readers(out) == {"/Tank/joint_state": 2000 - (1026 - 513)}
+    assert [m.log_time for m in iter_raw(out)][512:514] == [1_512_000_000, 2_026_000_000]  # the second chunk gone
 
 
 def test_an_unknown_message_type_is_listed_but_not_played(tmp_path, capsys):

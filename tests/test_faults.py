@@ -365,3 +365,134 @@ def test_shared_memory_clean_up_keeps_what_a_live_owner_locks():
         for name in files + [f"sem.{port}_mutex"]:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(os.path.join(SHM_DIR, name))
+
+
+# ------------------------------------------------------------ the recorder (issue 26)
+RECORD_SECONDS = 10.0  # s the recorder runs before its SIGKILL
+MAX_LOST = 1.0  # s of messages a killed recorder may lose (issue 26)
+
+
+def run_bag(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
+    """``rtt-bag ARGS`` as a process; its exit status and output."""
+    return subprocess.run(
+        module_command("tutorial.bag", *args), capture_output=True, text=True, timeout=timeout, cwd=ROOT
+    )
+
+
+def test_recorder_killed_loses_less_than_a_second_and_its_file_is_read_played_and_recovered(nodes, tmp_path):
+    """SIGKILL ``rtt-bag record`` 10 s into a Step 2 run: ``info`` reports at least 9 s of messages, the
+    newest less than 1 s before the kill; ``play`` plays them; ``recover`` writes a file both stock readers
+    read whole."""
+    from test_bag import recovered_by_stock_readers
+
+    sim = nodes.simulation()
+    path = tmp_path / "killed.mcap"
+    rec = nodes.start("tutorial.bag", "record", "/Tank/joint_state", "-o", str(path))
+    rec.wait_for_line(lambda line: "subscribed to /Tank/joint_state" in line, timeout=60)
+    time.sleep(RECORD_SECONDS)  # the fault's timing: the recording runs this long, then the kill
+    killed_ns = time.time_ns()
+    nodes.kill(rec)
+    assert sim.p.poll() is None, sim.err
+
+    info = run_bag("info", str(path), "--json")
+    assert info.returncode == 0, info.stderr
+    [line] = info.stderr.splitlines()
+    assert line.startswith(f"rtt-bag: info: {path}: not closed (") and "messages recovered" in line, line
+    summary = json.loads(info.stdout)
+    lost_s = (killed_ns - summary["last_ns"]) * 1e-9
+    print(
+        f"killed after {RECORD_SECONDS} s: {summary['count']} messages over {summary['duration_s']:.3f} s in the "
+        f"file ({path.stat().st_size} bytes); the newest {lost_s:.3f} s before the kill"
+    )
+    assert summary["closed"] is False
+    assert summary["duration_s"] >= RECORD_SECONDS - MAX_LOST, summary
+    assert lost_s < MAX_LOST
+    assert summary["count"] >= 45 * (RECORD_SECONDS - MAX_LOST)  # 50 Hz: none missing in between (a little slack)
+
+    played = run_bag("play", str(path), "--rate", "20")
+    assert played.returncode == 0, played.stderr
+    assert played.stderr.splitlines()[0].startswith(f"rtt-bag: play: {path}: not closed (")
+    assert f"published {summary['count']} messages" in played.stdout
+
+    whole = tmp_path / "whole.mcap"
+    recovered = run_bag("recover", str(path), "-o", str(whole))
+    assert recovered.returncode == 0, recovered.stderr
+    assert f"wrote {summary['count']} messages" in recovered.stdout
+    assert recovered_by_stock_readers(whole) == {"/Tank/joint_state": summary["count"]}
+
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 2 MiB tmpfs mounted for the test (root only), unmounted afterwards, also on failure."""
+    folder = tmp_path / "disk"
+    folder.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(folder)], capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode().strip()}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", "-l", str(folder)], check=False)
+
+
+def limit_file_size(limit: int):
+    """A ``preexec_fn``: files this process writes stop at ``limit`` bytes, a write past it fails with EFBIG.
+
+    SIGXFSZ, which the kernel sends then, must be ignored for ``write()`` to
+    return the error (Python ignores it anyway; said here so it holds for any program).
+    """
+    import resource
+
+    def apply() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    return apply
+
+
+@pytest.mark.parametrize("fault", ["disk-full", "file-size-limit"])
+def test_recorder_stops_with_one_line_when_the_disk_is_full_and_its_file_stays_readable(
+    nodes, node, request, tmp_path, fault
+):
+    """A 2 MiB tmpfs (ENOSPC) or a 2 MiB file-size limit (EFBIG) fills while recording 8 MB/s: the
+    recorder stops by itself with one line and exit status 1; the file keeps what was written through."""
+    import random
+
+    from sensor_msgs.msg import JointState
+
+    from tutorial.bag.info import bag_info
+
+    from test_bag import recovered_by_stock_readers
+
+    if fault == "disk-full":
+        path = request.getfixturevalue("small_disk") / "full.mcap"
+        extra = {}
+    else:
+        path = tmp_path / "limited.mcap"
+        extra = {"preexec_fn": limit_file_size(2 * 1024 * 1024)}
+    pub = node.create_publisher(JointState, "/bag_test/flood", 10)
+    rec = nodes.start("tutorial.bag", "record", "/bag_test/flood", "-o", str(path), "--compression", "none", **extra)
+    rec.wait_for_line(lambda line: "subscribed to /bag_test/flood" in line, timeout=60)
+    assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
+    rng = random.Random(26)
+    msg = JointState(name=["J"], position=[rng.random() for _ in range(2000)])  # 16 KB that do not compress
+    deadline = time.monotonic() + 60
+    sent = 0
+    while rec.p.poll() is None and time.monotonic() < deadline:
+        msg.header.stamp.sec = sent
+        pub.publish(msg)
+        sent += 1
+        time.sleep(0.002)  # the flood's pace (about 8 MB/s), not a synchronisation
+    assert rec.wait(30) == 1, (rec.out, rec.err)
+    [line] = rec.err.splitlines()
+    reason = "the disk is full (ENOSPC)" if fault == "disk-full" else "file-size limit) (EFBIG)"
+    assert line.startswith(f"rtt-bag: record: stopped: {path}: writing failed: ") and reason in line, line
+    written = int(re.search(r"after (\d+) messages were written through", line).group(1))
+    print(f"{fault}: stopped after {sent} sent; {line}")
+
+    info = bag_info(path)
+    assert not info.closed and info.count == written > 0  # every chunk written through, and no more
+    whole = tmp_path / "whole.mcap"  # beside the full disk
+    run = run_bag("recover", str(path), "-o", str(whole))
+    assert run.returncode == 0, run.stderr
+    assert recovered_by_stock_readers(whole) == {"/bag_test/flood": info.count}

@@ -93,3 +93,28 @@ def test_rtt_run_reports_a_bad_project_with_exit_status_2(tmp_path, procs):
     p = procs(module_command("tutorial.tools.rtt_run", str(path), "--headless"))
     assert p.wait(60) == 2
     assert f"{path}: simulatr: unknown key" in p.err
+
+
+@pytest.mark.parametrize("case", ["binary junk", "model with an XML error", "bad ROS argument"])
+def test_rtt_run_gives_one_line_and_status_2_for_a_bad_file_or_argument(tmp_path, procs, case):
+    """Each of these ended in a traceback or exit status 1 before issue 26."""
+    from conftest import module_command
+
+    project = tmp_path / "p.yaml"
+    args = [str(project), "--headless", "--duration", "0.1"]
+    if case == "binary junk":
+        project.write_bytes(bytes(range(256)) * 4)
+        expected = f"{project}: not a text file (byte 128 is not UTF-8)"
+    elif case == "model with an XML error":
+        model = tmp_path / "m.xml"
+        model.write_text('<mujoco><worldbody><body><geom size="0.1"/></body>\n<nope/></worldbody></mujoco>')
+        project.write_text(f"models:\n  - name: M\n    file: {model}\n")
+        expected = f"{project}: models[0].file: {model}: not a model MuJoCo can load: XML Error"
+    else:
+        project = PROJECT / "step2.yaml"
+        args = [str(project), "--headless", "--ros-args", "-p", "rate"]
+        expected = "bad ROS arguments after --ros-args: "
+    p = procs(module_command("tutorial.tools.rtt_run", *args))
+    assert p.wait(60) == 2, (p.out, p.err)
+    [line] = p.err.splitlines()
+    assert line.startswith(f"rtt-run: {expected}"), line

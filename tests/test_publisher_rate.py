@@ -25,3 +25,53 @@ def test_uneven_rate_holds_on_average():
     due = due_steps(0.001, 300.0, 30_000)  # period 3.333 ms: steps of 3 and 4
     assert len(due) == pytest.approx(9000, abs=1)
     assert set(b - a for a, b in zip(due, due[1:])) <= {3, 4}
+
+
+def test_first_due_false_starts_one_period_later():
+    acc = PeriodAccumulator(0.001, 50.0, first_due=False)
+    due = [k for k in range(100) if acc.tick()]
+    assert due == [20, 40, 60, 80]
+    every_step = PeriodAccumulator(0.001, 0.0, first_due=False)
+    assert [k for k in range(3) if every_step.tick()] == [1, 2]
+
+
+def test_the_step2_publisher_sends_the_start_state_then_one_per_period_then_the_final_state():
+    """start() publishes the state before the first step; at 0.1 Hz the next comes 10 s later (issue 26)."""
+    import mujoco
+
+    from tutorial.controllers.joint_state_publisher import RttJointStatePublisher
+    from tutorial.core.body import Body
+    from tutorial.core.controller import ControllerConfig, ControllerIO
+    from tutorial.core.world import ModelEntry, build_world
+
+    from conftest import MODEL
+
+    class Publisher:  # stands in for an rclpy publisher: keeps each message's stamp and TURRET_P
+        def __init__(self):
+            self.sent = []
+
+        def publish(self, msg):
+            self.sent.append((msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9, msg.position[1]))
+
+    class Node:
+        def create_publisher(self, *args):
+            self.publisher = Publisher()
+            return self.publisher
+
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    start_pitch = float(data.qpos[Body(model, data, "Tank").joint("TURRET_P").info.qpos_adr])
+    node, controller = Node(), RttJointStatePublisher()
+    body = Body(model, data, "Tank")
+    assert controller.configure(ControllerConfig(name="P", body=body, node=node, parameters={"rate": 0.1}))
+    assert controller.initialize(ControllerIO(body=body, time_step=model.opt.timestep, node=node, data=data))
+    assert controller.start()
+    assert node.publisher.sent == [(0.0, start_pitch)]  # the state the simulation starts in, at once
+    for _ in range(10_500):  # 10.5 s
+        controller.control()
+        mujoco.mj_step(model, data)
+    controller.stop()
+    stamps = [round(t, 3) for t, _ in node.publisher.sent]
+    assert stamps == [0.0, 10.0, 10.5]  # start, one period later, the final state
+    assert node.publisher.sent[1][1] != start_pitch  # the barrel sagged: a later state, not the start again

@@ -55,8 +55,55 @@ def test_viewer_ends_on_the_simulations_final_state(procs):
     assert counts["rejected"] == {}
     assert counts["received"] > 100  # 50 Hz for most of 6 s
     assert (
-        sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 300 + 1
-    )  # 50 Hz over 6 s (steps 0, 20, ..., 5980), and the final state
+        sim_summary["controllers"]["RttJointStatePublisher"]["published"] == 1 + 299 + 1
+    )  # the start state, 50 Hz over 6 s (steps 20, ..., 5980), and the final state
+
+
+JOIN_DEADLINE = 3.0  # s from a monitor joining (in the ROS graph) to the posture shown, at 0.1 Hz (issue 26)
+
+
+def test_a_monitor_joining_a_slow_publisher_shows_the_posture_at_once(procs, node):
+    """A simulation publishing at 0.1 Hz: a monitor started between two states shows the one its publisher
+    kept (the start state) within 3 s of joining the ROS graph, and its status line says so; before issue 26
+    the status line said "no state yet, 0/2 joints matched" until the next live state, up to 10 s later
+    (6.9 s measured).  Joining is timed from when this test sees the monitor's subscription in the graph:
+    the process's own start-up (imports: one to three seconds on a busy machine) is not joining."""
+    import json
+    import time
+
+    sim = procs(
+        module_command(
+            "tutorial.tools.rtt_run",
+            "project/step2.yaml",
+            "--headless",
+            "--json",
+            "--ros-args",
+            "-p",
+            "RttJointStatePublisher.rate:=0.1",
+        )
+    )
+    assert wait_until(lambda: node.count_publishers("/Tank/joint_state") >= 1, timeout=60), sim.err
+    started = time.monotonic()
+    view = viewer(procs)
+
+    def monitor_joined() -> bool:  # its subscriptions are in the ROS graph: it has joined
+        return any(i.node_name == "rtt_viewer" for i in node.get_subscriptions_info_by_topic("/Tank/joint_state"))
+
+    assert wait_until(monitor_joined, timeout=60, poll=0.01), view.err
+    joined = time.monotonic()
+    late = json.loads(view.wait_for_line(lambda line: '"event": "late_state"' in line, timeout=30))
+    shown = time.monotonic()
+    shown_after = shown - joined
+    is_status = lambda line: '"event": "status"' in line  # noqa: E731
+    status = json.loads(view.wait_for_count(is_status, view.count(is_status) + 1, timeout=5))  # the next one
+    print(
+        f"the monitor showed the posture {shown - started:.2f} s after its process started, {shown_after:.2f} s "
+        f"after this test saw it join the graph: {late['message']}"
+    )
+    assert late["stamp"] == 0.0 and late["matched"] == 2  # the state the simulation started in
+    assert status["matched"] == 2 and status["age_ms"] is not None  # the status line shows it too
+    assert not view.records("first_state")  # no live state yet: the next is 10 s of simulated time away
+    assert shown_after <= JOIN_DEADLINE
 
 
 HOSTILE = [

@@ -8,8 +8,10 @@ Foxglove open them.  One job per module:
 :mod:`tutorial.bag.record`       :class:`BagRecorder`: subscribe raw, write each message (ROS)
 :mod:`tutorial.bag.play`         :class:`BagPlayer`: republish with the recorded timing (ROS)
 :mod:`tutorial.bag.info`         :func:`bag_info`: per topic type, count, time span, rate, QoS
-:mod:`tutorial.bag.reader`       read without ROS: raw messages, decoded messages, :func:`joint_series`
-:mod:`tutorial.bag.writer`       the MCAP file as rosbag2 lays it out (schemas, channels, metadata)
+:mod:`tutorial.bag.reader`       read without ROS: raw messages, decoded messages, :func:`joint_series`;
+                                 a file that was not closed, record by record
+:mod:`tutorial.bag.recover`      :func:`recover`: a closed, indexed copy of a damaged or unclosed file
+:mod:`tutorial.bag.writer`       the MCAP file as rosbag2 lays it out; the write-through policy
 :mod:`tutorial.bag.definitions`  the full ``ros2msg`` text of a type, from the installed ``.msg`` files
 :mod:`tutorial.bag.qos`          ``offered_qos_profiles``: rosbag2's YAML and its QoS adaptations
 :mod:`tutorial.bag.cli`          the ``rtt-bag`` command line
@@ -59,10 +61,14 @@ Both are well kept, both read and write MCAP; compared on what a recorder needs:
   builds the CDR deserializer from the schema text stored in the file, so
   any bag decodes with no type store and no ROS.  ``rosbags`` decodes
   types it knows or that were registered from the file's schemas.
-* **A truncated file.** Both fail cleanly: ``mcap`` raises ``EndOfFile``
-  (or a length-limit error) when the footer is missing, ``rosbags``
-  "File end magic is invalid".  :func:`tutorial.bag.reader.check_file`
-  checks the magic at both ends first, for one clear line either way.
+* **A file that was not closed** (a killed recorder, a full disk).  Both
+  refuse it: ``mcap``'s seeking reader raises ``EndOfFile`` (or a
+  length-limit error) when the footer is missing, ``rosbags`` "File end
+  magic is invalid".  ``mcap`` also has a record-level reader
+  (``mcap.stream_reader.StreamReader``) that reads from the start, record by
+  record; :mod:`tutorial.bag.reader` uses it to read every complete chunk of
+  such a file, as the ``mcap recover`` command does, and
+  :mod:`tutorial.bag.recover` writes what it read into a closed file.
 
 So: ``mcap`` to write (what rosbag2 writes, in one file, by the format's
 own library) and to read, ``mcap-ros2-support`` to decode without ROS.

@@ -6,17 +6,22 @@
     rtt-bag info drive.mcap
     rtt-bag play drive.mcap --rate 2 --topics /Tank/joint_state --start-offset 1.5
     rtt-bag play drive.mcap --loop
+    rtt-bag recover killed.mcap -o whole.mcap               # a closed, indexed copy of what can be read
 
 The files are what ``ros2 bag record -s mcap`` writes, so ``ros2 bag
 info``/``play`` (with the mcap storage plugin) and Foxglove open them.
 ``record`` runs as node ``rtt_bag``, ``play`` as ``rtt_bag_play``; rename
 with ``--ros-args -r __node:=NAME``.  Ctrl-C or SIGTERM ends a recording
-cleanly: the file is closed with its indexes and summary.
+cleanly: the file is closed with its indexes and summary.  A recorder
+that is killed loses less than its last second (the write-through policy,
+:mod:`tutorial.bag.writer`); ``info`` and ``play`` read such a file that was
+not closed, saying so on stderr, and ``recover`` writes a closed copy.
 
-Exit status: 0 done (also when stopped by Ctrl-C/SIGTERM); 1 a failure
-while running (a write failed); 2 a bad command line, an output file that
-exists, or a bag that cannot be read or played (not MCAP, truncated,
-corrupt, a message type not installed): one line on stderr says which.
+Exit status: 0 done (also when stopped by Ctrl-C/SIGTERM, and for a file
+that was not closed but could be read); 1 a failure while running (a write
+failed: a full disk, a file-size limit); 2 a bad command line, an output
+file that exists, or a bag that cannot be read or played (missing, not
+MCAP, corrupt, a message type not installed): one line on stderr says which.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ import argparse
 import datetime
 import functools
 import json
+import math
 import signal
 import sys
 import time
@@ -42,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Record, list and replay ROS 2 bags in MCAP files.",
         epilog="ROS arguments go after --ros-args, e.g. --ros-args -r __node:=my_bag",
     )
-    sub = p.add_subparsers(dest="command", required=True, metavar="{record,info,play}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="{record,info,play,recover}")
 
     r = sub.add_parser("record", help="record topics to an MCAP file until Ctrl-C, SIGTERM or --duration")
     r.add_argument("topics", nargs="*", metavar="TOPIC", help="topics to record, e.g. /joy /Tank/joint_state")
@@ -90,7 +96,18 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="SECONDS",
         help="wait this long before playing (each loop), e.g. for discovery",
     )
+    v = sub.add_parser("recover", help="copy what can be read of a damaged or unclosed bag into a closed one")
+    v.add_argument("file", metavar="IN.mcap", help="the damaged or unclosed file (only read)")
+    v.add_argument("-o", "--output", metavar="OUT.mcap", required=True, help="the file to write; it must not exist")
+    v.add_argument(
+        "--compression", choices=["zstd", "lz4", "none"], default="zstd", help="chunk compression (default zstd)"
+    )
+    v.add_argument("--overwrite", action="store_true", help="replace OUT if it exists")
     return p
+
+
+def _finite(value: float | None) -> bool:
+    return value is None or math.isfinite(value)
 
 
 class _StopRequest:
@@ -138,8 +155,8 @@ def record(args, argv: list[str]) -> int:
 
     if not args.topics and not args.all and not args.tf:
         return _fail("record: name the topics to record, or pass --all or --tf")
-    if args.duration is not None and not args.duration > 0:
-        return _fail("record: --duration must be > 0")
+    if args.duration is not None and not (args.duration > 0 and _finite(args.duration)):
+        return _fail("record: --duration must be a number of seconds > 0")
     path = args.output or datetime.datetime.now().strftime("rtt_bag_%Y_%m_%d-%H_%M_%S.mcap")
     try:  # the file first: a name that exists fails before ROS starts
         recorder = BagRecorder(
@@ -154,14 +171,12 @@ def record(args, argv: list[str]) -> int:
     except (BagWriteError, ValueError) as exc:
         return _fail(f"record: {exc}")
     stop = _StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
-    status = 0
     deadline = None if args.duration is None else time.monotonic() + args.duration
     try:
         _init_ros(argv)
         recorder.start()
         while not stop.requested and (deadline is None or time.monotonic() < deadline):
-            if recorder.error is not None:
-                status = _fail(f"record: stopped: {recorder.error!r}", 1)
+            if recorder.failure is not None:
                 break
             time.sleep(0.05)  # the stop flag and the deadline are seen within 50 ms
     finally:
@@ -170,7 +185,20 @@ def record(args, argv: list[str]) -> int:
             recorder.close()
         finally:
             rclpy.try_shutdown()
-    return status
+    if recorder.failure is not None:  # a full disk, a file-size limit: one line, and the file stays readable
+        return _fail(f"record: stopped: {recorder.failure}; rtt-bag recover writes a closed copy", 1)
+    return 0
+
+
+def _say_not_closed(command: str, info) -> None:
+    """One line on stderr for a bag that was not closed; then the command goes on."""
+    if not info.closed:
+        print(
+            f"{PROG}: {command}: {info.path}: not closed (the recording was cut short: killed, or the disk "
+            f"filled): {info.recovery.describe()}; rtt-bag recover writes a closed copy",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def info(args) -> int:
@@ -182,6 +210,7 @@ def info(args) -> int:
         summary = bag_info(args.file)
     except BagError as exc:
         return _fail(f"info: {exc}")
+    _say_not_closed("info", summary)
     _say(json.dumps(summary.as_dict()) if args.json else format_info(summary))
     return 0
 
@@ -193,6 +222,8 @@ def play(args, argv: list[str]) -> int:
     from tutorial.bag.play import BagPlayer
     from tutorial.bag.reader import BagError
 
+    if not all(_finite(v) for v in (args.rate, args.start_offset, args.delay)):
+        return _fail("play: --rate, --start-offset and --delay must be finite numbers")
     try:
         player = BagPlayer(
             args.file,
@@ -205,6 +236,7 @@ def play(args, argv: list[str]) -> int:
         )
     except (BagError, ValueError) as exc:
         return _fail(f"play: {exc}")
+    _say_not_closed("play", player.info)
     _StopRequest(player.request_stop).install()
     _init_ros(argv)
     try:
@@ -220,16 +252,44 @@ def play(args, argv: list[str]) -> int:
     return 0
 
 
+def recover(args) -> int:
+    """``rtt-bag recover IN -o OUT``: no ROS needed."""
+    from tutorial.bag.reader import BagError
+    from tutorial.bag.recover import recover as recover_file
+    from tutorial.bag.writer import BagWriteError
+
+    try:
+        result = recover_file(args.file, args.output, compression=args.compression, overwrite=args.overwrite)
+    except BagError as exc:
+        return _fail(f"recover: {exc}")
+    except BagWriteError as exc:
+        return _fail(f"recover: {exc}", 2 if "exists already" in str(exc) or "cannot create" in str(exc) else 1)
+    stats = result.stats
+    per_topic = ", ".join(f"{t} {n}" for t, n in stats.per_topic.items()) or "no topics"
+    state = "closed" if result.closed else "not closed"
+    skipped = f"; skipped {'; '.join(result.skipped_channels)}" if result.skipped_channels else ""
+    _say(
+        f"[{PROG}] {result.source} ({state}): {result.recovery.describe()}{skipped}; "
+        f"wrote {stats.messages} messages ({per_topic}) to {result.target}, closed and indexed, "
+        f"{stats.size_bytes} bytes"
+    )
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """``rtt-bag``: parse the command line and run the subcommand; the exit status (main thread)."""
-    from rclpy.utilities import remove_ros_args
-
     argv = list(sys.argv if argv is None else argv)
-    args = build_parser().parse_args(remove_ros_args(argv)[1:])
+    try:
+        plain = ros_env.remove_ros_args_or_fail(argv)
+    except ValueError as exc:
+        return _fail(str(exc))
+    args = build_parser().parse_args(plain[1:])
     if args.command == "record":
         return record(args, argv)
     if args.command == "play":
         return play(args, argv)
+    if args.command == "recover":
+        return recover(args)
     return info(args)
 
 

@@ -3,7 +3,9 @@
 No ROS needed.  The counts and times come from reading the messages' log
 times (the summary's statistics give counts but not a time span per topic),
 so every chunk is read and CRC-checked: a damaged file is found here, not
-half-way through a replay.
+half-way through a replay.  A file that was not closed (no summary) is
+read record by record (:func:`tutorial.bag.reader.scan_records`): its
+:class:`BagInfo` says ``closed = False`` and what was recovered.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from tutorial.bag.qos import QosFormatError, describe, parse_profiles
-from tutorial.bag.reader import BagError, _reading, check_file
+from tutorial.bag.reader import BagError, Recovery, _reading, inspect_file, scan_records
 
 
 @dataclass
@@ -51,7 +53,12 @@ class TopicInfo:
 
 @dataclass
 class BagInfo:
-    """A bag's summary: file, size (bytes), profile, library, first/last log time (ns), topics."""
+    """A bag's summary: file, size (bytes), profile, library, first/last log time (ns), topics.
+
+    ``closed`` is False for a file that was not closed (a killed recorder, a
+    full disk); then ``recovery`` says what its complete records held, and
+    every count and time here is of those.
+    """
 
     path: Path
     size_bytes: int
@@ -61,6 +68,8 @@ class BagInfo:
     first_ns: int | None
     last_ns: int | None
     topics: list[TopicInfo]
+    closed: bool = True
+    recovery: Recovery | None = None
 
     @property
     def duration_s(self) -> float:
@@ -87,12 +96,16 @@ def bag_info(path) -> BagInfo:
     """Read a bag's summary (any thread; no ROS).
 
     Raises:
-        BagError: the file is not a whole, readable MCAP file, or a channel's
+        BagError: the file is not a readable MCAP file, or a channel's
             ``offered_qos_profiles`` is not rosbag2's format.
     """
+    p, closed = inspect_file(path)
+    return _closed_info(p) if closed else _unclosed_info(p)
+
+
+def _closed_info(p: Path) -> BagInfo:
     from mcap.reader import make_reader
 
-    p = check_file(path)
     topics: dict[int, TopicInfo] = {}
     with open(p, "rb") as f, _reading(p):
         reader = make_reader(f, validate_crcs=True)
@@ -102,19 +115,58 @@ def bag_info(path) -> BagInfo:
             for cid, channel in summary.channels.items():
                 topics[cid] = _topic_info(p, channel, summary.schemas.get(channel.schema_id))
         for schema, channel, message in reader.iter_messages(log_time_order=False):
-            t = topics.get(channel.id)
-            if t is None:
-                t = topics[channel.id] = _topic_info(p, channel, schema)
-            t.count += 1
-            t.first_ns = message.log_time if t.first_ns is None else min(t.first_ns, message.log_time)
-            t.last_ns = message.log_time if t.last_ns is None else max(t.last_ns, message.log_time)
+            _count(topics, p, schema, channel, message)
+    return _info(p, header.profile, header.library, topics)
+
+
+def _unclosed_info(p: Path) -> BagInfo:
+    """What the complete records of a file that was not closed hold, in one pass (:func:`scan_records`)."""
+    from mcap.records import Channel, Header, Message, Schema
+
+    recovery = Recovery()
+    topics: dict[int, TopicInfo] = {}
+    header = Header(profile="", library="")
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, Channel] = {}
+    with _reading(p):
+        for record in scan_records(p, recovery):
+            if isinstance(record, Header):
+                header = record
+            elif isinstance(record, Schema):
+                schemas[record.id] = record
+            elif isinstance(record, Channel):
+                channels[record.id] = record
+                if record.id not in topics:
+                    topics[record.id] = _topic_info(p, record, schemas.get(record.schema_id))
+            elif isinstance(record, Message):
+                channel = channels.get(record.channel_id)
+                if channel is None:
+                    recovery.orphans += 1
+                    continue
+                recovery.messages += 1
+                _count(topics, p, schemas.get(channel.schema_id), channel, record)
+    info = _info(p, header.profile, header.library, topics)
+    info.closed, info.recovery = False, recovery
+    return info
+
+
+def _count(topics: dict, p: Path, schema, channel, message) -> None:
+    t = topics.get(channel.id)
+    if t is None:
+        t = topics[channel.id] = _topic_info(p, channel, schema)
+    t.count += 1
+    t.first_ns = message.log_time if t.first_ns is None else min(t.first_ns, message.log_time)
+    t.last_ns = message.log_time if t.last_ns is None else max(t.last_ns, message.log_time)
+
+
+def _info(p: Path, profile: str, library: str, topics: dict[int, TopicInfo]) -> BagInfo:
     firsts = [t.first_ns for t in topics.values() if t.count]
     lasts = [t.last_ns for t in topics.values() if t.count]
     return BagInfo(
         p,
         p.stat().st_size,
-        header.profile,
-        header.library,
+        profile,
+        library,
         sum(t.count for t in topics.values()),
         min(firsts) if firsts else None,
         max(lasts) if lasts else None,
@@ -161,8 +213,10 @@ def format_info(info: BagInfo) -> str:
         f"Start:             {_time(info.first_ns)}",
         f"End:               {_time(info.last_ns)}",
         f"Messages:          {info.count}",
-        "Topic information:",
     ]
+    if not info.closed:
+        lines.append(f"Not closed:        {info.recovery.describe() if info.recovery else ''}")
+    lines.append("Topic information:")
     width = max((len(t.topic) for t in info.topics), default=0)
     twidth = max((len(t.type) for t in info.topics), default=0)
     for t in info.topics:

@@ -27,6 +27,13 @@ does the same:
 * The publishers' offered QoS and the type hash are stored as the
   channel's ``offered_qos_profiles`` and ``topic_type_hash``.  Publishers
   that appear later are not added to the stored list (rosbag2's limit too).
+* Write-through (:mod:`tutorial.bag.writer`): a timer every 0.1 s, beside
+  the check at each message, closes a chunk that is 0.5 s old and flushes
+  and fsyncs it, so a killed recorder loses less than the last second.
+  A write that fails (a full disk, a file-size limit) stops the recording:
+  :attr:`BagRecorder.failure` says why in one line, and the file keeps
+  everything written through before (``rtt-bag info`` reads it,
+  ``rtt-bag recover`` closes a copy).
 """
 
 from __future__ import annotations
@@ -36,7 +43,7 @@ import time
 
 from tutorial.bag.definitions import UnknownMessageType, full_text, message_class
 from tutorial.bag.qos import profile_dict, request_for_offers, serialize_profiles, to_qos_profile
-from tutorial.bag.writer import BagWriter, WriteStats
+from tutorial.bag.writer import WRITE_THROUGH_CHECK, BagWriter, WriteStats
 
 NODE_NAME = "rtt_bag"
 POLL_PERIOD = 0.1  # s between looks at the ROS graph for new topics (rosbag2's default)
@@ -70,6 +77,8 @@ class BagRecorder:
         tf: also record every body's robot description, odometry and joint
             states, and write ``/tf``, ``/tf_static`` and ``/robot_description``
             computed from them (:mod:`tutorial.urdf.recording`).
+        write_through: the writer's policy (:class:`~tutorial.bag.writer.BagWriter`);
+            False only for the benchmark's baseline.
 
     Raises:
         ValueError: no topics, ``all_topics`` nor ``tf``, or a bad ``compression``.
@@ -98,13 +107,14 @@ class BagRecorder:
         overwrite: bool = False,
         output=print,
         tf: bool = False,
+        write_through: bool = True,
     ):
         self.topics_wanted = [normalize_topic(t) for t in topics]
         if not self.topics_wanted and not all_topics and not tf:
             raise ValueError("name the topics to record, or record all topics")
         self.all_topics = all_topics
         self.output = output
-        self.writer = BagWriter(path, compression=compression, overwrite=overwrite)
+        self.writer = BagWriter(path, compression=compression, overwrite=overwrite, write_through=write_through)
         self.path = self.writer.path
         self.tf = None
         if tf:  # the TF computation is its own module's; the recorder only feeds it
@@ -116,6 +126,7 @@ class BagRecorder:
         self.node_name = node_name
         self._spin = None
         self._timer = None
+        self._write_through_timer = None
         self._subscriptions: dict[str, object] = {}
         # Discovery (spin thread) adds subscriptions, close() (owner thread) removes them: with a
         # node spun by its owner the two can overlap, so both hold this lock, and discovery
@@ -141,14 +152,25 @@ class BagRecorder:
         self._say(f"recording {wanted} to {self.path}")
         self._discover()
         self._timer = self.node.create_timer(POLL_PERIOD, self._discover)
+        if self.writer.write_through:
+            self._write_through_timer = self.node.create_timer(WRITE_THROUGH_CHECK, self.writer.write_through_due)
         if self._given_node is None:
             self._spin = ros_env.SpinThread(self.node).start()
         return self
 
     @property
     def error(self) -> BaseException | None:
-        """An exception that ended the recorder's own spin thread (a failed write), else None."""
+        """An exception that ended the recorder's own spin thread (a bug: a failed write is :attr:`failure`)."""
         return self._spin.error if self._spin is not None else None
+
+    @property
+    def failure(self) -> str | None:
+        """Why the recording stopped by itself, in one line (a failed write: a full disk...), else None (any thread)."""
+        if self.writer.error is not None:
+            return f"{self.writer.error}; the file was not closed: rtt-bag info and play read it as it is"
+        if self.error is not None:
+            return f"the recorder's spin thread stopped: {self.error!r}"
+        return None
 
     def stats(self) -> WriteStats:
         """Messages written so far, by topic (any thread)."""
@@ -166,9 +188,10 @@ class BagRecorder:
         if self.node is not None:
             with self._graph_lock:
                 self._closing = True
-                if self._timer is not None:
-                    self.node.destroy_timer(self._timer)
-                    self._timer = None
+                for timer in (self._timer, self._write_through_timer):
+                    if timer is not None:
+                        self.node.destroy_timer(timer)
+                self._timer = self._write_through_timer = None
                 for sub in self._subscriptions.values():
                     self.node.destroy_subscription(sub)
                 self._subscriptions.clear()
@@ -180,11 +203,17 @@ class BagRecorder:
         stats = self.writer.close()
         per_topic = ", ".join(f"{t} {n}" for t, n in stats.per_topic.items()) or "no topics"
         computed = sum(self.tf.written.values()) if self.tf is not None else 0
-        self._say(
-            f"wrote {stats.messages - computed} of {sum(self.received.values())} messages received"
-            + (f" and {computed} computed for TF" if computed else "")
-            + f" ({per_topic}) to {self.path}, {stats.size_bytes} bytes"
-        )
+        if self.writer.error is None:
+            self._say(
+                f"wrote {stats.messages - computed} of {sum(self.received.values())} messages received"
+                + (f" and {computed} computed for TF" if computed else "")
+                + f" ({per_topic}) to {self.path}, {stats.size_bytes} bytes"
+            )
+        else:
+            self._say(
+                f"stopped: {stats.written_through} of {sum(self.received.values())} messages received are in "
+                f"{self.path} ({stats.size_bytes} bytes, not closed)"
+            )
         return stats
 
     def __enter__(self) -> BagRecorder:

@@ -7,7 +7,9 @@ Built in ``notebooks/02_step2_joint_state_publisher.ipynb``: edit it there,
 then run ``make export``.  Topic ``/<body name>/joint_state``, type
 ``sensor_msgs/JointState``: one entry per numbered joint with its position
 (rad or m), velocity (rad/s or m/s) and effort (N*m or N), stamped with
-*simulation* time, at ``rate`` Hz of simulated time.
+*simulation* time, at ``rate`` Hz of simulated time.  It also publishes
+the state the simulation starts in (from ``start()``) and the state it
+ends in (from ``stop()``).
 """
 
 from __future__ import annotations
@@ -27,9 +29,11 @@ __all__ = ['DEFAULT_RATE', 'RttJointStatePublisher']
 class RttJointStatePublisher(SimpleController):
     """Step 2 controller: publishes ``/<body>/joint_state`` at ``rate`` Hz (simulated).
 
-    QoS: :func:`tutorial.interfaces.joint_state.joint_state_qos`.  When the
-    simulation stops it publishes the final state once more, so subscribers
-    see where the body stopped.
+    QoS: :func:`tutorial.interfaces.joint_state.joint_state_qos`.  It
+    publishes the state the simulation starts in from ``start()`` and the
+    state it ends in from ``stop()``, so a subscriber sees where the body
+    is from the first moment to the last, whatever the rate: transient
+    local keeps the newest state for one that joins later.
     """
 
     PARAMETERS = {
@@ -67,7 +71,8 @@ class RttJointStatePublisher(SimpleController):
     # ---- simulation thread --------------------------------------------------
     def initialize(self, io: ControllerIO) -> bool:
         self.data = io.data
-        self.accumulator = PeriodAccumulator(io.time_step, self.rate)
+        # start() sends the first state: the periodic ones begin a period later.
+        self.accumulator = PeriodAccumulator(io.time_step, self.rate, first_due=False)
         # One message, reused: the names never change, and publish() copies
         # the message, so refilling its arrays afterwards is safe.
         joints = io.body.joint_infos
@@ -85,6 +90,10 @@ class RttJointStatePublisher(SimpleController):
             memoryview(io.data.qfrc_actuator),
         )
         self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(joints)]
+        return True
+
+    def start(self) -> bool:
+        self.publish()  # the state the simulation starts in, before the first step
         return True
 
     def control(self) -> bool:

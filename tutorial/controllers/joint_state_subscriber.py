@@ -113,7 +113,8 @@ class RttJointStateMonitor(RttJointStateSubscriber):
       it is showing;
     * late joiners: a second, transient-local subscription receives the
       newest state a transient-local publisher kept from before the viewer
-      started; it is shown if no live state has come, then dropped;
+      started; it is shown if no live state has come (and the status line
+      says so: its age, the joints matched), then dropped;
     * a state stamped earlier than the one before (a publisher restarted
       from t = 0) is reported, and the new run is mirrored.
     """
@@ -154,7 +155,7 @@ class RttJointStateMonitor(RttJointStateSubscriber):
         self.config.call_later(self.update_joint_state, msg, arrival)
 
     def on_late_state(self, msg) -> None:
-        self.config.call_later(self.show_late_state, msg)
+        self.config.call_later(self.show_late_state, msg, self.status.clock())
 
     def on_matched(self, info) -> None:
         """A publisher appeared or went; newest count wins if two come at once."""
@@ -188,16 +189,25 @@ class RttJointStateMonitor(RttJointStateSubscriber):
             )
         return report
 
-    def show_late_state(self, msg) -> None:
-        """The newest state from before the viewer started: shown if none live came."""
+    def show_late_state(self, msg, arrival: float | None = None) -> None:
+        """The newest state from before the viewer started: shown if none live came.
+
+        The status line shows it too (its age, the joints matched): a
+        monitor of a slow publisher shows the posture at once, not after
+        the next live state.
+        """
         if self.status.applied == 0 and self.late_subscription is not None:
-            self.apply(msg)
+            report = self.apply(msg)
+            self.status.late_state_shown(arrival, report.matched, report.applied)
             self.late_states += 1
             stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
             self.say(
                 "late_state",
                 f"{self.topic}: showing the newest state published "
                 f"before this viewer started (t = {stamp:.3f} s)",
+                stamp=stamp,
+                matched=report.matched,
+                joints=self.body.num_joints,
             )
         self.drop_late_subscription()
 

@@ -24,7 +24,11 @@ simulation publishes there (:mod:`tutorial.interfaces.robot_description`),
 received when the project is opened.
 
 Every mistake raises one :class:`ProjectError` naming the file and the key,
-e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``.
+e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``,
+in one line: whatever the file holds (binary junk, YAML nested ten
+thousand deep, a number too big for a float, a path with a NUL byte)
+gives that, never another exception.  ``tests/test_fuzz_files.py`` feeds it
+generated files to keep it so.
 """
 
 from __future__ import annotations
@@ -45,10 +49,26 @@ from tutorial.core.world import ModelEntry
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 # An absolute ROS 2 topic name: /part/part, each part letters, digits and _, not starting with a digit.
 TOPIC_PATTERN = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
+MAX_PROJECT_BYTES = 1_000_000  # a project file is a page of YAML; a bigger "project" is the wrong file
 
 
 class ProjectError(ValueError):
-    """A project file cannot be used; the message names the file and the key."""
+    """A project file cannot be used; the message names the file and the key, in one line.
+
+    A line break that a key, a value or a file name brings into the message
+    is written as ``\\n`` (and so for every other line separator).
+    """
+
+    def __init__(self, message: str):
+        super().__init__(_one_line(message))
+
+
+_LINE_BREAKS = {c: repr(c)[1:-1] for c in "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"}
+
+
+def _one_line(text: str) -> str:
+    """``text`` with every character ``str.splitlines`` breaks at written as its escape."""
+    return text.translate(str.maketrans(_LINE_BREAKS))
 
 
 @dataclass
@@ -143,25 +163,79 @@ class _Reader:
         return value
 
     def number(self, value: Any, key: str, positive: bool = False) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise self.fail(key, f"expected a finite number, got {value!r}")
+        if not _is_finite_number(value):
+            raise self.fail(key, f"expected a finite number, got {_brief(value)}")
         if positive and value <= 0:
             raise self.fail(key, f"must be > 0, got {value!r}")
         return float(value)
 
     def vector(self, value: Any, key: str, n: int) -> tuple:
         if not isinstance(value, (list, tuple)) or len(value) != n:
-            raise self.fail(key, f"expected a list of {n} numbers, got {value!r}")
+            raise self.fail(key, f"expected a list of {n} numbers, got {_brief(value)}")
         return tuple(self.number(v, f"{key}[{i}]") for i, v in enumerate(value))
 
     def name(self, value: Any, key: str) -> str:
         if not isinstance(value, str) or not NAME_PATTERN.match(value):
-            raise self.fail(key, f"expected a name of letters, digits and _, starting with a letter, got {value!r}")
+            raise self.fail(
+                key, f"expected a name of letters, digits and _, starting with a letter, got {_brief(value)}"
+            )
         return value
 
 
 def _join(prefix: str, key: str) -> str:
     return f"{prefix}.{key}" if prefix else key
+
+
+def _brief(value: Any, limit: int = 80) -> str:
+    """``repr(value)`` on one line, cut to ``limit`` characters: an error message names the value, not a page of it."""
+    text = repr(value).replace("\n", " ")
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _is_finite_number(value: Any) -> bool:
+    """An int or float (not a bool) that is finite as a float (an int too big for one is not)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an int beyond 1.8e308
+        return False
+
+
+def _read_text(path: Path) -> str:
+    """The project file's text (UTF-8), or a :class:`ProjectError` saying why there is none."""
+    try:
+        if not path.is_file():
+            what = "no such file" if not path.exists() else "not a regular file"
+            raise ProjectError(f"{path}: cannot read the project file: {what}")
+        size = path.stat().st_size
+        if size > MAX_PROJECT_BYTES:
+            raise ProjectError(f"{path}: {size} bytes is too big for a project file (at most {MAX_PROJECT_BYTES})")
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ProjectError(f"{path}: cannot read the project file: {exc.strerror or exc}") from None
+    except ValueError as exc:  # a NUL byte in the name
+        raise ProjectError(f"{path!r}: cannot read the project file: {exc}") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ProjectError(
+            f"{path}: not a text file (byte {exc.start} is not UTF-8): a project file is YAML text"
+        ) from None
+
+
+def _parse_yaml(path: Path, text: str) -> Any:
+    """The YAML document, or one :class:`ProjectError` line naming where the YAML is wrong."""
+    try:
+        return yaml.safe_load(text)
+    except yaml.MarkedYAMLError as exc:
+        where = f" (line {exc.problem_mark.line + 1}, column {exc.problem_mark.column + 1})" if exc.problem_mark else ""
+        what = " ".join(str(exc.problem or exc.context or "syntax error").split())
+        raise ProjectError(f"{path}: not valid YAML: {what}{where}") from None
+    except yaml.YAMLError as exc:
+        raise ProjectError(f"{path}: not valid YAML: {' '.join(str(exc).split())[:200]}") from None
+    except RecursionError:
+        raise ProjectError(f"{path}: not valid YAML: nested too deeply") from None
 
 
 def load_project(path: str | Path) -> Project:
@@ -181,14 +255,7 @@ def load_project(path: str | Path) -> Project:
     """
     path = Path(path)
     r = _Reader(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ProjectError(f"{path}: cannot read the project file: {exc.strerror or exc}") from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ProjectError(f"{path}: not valid YAML: {exc}") from None
+    doc = _parse_yaml(path, _read_text(path))
     if doc is None:
         raise ProjectError(f"{path}: the project file is empty")
     r.mapping(doc, "", {"name": False, "description": False, "models": True, "simulator": False})
@@ -217,15 +284,19 @@ def load_project(path: str | Path) -> Project:
             if not isinstance(description, str) or not TOPIC_PATTERN.match(description):
                 raise r.fail(
                     f"{key}.description",
-                    f"expected a topic name like /{mname}/robot_description, got {description!r}",
+                    f"expected a topic name like /{mname}/robot_description, got {_brief(description)}",
                 )
         elif "file" not in m:
             raise r.fail(f"{key}.file", "missing: give file (a model file) or description (a robot-description topic)")
         else:
             if not isinstance(m["file"], str):
-                raise r.fail(f"{key}.file", f"expected a path, got {m['file']!r}")
-            mfile = (path.parent / m["file"]).resolve()
-            if not mfile.is_file():
+                raise r.fail(f"{key}.file", f"expected a path, got {_brief(m['file'])}")
+            try:
+                mfile = (path.parent / m["file"]).resolve()
+                found = mfile.is_file()
+            except (OSError, ValueError, RuntimeError) as exc:  # a NUL byte, a name too long, a symlink loop
+                raise r.fail(f"{key}.file", f"not a usable path: {_brief(m['file'])} ({exc})") from None
+            if not found:
                 raise r.fail(f"{key}.file", f"no such model file: {mfile}")
         entry = ModelEntry(
             name=mname,
@@ -255,7 +326,7 @@ def load_project(path: str | Path) -> Project:
         r.mapping(s, "simulator", {"time_step": False, "realtime_sync": False, "gravity": False})
         rt = s.get("realtime_sync", True)
         if not isinstance(rt, bool):
-            raise r.fail("simulator.realtime_sync", f"expected true or false, got {rt!r}")
+            raise r.fail("simulator.realtime_sync", f"expected true or false, got {_brief(rt)}")
         simulator = SimulatorSettings(
             time_step=r.number(s.get("time_step", 0.001), "simulator.time_step", positive=True),
             realtime_sync=rt,
@@ -273,15 +344,16 @@ def load_project(path: str | Path) -> Project:
 
 def _import_controller(r: _Reader, spec: Any, key: str) -> type:
     if not isinstance(spec, str) or spec.count(":") != 1:
-        raise r.fail(key, f"expected 'module:Class', got {spec!r}")
+        raise r.fail(key, f"expected 'module:Class', got {_brief(spec)}")
     module_name, class_name = spec.split(":")
     try:
         module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise r.fail(key, f"cannot import module {module_name!r}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - ImportError, and whatever the named module raises as it loads
+        detail = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise r.fail(key, f"cannot import module {_brief(module_name)}: {detail}") from None
     cls = getattr(module, class_name, None)
     if not (isinstance(cls, type) and issubclass(cls, SimpleController)):
-        raise r.fail(key, f"{module_name} has no SimpleController subclass named {class_name!r}")
+        raise r.fail(key, f"{module_name} has no SimpleController subclass named {_brief(class_name)}")
     return cls
 
 
@@ -305,13 +377,13 @@ def check_parameter(typ: type, value: Any, fail) -> Any:
         whatever ``fail(message)`` returns, when ``value`` is not a ``typ``.
     """
     if typ is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise fail(f"expected a finite number, got {value!r}")
+        if not _is_finite_number(value):
+            raise fail(f"expected a finite number, got {_brief(value)}")
         return float(value)
     if typ is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise fail(f"expected an integer, got {value!r}")
+            raise fail(f"expected an integer, got {_brief(value)}")
         return value
     if not isinstance(value, typ):
-        raise fail(f"expected {typ.__name__}, got {value!r}")
+        raise fail(f"expected {typ.__name__}, got {_brief(value)}")
     return value

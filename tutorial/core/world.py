@@ -12,6 +12,11 @@ of a model a stable name (the rule is in its docstring): in the world, every
 element of a model is then named ``<model name>/...``, and the world's
 top-level bodies so named are the model's roots (:class:`tutorial.core.body.Body`
 owns their kinematic subtrees).
+
+A model file MuJoCo cannot load (an XML error, junk bytes, a mesh it cannot
+find) or one with nothing in it is a bad *file*, not a failed simulation:
+:func:`build_world` raises :class:`ModelError`, one line naming the file
+(``rtt-run`` exits with status 2 for it).
 """
 
 from __future__ import annotations
@@ -28,6 +33,27 @@ import mujoco
 # owns by its kinematic tree (bodies, and what hangs on them), and the one
 # whose name goes on the wire (joints).  (MjSpec list attribute, name stem.)
 NAMED_KINDS = (("bodies", "body"), ("joints", "joint"), ("geoms", "geom"), ("sites", "site"))
+
+
+class ModelError(ValueError):
+    """A model file that cannot be loaded, or models that do not compile together.
+
+    Attributes:
+        entry: the :class:`ModelEntry` at fault, or None when no one file is
+            (the models load alone but not together).
+
+    The message is one line: the file, then MuJoCo's reason.
+    """
+
+    def __init__(self, message: str, entry: ModelEntry | None = None):
+        super().__init__(message)
+        self.entry = entry
+
+
+def _reason(exc: BaseException) -> str:
+    """MuJoCo's error text (often several lines: the error, then the element and line) as one line."""
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    return "; ".join(lines)[:300] or type(exc).__name__
 
 
 @dataclass
@@ -73,8 +99,9 @@ def build_world(
         :func:`name_unnamed_elements`.
 
     Raises:
-        ValueError: a model file does not parse or the world does not compile
-            (MuJoCo's message, with the file name).
+        ModelError: a model file does not load, does not compile, or has no
+            body, geom or site; or the models do not compile together
+            (MuJoCo's message, in one line, with the file name).
 
     Any thread may call this; the returned model is read-only for everyone.
     """
@@ -87,30 +114,78 @@ def build_world(
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.compiler.degree = False
     for entry in entries:
-        source = entry.file if entry.text is None else f"model {entry.name} ({entry.description or 'text'})"
-        if entry.text is None and entry.file is None:
-            raise ValueError(f"model {entry.name}: no model file, and its description {entry.description} not received")
-        try:
-            if entry.text is not None:
-                child = mujoco.MjSpec.from_string(entry.text)
-            else:
-                child = mujoco.MjSpec.from_file(str(entry.file))
-        except Exception as exc:  # mujoco raises ValueError with the parser's text
-            raise ValueError(f"{source}: {exc}") from exc
-        name_unnamed_elements(child)
+        child = _load(entry)
         half = entry.yaw / 2.0
         frame = spec.worldbody.add_frame(pos=list(entry.position), quat=[math.cos(half), 0.0, 0.0, math.sin(half)])
-        with warnings.catch_warnings():
-            # MuJoCo warns when a child's <option> differs from the world's;
-            # the world's (the project's) settings are the ones we want.
-            warnings.simplefilter("ignore")
-            spec.attach(child, prefix=f"{entry.name}/", frame=frame)
+        try:
+            with warnings.catch_warnings():
+                # MuJoCo warns when a child's <option> differs from the world's;
+                # the world's (the project's) settings are the ones we want.
+                warnings.simplefilter("ignore")
+                spec.attach(child, prefix=f"{entry.name}/", frame=frame)
+        except Exception as exc:  # noqa: BLE001 - MuJoCo's own errors, each a property of the file
+            raise ModelError(f"{entry.file}: cannot be added to the world: {_reason(exc)}", entry) from None
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return spec.compile()
-    except Exception as exc:
-        raise ValueError(f"the world does not compile: {exc}") from exc
+            model = spec.compile()
+    except Exception as exc:  # noqa: BLE001 - find the file at fault, if one is
+        for entry in entries:
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    _load(entry).compile()
+            except Exception as alone:  # noqa: BLE001
+                raise ModelError(f"{entry.file}: does not compile: {_reason(alone)}", entry) from None
+        raise ModelError(f"the models do not compile together: {_reason(exc)}") from None
+    for entry in entries:
+        if not _has_elements(model, f"{entry.name}/"):
+            raise ModelError(f"{entry.file}: the model has no body, geom or site: nothing to simulate or show", entry)
+    return model
+
+
+def _load(entry: ModelEntry) -> mujoco.MjSpec:
+    """The model parsed (its file, or its text), its unnamed elements named; :class:`ModelError` if MuJoCo cannot
+    read it, or a description-only entry's text has not been received."""
+    if entry.text is not None:
+        try:
+            child = mujoco.MjSpec.from_string(entry.text)
+            name_unnamed_elements(child)
+        except Exception as exc:  # noqa: BLE001 - mujoco raises ValueError with the parser's text
+            raise ModelError(
+                f"model {entry.name} ({entry.description or 'text'}): not a model MuJoCo can load: {_reason(exc)}",
+                entry,
+            ) from None
+        return child
+    if entry.file is None:
+        raise ModelError(
+            f"model {entry.name}: no model file, and its description {entry.description} not received", entry
+        )
+    try:
+        # MJCF is XML in UTF-8; a name in another encoding would load, then fail where Python reads it.
+        Path(entry.file).read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ModelError(
+            f"{entry.file}: not UTF-8 text (byte {exc.start}): an MJCF file is XML in UTF-8", entry
+        ) from None
+    except (OSError, ValueError) as exc:
+        raise ModelError(f"{entry.file}: cannot read it: {_reason(exc)}", entry) from None
+    try:
+        child = mujoco.MjSpec.from_file(str(entry.file))
+        name_unnamed_elements(child)
+    except Exception as exc:  # noqa: BLE001 - mujoco raises ValueError with the parser's text
+        raise ModelError(f"{entry.file}: not a model MuJoCo can load: {_reason(exc)}", entry) from None
+    return child
+
+
+def _has_elements(model: mujoco.MjModel, prefix: str) -> bool:
+    """Whether any top-level body, or any geom or site, of the world is named ``<prefix>...``."""
+    kinds = (
+        (mujoco.mjtObj.mjOBJ_BODY, range(1, model.nbody)),
+        (mujoco.mjtObj.mjOBJ_GEOM, range(model.ngeom)),
+        (mujoco.mjtObj.mjOBJ_SITE, range(model.nsite)),
+    )
+    return any((mujoco.mj_id2name(model, kind, i) or "").startswith(prefix) for kind, ids in kinds for i in ids)
 
 
 def name_unnamed_elements(spec: mujoco.MjSpec) -> int:

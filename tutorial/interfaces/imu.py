@@ -131,7 +131,10 @@ def check_imu(msg, frame_id: str):
     gyro = np.array([w.x, w.y, w.z], dtype=float)
     if not (np.isfinite(accel).all() and np.isfinite(gyro).all()):
         return None, None, "not_finite"
-    if np.linalg.norm(accel) > ACCEL_LIMIT or np.linalg.norm(gyro) > GYRO_LIMIT:
+    # A norm past 1.8e308 overflows to inf, which is absurd: no numpy warning for it.
+    with np.errstate(over="ignore"):
+        absurd = np.linalg.norm(accel) > ACCEL_LIMIT or np.linalg.norm(gyro) > GYRO_LIMIT
+    if absurd:
         return None, None, "absurd"
     if msg.header.frame_id not in ("", frame_id):
         return None, None, "wrong_frame"

@@ -160,6 +160,32 @@ def init(args: Sequence[str] | None = None):
     return remove_ros_args(list(args) if args is not None else None)
 
 
+def remove_ros_args_or_fail(args: Sequence[str]) -> list[str]:
+    """The command line without its ROS arguments, for argparse; a bad ROS argument is one clear error.
+
+    rcl parses ``--ros-args ...`` (``-r from:=to``, ``-p name:=value``...);
+    ``rclpy.utilities.remove_ros_args`` raises its own exception types for a
+    malformed rule, and ``rclpy.init`` would fail the same way.  A program
+    calls this first, so a typo there ends in one line and exit status 2,
+    not a traceback.
+
+    Args:
+        args: ``sys.argv`` style, the program name first.
+
+    Raises:
+        ValueError: a ROS argument rcl does not accept; the text says which, in one line.
+
+    Any thread may call it; it needs no ``rclpy.init``.
+    """
+    from rclpy.utilities import remove_ros_args
+
+    try:
+        return list(remove_ros_args(list(args)))
+    except Exception as exc:  # noqa: BLE001 - rclpy's RCLInvalidROSArgsError, UnknownROSArgsError, ...
+        detail = str(exc).split(", at /")[0].splitlines()[0] if str(exc) else type(exc).__name__
+        raise ValueError(f"bad ROS arguments after --ros-args: {detail}") from None
+
+
 def ignore_stop_signals() -> None:
     """Ignore further Ctrl-C and SIGTERM while the program cleans up (main thread, at the start of clean-up).
 

@@ -11,7 +11,9 @@ On exit it prints a summary (``--json``: one JSON object per line for every
 status line and the summary).
 
 Exit status: 0 on a clean end or Ctrl-C/SIGTERM, 1 when a controller or the
-simulation failed, 2 for a bad command line or project file.
+simulation failed, 2 for a bad command line (ROS arguments included), a bad
+project file or a model file it names that MuJoCo cannot load: one line on
+stderr names the file and, where it can, the key.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import sys
 
 from tutorial.core.app import DEFAULT_NODE_NAME, App, ControllerError
 from tutorial.core.project import ProjectError, load_project
+from tutorial.core.world import ModelError
 from tutorial.ros import env as ros_env
 from tutorial.view.status import format_status
 
@@ -138,20 +141,35 @@ def _stop_on_signal(app: App) -> None:
     signal.signal(signal.SIGTERM, handler)
 
 
+def _fail(text: str, status: int) -> int:
+    """One line on stderr (a line break in a name or a message is written as ``\\n``); the exit status."""
+    print("rtt-run: " + " \\n ".join(text.splitlines()), file=sys.stderr, flush=True)
+    return status
+
+
+def _model_key(project, exc: ModelError) -> str:
+    """``<project>: models[i].file: `` for the model at fault, or the project alone."""
+    for i, entry in enumerate(project.models):
+        if entry is exc.entry:
+            return f"{project.path}: models[{i}].file: "
+    return f"{project.path}: models: "
+
+
 def main(argv: list[str] | None = None) -> int:
     """``rtt-run``: parse the command line, run the project, print the summary; the exit status (main thread)."""
-    from rclpy.utilities import remove_ros_args
-
     argv = list(sys.argv if argv is None else argv)
-    args = build_parser().parse_args(remove_ros_args(argv)[1:])
+    try:
+        plain = ros_env.remove_ros_args_or_fail(argv)
+    except ValueError as exc:
+        return _fail(str(exc), 2)
+    args = build_parser().parse_args(plain[1:])
     if args.duration is not None and not args.duration > 0:
         build_parser().error("--duration must be > 0")
     output = make_output(args.json)
     try:
         project = load_project(args.project)
     except ProjectError as exc:
-        print(f"rtt-run: {exc}", file=sys.stderr)
-        return 2
+        return _fail(str(exc), 2)
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.signals import SignalHandlerOptions
@@ -173,9 +191,10 @@ def main(argv: list[str] | None = None) -> int:
         app.run()
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ModelError as exc:  # a bad model file: the project's fault, like a bad key
+        status = _fail(_model_key(project, exc) + str(exc), 2)
     except (ControllerError, ValueError, RuntimeError) as exc:
-        print(f"rtt-run: {exc}", file=sys.stderr)
-        status = 1
+        status = _fail(str(exc), 1)
     finally:
         ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
         try:

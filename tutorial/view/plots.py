@@ -14,6 +14,8 @@ import threading
 from tutorial.interfaces.joint_state import joint_state_qos
 from tutorial.interfaces.timing import stamp_seconds
 
+MAX_POSITION = 1e6  # rad or m: a larger position is a broken publisher's
+
 
 class JointStateHistory:
     """Collects (stamp, positions) from a JointState topic.
@@ -25,6 +27,11 @@ class JointStateHistory:
         node: the ``rclpy`` node.
         topic: e.g. ``/Tank/joint_state``.
         max_samples: oldest samples are dropped beyond this many.
+
+    A position that is not finite or is beyond :data:`MAX_POSITION` (a broken
+    publisher: no joint turns a million radians) is not kept; each is counted
+    in :attr:`rejected`.  Kept, it would stretch the plot's axis until every
+    real line lay flat.
     """
 
     def __init__(self, node, topic: str, max_samples: int = 100_000):
@@ -32,13 +39,16 @@ class JointStateHistory:
 
         self._lock = threading.Lock()
         self.samples: list[tuple[float, dict[str, float]]] = []
+        self.rejected = 0  # positions not kept (see above); under the lock
         self.max_samples = max_samples
         self.subscription = node.create_subscription(JointState, topic, self.on_message, joint_state_qos())
 
     def on_message(self, msg) -> None:
         t = stamp_seconds(msg.header.stamp)
-        values = {n: float(p) for n, p in zip(msg.name, msg.position)}
+        values = {n: float(p) for n, p in zip(msg.name, msg.position) if abs(p) <= MAX_POSITION}  # NaN fails too
+        rejected = min(len(msg.name), len(msg.position)) - len(values)
         with self._lock:
+            self.rejected += rejected
             self.samples.append((t, values))
             if len(self.samples) > self.max_samples:
                 del self.samples[: len(self.samples) - self.max_samples]

@@ -64,6 +64,17 @@ class ViewerStatus:
         self.rejections.update(rejected)
         self.last_positions.update(positions)
 
+    def late_state_shown(self, arrival: float | None, matched: int, positions: dict[str, float]) -> None:
+        """A late joiner's state (kept by a transient-local publisher from before the viewer started) is shown.
+
+        The status line then gives its age and the joints it matched, as
+        for a live state; the count of live states applied, the rate and
+        the stale watch are left to live states (main thread).
+        """
+        self.applied_arrival = arrival
+        self.matched = matched
+        self.last_positions.update(positions)
+
     def check_stale(self) -> list[dict]:
         """A ``stale`` or ``recovered`` record when the view changed between live and stale, else none (main thread)."""
         with self._lock:
