@@ -182,19 +182,14 @@ class App:
         waiting = [m for m in self.project.models if m.description is not None and m.text is None]
         if not waiting:
             return
-        from tutorial.interfaces.robot_description import DescriptionError, receive_robot_description
-        from tutorial.urdf.kinematics import UrdfKinematics
-        from tutorial.urdf.mujoco_load import mujoco_text
+        from tutorial.interfaces.robot_description import receive_robot_description
+        from tutorial.urdf.mujoco_load import load_description
 
         models = list(self.project.models)
         fqn = self.node.get_fully_qualified_name()
         for entry in waiting:
             urdf = receive_robot_description(self.node, entry.description, self.description_timeout)
-            try:
-                tree = UrdfKinematics(urdf)
-                text, dropped = mujoco_text(urdf)
-            except ValueError as exc:
-                raise DescriptionError(f"{entry.description}: {exc}") from None
+            text, dropped, tree = load_description(urdf, entry.description)
             models[models.index(entry)] = dataclasses.replace(entry, text=text)
             note = f"; {dropped} mesh visuals left out (package:// names need ROS)" if dropped else ""
             self.output(

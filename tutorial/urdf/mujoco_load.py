@@ -63,3 +63,28 @@ def mujoco_text(urdf: str) -> tuple[str, int]:
     extension = etree.SubElement(root, "mujoco")
     etree.SubElement(extension, "compiler", attrib=COMPILER)
     return etree.tostring(root, encoding="unicode"), dropped
+
+
+def load_description(urdf: str, source: str):
+    """A received robot description, checked all the way to MuJoCo's text: ``(text, visuals dropped, tree)``.
+
+    What a viewer does with ``std_msgs/String.data`` from a description
+    topic: :func:`tutorial.interfaces.robot_description.check_robot_description`,
+    then the joint tree (:class:`tutorial.urdf.kinematics.UrdfKinematics`)
+    and :func:`mujoco_text`.  ``tree`` says how many links and moving joints
+    it has.  Any thread.
+
+    Raises:
+        tutorial.interfaces.robot_description.DescriptionError: any of those
+            refused it; the message names ``source`` (the topic) and why.
+    """
+    from tutorial.interfaces.robot_description import DescriptionError, check_robot_description
+    from tutorial.urdf.kinematics import UrdfKinematics
+
+    check_robot_description(urdf, source)
+    try:
+        tree = UrdfKinematics(urdf)
+        text, dropped = mujoco_text(urdf)
+    except ValueError as exc:
+        raise DescriptionError(f"{source}: {exc}") from None
+    return text, dropped, tree
