@@ -1,4 +1,4 @@
-"""The operator's side of ``benchmarks.network``: what arrived, when, and how big.
+"""The operator's side of ``benchmarks.experiments.network``: what arrived, when, and how big.
 
     python -m benchmarks.net_probe camera --transport compressed --duration S --out FILE
     python -m benchmarks.net_probe bytes --duration S --out FILE TOPIC:TYPE [TOPIC:TYPE ...]

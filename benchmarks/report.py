@@ -160,6 +160,11 @@ def print_report(r: dict) -> None:
                 f"bare send->drawn {bare['sent_to_drawn']['p50']}/{bare['sent_to_drawn']['p99']}, "
                 f"{bare['frames_per_s']} frames/s"
             )
+    if r.get("network"):
+        from benchmarks.experiments.network import print_table
+
+        print("\n== across hosts (two network namespaces; benchmarks.experiments.network)")
+        print_table(r["network"])
     print("\n== targets")
     for t in r["targets"]:
         figure = (

@@ -40,6 +40,8 @@ class Target:
     baseline, if given, is shown for reference), ``"times"`` (the limit
     times the baseline), ``"plus"`` (the limit plus the baseline), or
     ``"ratio"`` (not the figure: ``ratio(r)`` is held against the limit).
+    With ``"times"``, ``offset`` is added to the bound (``{offset}`` in the
+    text writes it).
     A figure, baseline or ratio that is None was not measured: "n/a", a fail.
     """
 
@@ -47,7 +49,7 @@ class Target:
     limit: float
     compare: Callable[[float, float], bool]  # AT_MOST or AT_LEAST: compare(figure, what it is held against)
     figure: Callable[[dict], float | None]  # run results -> the measured figure
-    fmt: str  # the figure written, e.g. "{:.3f} ms"
+    fmt: str | Callable[[object], str]  # the figure written: a format, e.g. "{:.3f} ms", or a function
     against: str = "limit"  # "limit", "times", "plus" or "ratio" (see above)
     baseline: Callable[[dict], float | None] | None = None  # run results -> the same-run baseline, same unit
     baseline_fmt: str | None = None  # the baseline written (None: as `fmt`)
@@ -55,6 +57,7 @@ class Target:
     ratio_fmt: str = "{:.2f}x"
     limit_fmt: str = "{:g}"
     needs: str | None = None  # a key of the run results without which the target is left out ("scale")
+    offset: float = 0.0  # with "times": the figure is held against limit x baseline + offset
 
     @property
     def limit_text(self) -> str:
@@ -64,7 +67,11 @@ class Target:
     @property
     def label(self) -> str:
         """The target's words, its limit written in."""
-        return self.text.format(limit=self.limit_text)
+        return self.text.format(limit=self.limit_text, offset=f"{self.offset:g}")
+
+    def written(self, value) -> str:
+        """A figure as the row writes it."""
+        return self.fmt(value) if callable(self.fmt) else self.fmt.format(value)
 
     def row(self, r: dict) -> dict:
         """The table's row for run results ``r``: target, measured, baseline, ratio (text) and pass (bool)."""
@@ -84,15 +91,20 @@ class Target:
         elif base is None:
             baseline = "n/a"
         else:
-            baseline = (self.baseline_fmt or self.fmt).format(base)
+            baseline = self.baseline_fmt.format(base) if self.baseline_fmt else self.written(base)
             if self.against == "plus":
                 baseline = f"{self.limit_text} + {baseline}"
         return {
             "target": self.label,
-            "measured": "n/a" if value is None else self.fmt.format(value),
+            "measured": "n/a" if value is None else self.written(value),
             "baseline": baseline,
             "ratio": "" if ratio is None else self.ratio_fmt.format(ratio),
-            "pass": held is not None and bool(self.compare(held, BOUNDS[self.against](self.limit, base))),
+            "pass": held is not None
+            and bool(
+                self.compare(
+                    held, BOUNDS[self.against](self.limit, base) + (self.offset if self.against == "times" else 0.0)
+                )
+            ),
         }
 
 
@@ -187,6 +199,80 @@ BROWSER_TARGETS = tuple(
     ),
 )
 
+_NET = "network"
+NETWORK_TARGETS = (
+    Target(
+        "across hosts, 5 Mbit/s, camera on: remote camera >= {limit} pictures/s",
+        10.0,
+        AT_LEAST,
+        read(_NET, "5mbit", "camera_per_s"),
+        "{:.1f} pictures/s",
+        needs=_NET,
+    ),
+    Target(
+        "across hosts, 5 Mbit/s, camera on: joint-state age p99 at the remote monitor <= {limit}x the clean link's "
+        "p99 + {offset} ms",
+        2.0,
+        AT_MOST,
+        read(_NET, "5mbit", "age_p99_ms"),
+        "{:.2f} ms",
+        against="times",
+        offset=5.0,
+        baseline=read(_NET, "clean", "age_p99_ms"),
+        baseline_fmt="clean link {:.2f} ms",
+        needs=_NET,
+    ),
+    Target(
+        "across hosts, 20 % loss: the monitor applies >= {limit} states/s",
+        40.0,
+        AT_LEAST,
+        read(_NET, "loss20", "states_per_s"),
+        "{:.1f} states/s",
+        baseline=read(_NET, "clean", "states_per_s"),
+        baseline_fmt="clean link {:.1f} states/s",
+        needs=_NET,
+    ),
+    Target(
+        "across hosts, 20 % loss: the monitor ends on the simulation's final state",
+        1.0,
+        AT_LEAST,
+        lambda r: float(r[_NET]["loss20"]["ends_exact"]),
+        lambda exact: "yes" if exact else "no",
+        needs=_NET,
+    ),
+    Target(
+        "across hosts, 4 s partition: stale within {limit} s of the cut",
+        1.25,
+        AT_MOST,
+        read(_NET, "partition", "stale_after_s"),
+        "{:.2f} s",
+        needs=_NET,
+    ),
+    Target(
+        "across hosts, 4 s partition: live within {limit} s of the heal",
+        2.0,
+        AT_MOST,
+        read(_NET, "partition", "live_after_s"),
+        "{:.2f} s",
+        needs=_NET,
+    ),
+) + tuple(
+    Target(
+        f"across hosts, {words}: the simulation keeps real time (real-time factor >= {{limit}})",
+        0.98,
+        AT_LEAST,
+        read(_NET, case, "real_time_factor"),
+        "{:.3f}",
+        needs=_NET,
+    )
+    for case, words in (
+        ("clean", "clean link"),
+        ("loss20", "20 % loss"),
+        ("5mbit", "5 Mbit/s"),
+        ("partition", "partition"),
+    )
+)
+
 TARGETS = (
     Target(
         "simulation with the 50 Hz publisher >= {limit}x bare mj_step (steps/s)",
@@ -241,6 +327,7 @@ TARGETS = (
     SCALE_FRAMES,
     SCALE_AGE,
     SCALE_CPU,
+    *NETWORK_TARGETS,
     *BROWSER_TARGETS,
 )
 

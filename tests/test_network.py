@@ -3,7 +3,7 @@
 Two hosts (``tests/netns.py``): the simulation runs on ``robot``; the Step 3
 monitor and the demo joystick run on ``operator``.  Faults are put on the
 robot's link.  Every wait has a deadline; the bounds on time are loose (the
-machine is shared): the benchmark (``python -m benchmarks.network``)
+machine is shared): the benchmark (``python -m benchmarks.experiments.network``)
 measures them.
 """
 

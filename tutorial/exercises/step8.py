@@ -28,7 +28,7 @@ PICTURES = 12  # rendered for the check, along the turret's swing
 def check_lossy_link_qos(func) -> Result:
     """Check ``func() -> QoSProfile`` for the monitor's live joint-state subscription on a lossy link.
 
-    What ``python -m benchmarks.network`` measured at 20 % loss: a reliable
+    What ``python -m benchmarks.experiments.network`` measured at 20 % loss: a reliable
     monitor applied 39.4 states/s, a best-effort one 39.9 (50 are sent; 40
     get through): the Step 2 publisher keeps only its newest state, so
     reliability cannot bring lost states back, and costs nothing either;

@@ -27,13 +27,13 @@ picture takes 4 to 30 ms to *render*, so either is lost in that.  Pillow
 also writes PNG (2.6 ms at compression level 1), is already installed
 (matplotlib needs it) and is one of Python's best-kept libraries: Pillow it
 is.  (PyTurboJPEG needs the system's libjpeg-turbo 3, which Debian 12 does
-not have.)  ``python -m benchmarks.network --encoders`` measures it again.
+not have.)  ``python -m benchmarks.experiments.network --encoders`` measures it again.
 
 **Sharing a thin link with the joint states.**  A raw 320 x 240 rgb8 picture
 is 230 400 bytes: 55 Mbit/s at 30 Hz, ten times a 5 Mbit/s link; the link's
 queue fills, every state waits in it, and hardly a picture arrives whole.
 What keeps the joint states flowing is a budget of three parts, each
-measured by ``python -m benchmarks.network``:
+measured by ``python -m benchmarks.experiments.network``:
 
 1. *Only what is subscribed crosses the link.*  DDS sends a sample only to
    the readers that matched it, and the publisher encodes a compressed

@@ -1,8 +1,8 @@
 """Across the network: the robot on one host, the operator's monitor and camera viewer on another.
 
-    python -m benchmarks.network [--seconds 14] [--cases clean,loss20,5mbit,partition,5mbit_raw]
-    python -m benchmarks.network --bandwidth     # each topic's bandwidth at its default rate
-    python -m benchmarks.network --encoders      # Pillow against simplejpeg on the camera's pictures
+    python -m benchmarks.experiments.network [--seconds 14] [--cases clean,loss20,5mbit,partition,5mbit_raw]
+    python -m benchmarks.experiments.network --bandwidth     # each topic's bandwidth at its default rate
+    python -m benchmarks.experiments.network --encoders      # Pillow against simplejpeg on the camera's pictures
 
 Two hosts (:class:`tutorial.network.hosts.Network`, network namespaces joined by
 a switch; root only).  On ``robot``: the simulation with the tank's joystick
@@ -30,10 +30,9 @@ and back to ``live`` after the heal, camera pictures per second at the viewer
 and their age (to the end of decoding), whether the monitor ended on the
 simulation's final state, and the simulation's real-time factor.
 
-:func:`measure` returns the figures as a dict; :data:`TARGETS` holds the
-targets as data and :func:`check` grades figures against them (for ``make
-bench``'s table).  The machine is shared while it runs: the lead engineer
-takes the final figures on a quiet one.
+:func:`measure` returns the figures as a dict (``make bench`` keeps them as
+``latest.json``'s ``network``); the targets are data in
+:data:`benchmarks.targets.NETWORK_TARGETS`.
 """
 
 from __future__ import annotations
@@ -52,7 +51,10 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
+from benchmarks.paths import ROOT
+from benchmarks.procs import py
+from benchmarks.stats import pct
+
 SIM_PROJECT = "benchmarks/projects/tank_net_sim.yaml"
 VIEW_PROJECT = "benchmarks/projects/tank_view.yaml"
 CASES = {  # in the order they run; the raw flood last, so nothing of it can linger into another case
@@ -65,39 +67,6 @@ CASES = {  # in the order they run; the raw flood last, so nothing of it can lin
 }
 PARTITION_AFTER = 3.0  # s after the monitor's first state
 STARTUP_TIMEOUT = 60.0  # s for the monitor's first state
-
-# The targets, as data: (name, case, figure, comparison, bound).  A bound is a number, or
-# ("clean", figure, factor, offset): factor x the same run's clean-link figure + offset.
-TARGETS = [
-    ("5 Mbit/s, camera on: remote camera >= 10 pictures/s", "5mbit", "camera_per_s", ">=", 10.0),
-    (
-        "5 Mbit/s, camera on: joint-state age p99 at the remote monitor <= 2x the clean link's p99 + 5 ms",
-        "5mbit",
-        "age_p99_ms",
-        "<=",
-        ("clean", "age_p99_ms", 2.0, 5.0),
-    ),
-    ("20 % loss: the monitor applies >= 40 states/s", "loss20", "states_per_s", ">=", 40.0),
-    ("20 % loss: the monitor ends on the simulation's final state", "loss20", "ends_exact", "==", True),
-    ("4 s partition: stale within 1.25 s of the cut", "partition", "stale_after_s", "<=", 1.25),
-    ("4 s partition: live within 2 s of the heal", "partition", "live_after_s", "<=", 2.0),
-] + [
-    (f"{case}: the simulation keeps real time (real-time factor >= 0.98)", case, "real_time_factor", ">=", 0.98)
-    for case in ("clean", "loss20", "5mbit", "partition")
-]
-
-
-def pct(values, scale: float = 1.0) -> dict:
-    """p50/p99/max of ``values`` times ``scale``, rounded (empty: None)."""
-    if len(values) == 0:
-        return {"n": 0, "p50": None, "p99": None, "max": None}
-    a = np.asarray(values, dtype=float) * scale
-    return {
-        "n": int(a.size),
-        "p50": round(float(np.percentile(a, 50)), 2),
-        "p99": round(float(np.percentile(a, 99)), 2),
-        "max": round(float(a.max()), 2),
-    }
 
 
 class Program:
@@ -150,10 +119,6 @@ class Program:
             self.p.wait()
         self._reader.join(5)
         return self.p.returncode
-
-
-def py(module: str, *args: str) -> list[str]:
-    return [sys.executable, "-u", "-m", module, *args]
 
 
 def viewer_record(line: str) -> dict | None:
@@ -322,37 +287,6 @@ def measure(seconds: float = 14.0, cases=tuple(CASES)) -> dict:
     return results
 
 
-def check(results: dict) -> list[dict]:
-    """Each target of :data:`TARGETS` against ``results``: name, measured, baseline, ratio, pass."""
-    rows = []
-    for name, case, key, op, bound in TARGETS:
-        if case not in results:
-            continue
-        measured = results[case].get(key)
-        baseline = None
-        if isinstance(bound, tuple):
-            base_case, base_key, factor, offset = bound
-            baseline = results.get(base_case, {}).get(base_key)
-            bound = None if baseline is None else factor * baseline + offset
-        if measured is None or bound is None:
-            ok = False
-        elif op == ">=":
-            ok = measured >= bound
-        elif op == "<=":
-            ok = measured <= bound
-        else:
-            ok = measured == bound
-        ratio = (
-            round(measured / bound, 2)
-            if isinstance(measured, (int, float)) and not isinstance(measured, bool) and bound
-            else None
-        )
-        rows.append(
-            {"target": name, "measured": measured, "bound": bound, "baseline": baseline, "ratio": ratio, "pass": ok}
-        )
-    return rows
-
-
 def print_table(results: dict) -> None:
     clean = results.get("clean")
     print("\nAcross hosts (robot -> operator), each beside the same run's clean link:")
@@ -375,12 +309,6 @@ def print_table(results: dict) -> None:
         print(row(r))
         if clean is not None and name != "clean":
             print(row(clean).replace("clean             ", "  (clean)         ", 1))
-    print("\ntargets:")
-    for t in check(results):
-        print(
-            f"  [{'PASS' if t['pass'] else 'FAIL'}] {t['target']}: measured {t['measured']}, "
-            f"bound {t['bound']}" + (f" (clean {t['baseline']})" if t["baseline"] is not None else "")
-        )
 
 
 # ---------------------------------------------------------------- bandwidth of each topic
@@ -555,7 +483,15 @@ def main(argv=None) -> int:
             p.error(f"unknown cases {sorted(unknown)}")
         result = measure(args.seconds, cases)
         print_table(result)
-        result = {"cases": result, "targets": check(result)}
+        from benchmarks.targets import NETWORK_TARGETS
+
+        print("\ntargets:")
+        for row in (target.row({"network": result}) for target in NETWORK_TARGETS):
+            print(
+                f"  [{'PASS' if row['pass'] else 'FAIL'}] {row['target']}: {row['measured']}"
+                + (f" vs {row['baseline']}" if row["baseline"] else "")
+            )
+        result = {"cases": result}
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=2))
     return 0
