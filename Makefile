@@ -60,7 +60,10 @@ run-notebooks: $(VENV)/.installed
 book: $(VENV)/.installed
 	$(VENV)/bin/jupyter-book build book --warningiserror --keep-going
 
+# The browser experiment needs Chromium, the cross-host one nftables (it skips, saying why, when not root).
 bench: $(VENV)/.installed
+	bash scripts/ensure-chromium.sh
+	bash scripts/ensure-nftables.sh
 	$(PY) -m benchmarks.run
 
 clean:

@@ -141,7 +141,12 @@ def print_report(r: dict) -> None:
                     f"(every frame: {s['displayed_age_ms']['p99']:.2f}); CPU {parts}"
                 )
     if r.get("browser"):
-        print("\n== publish -> pixel in headless Chromium (ms, p50/p99 per stage; bare: the same commands replayed)")
+        from benchmarks.experiments.browser import VIEWPORT
+
+        print(
+            f"\n== publish -> pixel in headless Chromium, {VIEWPORT['width']}x{VIEWPORT['height']} px, SwiftShader "
+            "(ms, p50/p99 per stage; bare: the same commands replayed)"
+        )
         for case, b in r["browser"].items():
             tut, bare = b["tutorial"], b["bare"]
             stages = ", ".join(
@@ -156,7 +161,8 @@ def print_report(r: dict) -> None:
             )
             print(
                 f"  {case}: publish->drawn {tut['publish_to_drawn']['p50']}/{tut['publish_to_drawn']['p99']} "
-                f"({tut['states_drawn']} states drawn; {stages}); page {tut['frames_per_s']} frames/s; "
+                f"({tut['states_drawn']} states drawn; {stages}); page {tut['frames_per_s']} frames/s, "
+                f"{tut['messages_per_s']} messages/s; "
                 f"bare send->drawn {bare['sent_to_drawn']['p50']}/{bare['sent_to_drawn']['p99']}, "
                 f"{bare['frames_per_s']} frames/s"
             )

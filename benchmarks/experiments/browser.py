@@ -19,9 +19,11 @@ drawn                     the end of the first ``viewer.render()`` (three.js) af
 ========================  ====================================================
 
 A message is recognised in the page by the CRC-32 of its bytes (the server
-forwards the bytes it was sent unchanged), in order.  The browser's clock
-(``performance.timeOrigin + performance.now()``, wall time, 0.1 ms) is turned
-into ``time.monotonic_ns()`` by this machine's offset between the two clocks.
+forwards the bytes it was sent unchanged), in order.  The page's clock
+(``performance.timeOrigin + performance.now()``, 0.1 ms) is turned into
+``time.monotonic_ns()`` by the offset between the two read from the page at
+the end of its run (:meth:`Page.clock_offset_ns`), not through this
+machine's wall clock, which a virtual machine may step during a run.
 A state the viewer never drew (at 1 kHz it draws at most 60 frames a second,
 the newest state each time) has no drawn moment and is not counted.
 
@@ -61,6 +63,12 @@ CASES = {  # name: (kind, size, publisher rate Hz)
     "tanks_8": ("tanks", 8, 50.0),
     "arm_48": ("arm", 48, 50.0),
 }
+# The page's size: one view of the notebooks' side-by-side display (380 px high, half a column wide).
+# This machine has no GPU: Chromium rasterizes with SwiftShader on the CPU, on the same two cores as the
+# simulation and the viewer, at a cost that grows with the pixels.  Measured with the bare replay of one
+# tank at 50 Hz: 60 frames/s and send -> page p50 1 to 3 ms up to 480 x 360; 57 frames/s and 20 ms at
+# 640 x 480; 25 to 39 frames/s and 34 to 41 ms at 800 x 600.  A browser with a GPU does not pay it.
+VIEWPORT = {"width": 480, "height": 380}
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
     "--no-sandbox",
@@ -120,17 +128,6 @@ window.__rtt = {msgs: [], renders: [], render_ms: [], rafs: []};
 """
 
 
-def clock_offset_ns() -> int:
-    """``time.time_ns() - time.monotonic_ns()``: adds to a monotonic time to give wall time (this machine)."""
-    pairs = []
-    for _ in range(5):
-        a = time.monotonic_ns()
-        w = time.time_ns()
-        b = time.monotonic_ns()
-        pairs.append((b - a, w - (a + b) // 2))
-    return min(pairs)[1]
-
-
 class Page:
     """A headless Chromium page on a meshcat URL, with :data:`PAGE_PROBE` in it (one thread only)."""
 
@@ -140,14 +137,38 @@ class Page:
         assert url.startswith("http://127.0.0.1:"), url
         self._pw = sync_playwright().start()
         self._browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        self.page = self._browser.new_page(viewport={"width": 800, "height": 600})
+        self.page = self._browser.new_page(viewport=VIEWPORT)
         self.page.add_init_script(PAGE_PROBE)
         self.page.goto(url)
         self.page.wait_for_function("window.viewer && window.viewer.__rtt_hooked", timeout=timeout_s * 1000)
 
+    def clock_offset_ns(self, tries: int = 20) -> int:
+        """The page's clock minus ``time.monotonic_ns()``, ns: subtract it from a page time (in ns) to compare.
+
+        Read from the page itself, not from this machine's wall clock: the
+        page's times are ``performance.timeOrigin + performance.now()``, which
+        moves with the monotonic clock from the page's load on, while the
+        wall clock may be stepped during a run (a virtual machine's clock
+        sync).  Of ``tries`` readings, the one with the shortest round trip
+        is kept; the uncertainty is half of it (well under 1 ms here).
+        """
+        best = None
+        for _ in range(tries):
+            a = time.monotonic_ns()
+            t = self.page.evaluate("performance.timeOrigin + performance.now()")
+            b = time.monotonic_ns()
+            if best is None or b - a < best[0]:
+                best = (b - a, round(t * 1e6) - (a + b) // 2)
+        return best[1]
+
     def samples(self) -> dict:
-        """``{"msgs": [[wall ms, crc32], ...], "renders": [wall ms], "rafs": [wall ms]}`` so far."""
-        return self.page.evaluate("window.__rtt")
+        """``{"msgs": [[ms, crc32], ...], "renders": [ms], "render_ms": [ms], "rafs": [ms], "offset_ns": ns}`` so far.
+
+        Times are the page's clock (ms); ``offset_ns`` is :meth:`clock_offset_ns`, read now.
+        """
+        samples = self.page.evaluate("window.__rtt")
+        samples["offset_ns"] = self.clock_offset_ns()
+        return samples
 
     def close(self) -> None:
         self._browser.close()
@@ -317,7 +338,7 @@ def _first_after(times: np.ndarray, t: float) -> float | None:
     return float(times[i]) if i < len(times) else None
 
 
-def analyse_tutorial(run: dict, offset_ns: int, warmup: float) -> dict:
+def analyse_tutorial(run: dict, warmup: float) -> dict:
     """Stage by stage, per state drawn (ms), for one tutorial run."""
     step_wall = {round(t / 1000): w for t, w in zip(run["sim"]["sim_ns"], run["sim"]["wall_ns"])}
     end_ns = run["sim"]["wall_ns"][-1]
@@ -328,8 +349,9 @@ def analyse_tutorial(run: dict, offset_ns: int, warmup: float) -> dict:
     transforms = [c for c in run["tape"] if c[4] is not None and c[1] == "set_transform"]
     crcs = [zlib.crc32(bytes.fromhex(c[3])) for c in transforms]
     page = run["page"]
+    offset_ns = page["offset_ns"]
     renders = np.array(sorted(page["renders"]))
-    to_mono = lambda wall_ms: wall_ms * 1e6 - offset_ns  # noqa: E731 - one line of arithmetic
+    to_mono = lambda page_ms: page_ms * 1e6 - offset_ns  # noqa: E731 - one line of arithmetic
     start_ns = min(c[0] for c in transforms) + int(warmup * 1e9)
     stages = {
         k: []
@@ -370,8 +392,9 @@ def analyse_tutorial(run: dict, offset_ns: int, warmup: float) -> dict:
     return out
 
 
-def analyse_bare(samples: dict, sent: list, offset_ns: int, warmup: float) -> dict:
+def analyse_bare(samples: dict, sent: list, warmup: float) -> dict:
     """send -> page and send -> drawn (ms) for the bare replay."""
+    offset_ns = samples["offset_ns"]
     renders = np.array(sorted(samples["renders"]))
     crcs = [c for _, c in sent]
     start_ns = sent[0][0] + int(warmup * 1e9)
@@ -392,27 +415,32 @@ def analyse_bare(samples: dict, sent: list, offset_ns: int, warmup: float) -> di
 
 
 def _page_rates(page: dict, start_ns: int, end_ns: int, offset_ns: int) -> dict:
-    """The page's frames (requestAnimationFrame) and renders per second within [start, end] (monotonic ns)."""
+    """The page's frames (requestAnimationFrame), renders and WebSocket messages per second within [start, end]
+    (monotonic ns), and the time of its render calls (ms, the whole run)."""
 
     def per_s(times):
         t = np.array([x * 1e6 - offset_ns for x in times])
         t = t[(t >= start_ns) & (t <= end_ns)]
         return round(float((len(t) - 1) / ((t[-1] - t[0]) * 1e-9)), 1) if len(t) > 1 else None
 
-    return {"frames_per_s": per_s(page["rafs"]), "renders_per_s": per_s(page["renders"])}
+    return {
+        "frames_per_s": per_s(page["rafs"]),
+        "renders_per_s": per_s(page["renders"]),
+        "messages_per_s": per_s([m[0] for m in page["msgs"]]),
+        "render_js_ms": pct(page["render_ms"], 1.0),  # three.js's render call (the rasterizing is elsewhere)
+    }
 
 
 def pixel_latency(cases: list[str], seconds: float, warmup: float) -> dict:
     """Every case: the tutorial's stages and the bare replay's, in the same run."""
-    offset = clock_offset_ns()
     out = {}
     for case in cases:
         with tempfile.TemporaryDirectory() as d:
             run = tutorial_run(case, seconds, Path(d))
         samples, sent = bare_run(run["tape"])
         out[case] = {
-            "tutorial": analyse_tutorial(run, offset, warmup),
-            "bare": analyse_bare(samples, sent, offset, warmup),
+            "tutorial": analyse_tutorial(run, warmup),
+            "bare": analyse_bare(samples, sent, warmup),
         }
     return out
 
