@@ -1,4 +1,4 @@
-"""The plots of a run: the scale curves and the 1 kHz latency distributions, as PNG files for the book."""
+"""The plots of a run: scale curves, 1 kHz latency distributions, publish -> pixel; PNG files for the book."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.experiments.browser import STAGES as BROWSER_STAGES
 from benchmarks.scale_projects import SCALE_JOINTS, SCALE_RATE, SCALE_TANKS
 from benchmarks.targets import SCALE_AGE, SCALE_CPU, SCALE_FRAMES, SCALE_REAL_TIME
 
@@ -115,15 +116,6 @@ def plot_latency(r: dict, path: Path) -> Path:
     fig.savefig(path, dpi=80)
     plt.close(fig)
     return path
-
-
-BROWSER_STAGES = (
-    ("publish_to_callback", "ROS delivery"),
-    ("callback_to_applied", "hand-off to the main thread"),
-    ("applied_to_sent", "frame pacing and scene update"),
-    ("sent_to_page", "meshcat server and WebSocket"),
-    ("page_to_drawn", "the page's next render"),
-)
 
 
 def plot_browser(r: dict, path: Path) -> Path:

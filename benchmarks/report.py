@@ -141,7 +141,7 @@ def print_report(r: dict) -> None:
                     f"(every frame: {s['displayed_age_ms']['p99']:.2f}); CPU {parts}"
                 )
     if r.get("browser"):
-        from benchmarks.experiments.browser import VIEWPORT
+        from benchmarks.experiments.browser import STAGES, VIEWPORT
 
         print(
             f"\n== publish -> pixel in headless Chromium, {VIEWPORT['width']}x{VIEWPORT['height']} px, SwiftShader "
@@ -149,16 +149,7 @@ def print_report(r: dict) -> None:
         )
         for case, b in r["browser"].items():
             tut, bare = b["tutorial"], b["bare"]
-            stages = ", ".join(
-                f"{k} {tut[k]['p50']}/{tut[k]['p99']}"
-                for k in (
-                    "publish_to_callback",
-                    "callback_to_applied",
-                    "applied_to_sent",
-                    "sent_to_page",
-                    "page_to_drawn",
-                )
-            )
+            stages = ", ".join(f"{k} {tut[k]['p50']}/{tut[k]['p99']}" for k, _ in STAGES)
             print(
                 f"  {case}: publish->drawn {tut['publish_to_drawn']['p50']}/{tut['publish_to_drawn']['p99']} "
                 f"({tut['states_drawn']} states drawn; {stages}); page {tut['frames_per_s']} frames/s, "

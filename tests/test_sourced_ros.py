@@ -4,6 +4,7 @@ Unit tier, but for the last test (a program of ours in a process of its own: cro
 
 from __future__ import annotations
 
+import os
 import sys
 
 from tutorial.ros.env import sourced_ros_installation
@@ -20,6 +21,12 @@ SOURCED = {
 def test_nothing_sourced_is_fine():
     assert sourced_ros_installation({}, OURS, VENV) is None
     assert sourced_ros_installation({"PYTHONPATH": "/home/me/src", "LD_LIBRARY_PATH": "/usr/lib"}, OURS, VENV) is None
+
+
+def test_a_pythonpath_entry_that_holds_this_environment_is_fine():
+    # the project's folder on PYTHONPATH, its .venv inside it: the rclpy found is ours
+    project = os.path.dirname(VENV)
+    assert sourced_ros_installation({"PYTHONPATH": project}, OURS, VENV) is None
 
 
 def test_the_installations_rclpy_first_is_an_error():

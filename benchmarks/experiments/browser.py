@@ -57,6 +57,13 @@ from benchmarks.scale_projects import arm_projects, tanks_projects
 from benchmarks.stats import pct
 
 FRAME_MS = 1000.0 / 60.0
+STAGES = (  # (key, what happens in it), in order: their sum is publish -> drawn
+    ("publish_to_callback", "ROS delivery"),
+    ("callback_to_applied", "hand-off to the main thread"),
+    ("applied_to_sent", "frame pacing and scene update"),
+    ("sent_to_page", "meshcat server and WebSocket"),
+    ("page_to_drawn", "the page's next render"),
+)
 CASES = {  # name: (kind, size, publisher rate Hz)
     "tank_50Hz": ("tanks", 1, 50.0),
     "tank_1kHz": ("tanks", 1, 1000.0),
@@ -353,17 +360,7 @@ def analyse_tutorial(run: dict, warmup: float) -> dict:
     renders = np.array(sorted(page["renders"]))
     to_mono = lambda page_ms: page_ms * 1e6 - offset_ns  # noqa: E731 - one line of arithmetic
     start_ns = min(c[0] for c in transforms) + int(warmup * 1e9)
-    stages = {
-        k: []
-        for k in (
-            "publish_to_callback",
-            "callback_to_applied",
-            "applied_to_sent",
-            "sent_to_page",
-            "page_to_drawn",
-            "publish_to_drawn",
-        )
-    }
+    stages = {k: [] for k in (*(key for key, _ in STAGES), "publish_to_drawn")}
     seen = set()
     for i, k in _match(page["msgs"], crcs):
         sent_ns, _, _, _, body, stamp = transforms[k]

@@ -41,11 +41,8 @@ import argparse
 import json
 import os
 import random
-import signal
-import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -54,6 +51,7 @@ import numpy as np
 from benchmarks.paths import ROOT
 from benchmarks.procs import py
 from benchmarks.stats import pct
+from tutorial.network.program import HostProgram
 
 SIM_PROJECT = "benchmarks/projects/tank_net_sim.yaml"
 VIEW_PROJECT = "benchmarks/projects/tank_view.yaml"
@@ -67,58 +65,6 @@ CASES = {  # in the order they run; the raw flood last, so nothing of it can lin
 }
 PARTITION_AFTER = 3.0  # s after the monitor's first state
 STARTUP_TIMEOUT = 60.0  # s for the monitor's first state
-
-
-class Program:
-    """A program on a host whose output lines are kept with the monotonic time each arrived."""
-
-    def __init__(self, host, argv: list[str], **env: str):
-        self.argv = argv
-        self.p = subprocess.Popen(
-            host.command(argv),
-            cwd=ROOT,
-            env=host.env(**env),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        self.lines: list[tuple[float, str]] = []
-        self._lock = threading.Lock()
-        self._reader = threading.Thread(target=self._read, daemon=True)
-        self._reader.start()
-
-    def _read(self) -> None:
-        for line in iter(self.p.stdout.readline, ""):
-            with self._lock:
-                self.lines.append((time.monotonic(), line.rstrip("\n")))
-
-    def first(self, predicate, timeout: float) -> float | None:
-        """The arrival time of the first line for which ``predicate`` holds, waiting up to ``timeout`` s."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            with self._lock:
-                for t, line in self.lines:
-                    if predicate(line):
-                        return t
-            if self.p.poll() is not None and not self._reader.is_alive():
-                return None
-            time.sleep(0.02)  # polling another process's output: a deadline loop
-        return None
-
-    def text(self) -> str:
-        with self._lock:
-            return "\n".join(line for _, line in self.lines)
-
-    def stop(self, timeout: float = 20.0) -> int:
-        if self.p.poll() is None:
-            self.p.send_signal(signal.SIGINT)
-        try:
-            self.p.wait(timeout)
-        except subprocess.TimeoutExpired:
-            self.p.kill()
-            self.p.wait()
-        self._reader.join(5)
-        return self.p.returncode
 
 
 def viewer_record(line: str) -> dict | None:
@@ -147,7 +93,7 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
     transport = spec.get("transport", "compressed")
     sim_probe, view_probe = work / f"{name}.sim.json", work / f"{name}.view.json"
     camera_out = work / f"{name}.camera.json"
-    view = Program(
+    view = HostProgram(
         operator,
         py(
             "tutorial.tools.rtt_run",
@@ -158,9 +104,9 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
             "-r",
             "__node:=rtt_viewer",
         ),
-        RTT_PROBE_FILE=str(view_probe),
+        {"RTT_PROBE_FILE": str(view_probe)},
     )
-    camera = Program(
+    camera = HostProgram(
         operator,
         py(
             "benchmarks.net_probe",
@@ -173,15 +119,15 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
             str(camera_out),
         ),
     )
-    joy = Program(operator, py("tutorial.tools.rtt_joy", "--demo"))
+    joy = HostProgram(operator, py("tutorial.tools.rtt_joy", "--demo"))
     sim = None
     try:
         if camera.first(lambda line: line.startswith("probe: subscribed"), 30) is None:
             raise RuntimeError(f"the camera probe did not start:\n{camera.text()}")
-        sim = Program(
+        sim = HostProgram(
             robot,
             py("tutorial.tools.rtt_run", SIM_PROJECT, "--headless", "--json", "--duration", str(seconds)),
-            RTT_PROBE_FILE=str(sim_probe),
+            {"RTT_PROBE_FILE": str(sim_probe)},
         )
         first = view.first(is_event("first_state"), STARTUP_TIMEOUT)
         if first is None:
@@ -196,7 +142,7 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
             robot.heal()
         if sim.p.wait(seconds + 60) != 0:
             raise RuntimeError(f"{name}: the simulation failed:\n{sim.text()}")
-        sim.stop()
+        sim.stop(20)
         # The monitor has its last state when it says stale (nothing more is coming), or 5 s on.
         stale_before = sum(1 for line in view.text().splitlines() if is_event("stale")(line))
         deadline = time.monotonic() + 5
@@ -207,7 +153,7 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
     finally:
         for program in (joy, camera, view, sim):
             if program is not None:
-                program.stop()
+                program.stop(20)
         robot.clear_faults()
     summary = next(
         json.loads(line) for line in reversed(sim.text().splitlines()) if line.startswith('{"event": "summary"')
@@ -259,8 +205,8 @@ def figures(name, spec, summary, sim_probe, view_probe, camera_out, view, cut, h
         "camera_published": summary["controllers"]["RttCameraImagePublisher"]["published"],
     }
     if cut is not None:
-        times = [t for t, line in view.lines if t >= cut and is_event("stale")(line)]
-        back = [t for t, line in view.lines if t >= healed and is_event("recovered")(line)]
+        times = [t for t, line in view.timed_lines() if t >= cut and is_event("stale")(line)]
+        back = [t for t, line in view.timed_lines() if t >= healed and is_event("recovered")(line)]
         out["stale_after_s"] = round(times[0] - cut, 3) if times else None
         out["live_after_s"] = round(back[0] - healed, 3) if back else None
     return out
@@ -343,7 +289,7 @@ def bandwidth(seconds: float = 8.0) -> dict:
     with tempfile.TemporaryDirectory(prefix="rtt-net-bw-") as tmp, Network(("robot", "operator")) as net:
         out = Path(tmp) / "bytes.json"
         robot, operator = net["robot"], net["operator"]
-        probe = Program(
+        probe = HostProgram(
             operator,
             py(
                 "benchmarks.net_probe",
@@ -356,16 +302,16 @@ def bandwidth(seconds: float = 8.0) -> dict:
             ),
         )
         probe.first(lambda line: line.startswith("probe: subscribed"), 30)
-        joy = Program(robot, py("tutorial.tools.rtt_joy", "--demo"))
-        sim = Program(
+        joy = HostProgram(robot, py("tutorial.tools.rtt_joy", "--demo"))
+        sim = HostProgram(
             robot,
             py("tutorial.tools.rtt_run", SIM_PROJECT, "--headless", "--json", "--duration", str(seconds + 4)),
-            RTT_PROBE_FILE=str(Path(tmp) / "sim.json"),
+            {"RTT_PROBE_FILE": str(Path(tmp) / "sim.json")},
         )
         sim.p.wait(seconds + 60)
         probe.p.wait(60)
         for program in (joy, sim, probe):
-            program.stop()
+            program.stop(20)
         if not out.exists():
             raise RuntimeError(f"the probe wrote nothing:\n{probe.text()}")
         sizes = json.loads(out.read_text())["sizes"]

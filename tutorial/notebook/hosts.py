@@ -11,76 +11,8 @@ instead of failing.  Main thread (the notebook's) only.
 
 from __future__ import annotations
 
-import json
-import signal
-import subprocess
-import sys
-import threading
-import time
-
 from tutorial.network.hosts import Host, Network, why_unavailable
-
-ROOT_DIR = __import__("pathlib").Path(__file__).resolve().parents[2]
-
-
-class Program:
-    """A program running on a host, its output lines collected as they come (a reader thread)."""
-
-    def __init__(self, host: Host, argv: list[str], env: dict[str, str]):
-        self.host = host
-        self.p = subprocess.Popen(
-            host.command(argv),
-            cwd=ROOT_DIR,
-            env=host.env(**env),
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-        )
-        self._lines: list[str] = []
-        self._lock = threading.Lock()  # the reader thread appends, the notebook reads
-        self._reader = threading.Thread(target=self._read, daemon=True)
-        self._reader.start()
-
-    def _read(self) -> None:
-        for line in iter(self.p.stdout.readline, ""):
-            with self._lock:
-                self._lines.append(line.rstrip("\n"))
-
-    def lines(self) -> list[str]:
-        with self._lock:
-            return list(self._lines)
-
-    def records(self, event: str) -> list[dict]:
-        """The JSON records of one event this program printed (``rtt-run --json``)."""
-        out = []
-        for line in self.lines():
-            if line.startswith("{") and f'"event": "{event}"' in line:
-                out.append(json.loads(line))
-        return out
-
-    def wait_for(self, predicate, timeout: float) -> bool:
-        """Whether ``predicate(self)`` became true within ``timeout`` s (checked every 0.1 s)."""
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if predicate(self):
-                return True
-            time.sleep(0.1)  # polling another process's output under a deadline
-        return bool(predicate(self))
-
-    def stop(self) -> None:
-        """Ctrl-C, then SIGKILL after 10 s."""
-        if self.p.poll() is None:
-            self.p.send_signal(signal.SIGINT)
-            try:
-                self.p.wait(10)
-            except subprocess.TimeoutExpired:
-                self.p.kill()
-                self.p.wait()
-        self._reader.join(5)
-
-
-def python(module: str, *args: str) -> list[str]:
-    return [sys.executable, "-u", "-m", module, *args]
+from tutorial.network.program import HostProgram, python
 
 
 class TwoHosts:
@@ -89,7 +21,7 @@ class TwoHosts:
     def __init__(self):
         self.problem = why_unavailable()
         self.net: Network | None = None
-        self.programs: list[Program] = []
+        self.programs: list[HostProgram] = []
         if self.problem is None:
             self.net = Network(("robot", "operator")).open()
 
@@ -107,20 +39,22 @@ class TwoHosts:
             f"{h.name:<9} {h.address:<13} namespace {h.name}, its own /dev/shm" for h in self.net.hosts.values()
         )
 
-    def start(self, host: str, argv: list[str], **env: str) -> Program:
-        program = Program(self[host], argv, env)
+    def start(self, host: str, argv: list[str], **env: str) -> HostProgram:
+        program = HostProgram(self[host], argv, env)
         self.programs.append(program)
         return program
 
-    def simulation(self, host: str = "robot", project: str = "project/step2.yaml", *args: str, **env: str) -> Program:
+    def simulation(
+        self, host: str = "robot", project: str = "project/step2.yaml", *args: str, **env: str
+    ) -> HostProgram:
         return self.start(host, python("tutorial.tools.rtt_run", project, "--headless", "--json", *args), **env)
 
-    def monitor(self, host: str = "operator", name: str = "rtt_viewer", **env: str) -> Program:
+    def monitor(self, host: str = "operator", name: str = "rtt_viewer", **env: str) -> HostProgram:
         project = "project/step3.yaml"
         argv = python("tutorial.tools.rtt_run", project, "--headless", "--json", "--ros-args", "-r", f"__node:={name}")
         return self.start(host, argv, **env)
 
-    def image_viewer(self, host: str = "operator", transport: str = "raw") -> Program:
+    def image_viewer(self, host: str = "operator", transport: str = "raw") -> HostProgram:
         out = f"{self[host].shm_dir}/camera_{transport}.png"
         return self.start(
             host, python("tutorial.tools.rtt_image", "--transport", transport, "--no-window", "--output", out)
@@ -149,18 +83,18 @@ class TwoHosts:
             self.net = None
 
 
-def publishers(monitor: Program) -> int:
+def publishers(monitor: HostProgram) -> int:
     """The newest count of joint-state publishers the monitor reported (0 before any)."""
     seen = monitor.records("publishers")
     return seen[-1]["count"] if seen else 0
 
 
-def states_applied(monitor: Program) -> int:
+def states_applied(monitor: HostProgram) -> int:
     statuses = monitor.records("status")
     return statuses[-1]["applied"] if statuses else 0
 
 
-def image_rates(viewer: Program) -> list[float]:
+def image_rates(viewer: HostProgram) -> list[float]:
     """The pictures per second ``rtt-image`` reported, once a second."""
     rates = []
     for line in viewer.lines():

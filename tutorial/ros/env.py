@@ -78,11 +78,12 @@ def sourced_ros_installation(
         for path in env.get(name, "").split(os.pathsep)
         if path and outside(path) and any(os.path.realpath(path).startswith(r) for r in roots)
     ]
-    # PYTHONPATH comes before site-packages: an rclpy under one of its entries shadows ours.
+    # PYTHONPATH comes before site-packages: an rclpy under one of its entries shadows ours.  (An entry
+    # that holds this environment, e.g. the project's folder with .venv inside it, shadows nothing.)
     shadowing = [
         p
         for p in env.get("PYTHONPATH", "").split(os.pathsep)
-        if p and outside(p) and rclpy_origin is not None
+        if p and outside(p) and rclpy_origin is not None and outside(rclpy_origin)
         if os.path.realpath(rclpy_origin).startswith(os.path.realpath(p) + os.sep)
     ]
     if shadowing:
