@@ -126,7 +126,7 @@ def plot_browser(r: dict, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
     cases = list(r["browser"])
-    fig, ax = plt.subplots(figsize=(8, 0.9 + 0.75 * len(cases)), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(8, 1.6 + 0.75 * len(cases)), constrained_layout=True)
     colors = plt.cm.tab10.colors
     for row, case in enumerate(cases):
         tut, bare = r["browser"][case]["tutorial"], r["browser"][case]["bare"]
@@ -151,13 +151,21 @@ def plot_browser(r: dict, path: Path) -> Path:
         tut, bare = r["browser"][case]["tutorial"], r["browser"][case]["bare"]
         for y, p99 in ((row + 0.18, tut["publish_to_drawn"]["p99"]), (row - 0.18, bare["sent_to_drawn"]["p99"])):
             if p99 is not None and p99 > xmax:
-                ax.text(xmax * 0.99, y, f"p99 {p99:,.0f} ms >", ha="right", va="center", fontsize=7)
+                ax.text(
+                    xmax * 0.99,
+                    y,
+                    f"p99 {p99:,.0f} ms >",
+                    ha="right",
+                    va="center",
+                    fontsize=7,
+                    bbox={"facecolor": "white", "edgecolor": "none", "pad": 1},
+                )
     ax.set_xlim(0, xmax)
     ax.set_yticks(range(len(cases)), cases)
     ax.invert_yaxis()
     ax.axvline(2 * 1000 / 60, color="red", ls=":", lw=1)
     ax.set_xlabel("ms from publish (tutorial) or send (bare page) to drawn: bars p50 per stage, marks p99")
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3)
     ax.grid(alpha=0.3, axis="x")
     ax.set_title(f"A state's way to the pixel, headless Chromium (make bench, {r['when']})", fontsize=10)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -61,7 +61,7 @@ STAGES = (  # (key, what happens in it), in order: their sum is publish -> drawn
     ("publish_to_callback", "ROS delivery"),
     ("callback_to_applied", "hand-off to the main thread"),
     ("applied_to_sent", "frame pacing and scene update"),
-    ("sent_to_page", "meshcat server and WebSocket"),
+    ("sent_to_page", "meshcat server, WebSocket, a busy page"),
     ("page_to_drawn", "the page's next render"),
 )
 CASES = {  # name: (kind, size, publisher rate Hz)
