@@ -28,8 +28,12 @@ def chromium() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser")
 
 
-def screenshot(url: str, path: Path, budget_ms: int = 8000, timeout: float = 60.0) -> np.ndarray:
-    """Load ``url`` (localhost only) and return the screenshot as an (H, W, 3) float array in 0..1."""
+def screenshot(url: str, path: Path, budget_ms: int = 3000, timeout: float = 60.0) -> np.ndarray:
+    """Load ``url`` (localhost only) and return the screenshot as an (H, W, 3) float array in 0..1.
+
+    ``budget_ms`` of virtual time: Chromium waits for the page's loads (meshcat's script, its WebSocket) and
+    lets it run that long before the picture; 3 s draws every page here (8 s took 2 to 3 s longer a picture).
+    """
     import matplotlib.image
 
     assert url.startswith("http://127.0.0.1:"), url
