@@ -23,7 +23,7 @@ forwards the bytes it was sent unchanged), in order.  The page's clock
 (``performance.timeOrigin + performance.now()``, 0.1 ms) is turned into
 ``time.monotonic_ns()`` by the offset between the two read from the page at
 the end of its run (:meth:`Page.clock_offset_ns`), not through this
-machine's wall clock, which a virtual machine may step during a run.
+machine's wall clock.
 A state the viewer never drew (at 1 kHz it draws at most 60 frames a second,
 the newest state each time) has no drawn moment and is not counted.
 
@@ -152,11 +152,12 @@ class Page:
     def clock_offset_ns(self, tries: int = 20) -> int:
         """The page's clock minus ``time.monotonic_ns()``, ns: subtract it from a page time (in ns) to compare.
 
-        Read from the page itself, not from this machine's wall clock: the
-        page's times are ``performance.timeOrigin + performance.now()``, which
-        moves with the monotonic clock from the page's load on, while the
-        wall clock may be stepped during a run (a virtual machine's clock
-        sync).  Of ``tries`` readings, the one with the shortest round trip
+        Read from the page itself, not through this machine's wall clock:
+        the page's times are ``performance.timeOrigin + performance.now()``,
+        whose origin is the wall clock when the page was made and which
+        moves with the monotonic clock after; a wall clock that was off then
+        (a virtual machine's clock sync) would shift every one of them (one
+        case of eight tanks once matched no state at all).  Of ``tries`` readings, the one with the shortest round trip
         is kept; the uncertainty is half of it (well under 1 ms here).
         """
         best = None
