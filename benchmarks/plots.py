@@ -145,7 +145,7 @@ def plot_browser(r: dict, path: Path) -> Path:
         )
         ax.plot([bare["sent_to_drawn"]["p99"]], [row - 0.18], "|", color="grey", ms=14, mew=2)
     # A case far beyond the others (the page starved of CPU) would squeeze them into a corner: its bars are
-    # cut at XMAX and their p99 written out.
+    # cut at 200 ms and their p99 written out.
     xmax = 200.0
     for row, case in enumerate(cases):
         tut, bare = r["browser"][case]["tutorial"], r["browser"][case]["bare"]
