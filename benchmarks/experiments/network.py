@@ -144,10 +144,10 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
             raise RuntimeError(f"{name}: the simulation failed:\n{sim.text()}")
         sim.stop(20)
         # The monitor has its last state when it says stale (nothing more is coming), or 5 s on.
-        stale_before = sum(1 for line in view.text().splitlines() if is_event("stale")(line))
+        stale_before = sum(1 for line in view.lines() if is_event("stale")(line))
         deadline = time.monotonic() + 5
         while time.monotonic() < deadline:
-            if sum(1 for line in view.text().splitlines() if is_event("stale")(line)) > stale_before:
+            if sum(1 for line in view.lines() if is_event("stale")(line)) > stale_before:
                 break
             time.sleep(0.05)  # polling the monitor's output: a deadline loop
     finally:
@@ -155,9 +155,7 @@ def run_case(net, name: str, spec: dict, seconds: float, work: Path) -> dict:
             if program is not None:
                 program.stop(20)
         robot.clear_faults()
-    summary = next(
-        json.loads(line) for line in reversed(sim.text().splitlines()) if line.startswith('{"event": "summary"')
-    )
+    summary = next(json.loads(line) for line in reversed(sim.lines()) if line.startswith('{"event": "summary"'))
     return figures(name, spec, summary, sim_probe, view_probe, camera_out, view, cut, healed)
 
 
@@ -172,7 +170,7 @@ def figures(name, spec, summary, sim_probe, view_probe, camera_out, view, cut, h
     span = (max(stamps) - min(stamps)) / 1e9 if len(stamps) > 1 else 0.0
     final_time = summary["simulated_time"]
     final = summary["bodies"]["Tank"]["joint_positions"]
-    records = [r for r in map(viewer_record, view.text().splitlines()) if r]
+    records = [r for r in map(viewer_record, view.lines()) if r]
     shown_last = next((r for r in reversed(records) if r.get("event") == "summary"), None)
     last_positions = (shown_last or {}).get("controllers", {}).get("RttJointStateMonitor", {}).get("last_positions")
     ends_exact = bool(

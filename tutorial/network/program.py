@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import signal
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -120,6 +121,4 @@ class HostProgram:
 
 def python(module: str, *args: str) -> list[str]:
     """The command that runs ``python -u -m module args...`` with this interpreter."""
-    import sys
-
     return [sys.executable, "-u", "-m", module, *args]
