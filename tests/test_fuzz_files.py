@@ -329,14 +329,10 @@ def test_rtt_bag_command_lines_end_in_a_status(tmp_path_factory, monkeypatch, co
 @examples(30)
 @given(args=st.lists(ARG_TOKENS, max_size=6))
 def test_rtt_bag_record_arguments_parse_or_exit_2(args):
-    from tutorial.ros.env import remove_ros_args_or_fail
+    from tutorial.ros.env import parse_command_line
 
     def parse(argv):
-        try:
-            plain = remove_ros_args_or_fail(argv)
-        except ValueError:
-            return 2
-        bag_cli.build_parser().parse_args(plain[1:])
+        parse_command_line(bag_cli.build_parser(), argv)
         return 0
 
     assert exit_status(parse, ["rtt-bag", "record", *args]) in (0, 2)

@@ -1,8 +1,38 @@
-"""rtt-plot and rtt-graph, the stand-ins for rqt_plot and rqt_graph, against a running Step 2."""
+"""rtt-plot and rtt-graph, the stand-ins for rqt_plot and rqt_graph, against a running Step 2; every
+program's answer to a bad ``--ros-args``."""
 
+import contextlib
+import importlib
+import io
 import json
 
+import pytest
+
 from conftest import module_command
+
+PROGRAMS = {  # prog name: module whose main() it runs
+    "rtt-run": "tutorial.tools.rtt_run",
+    "rtt-joy": "tutorial.tools.rtt_joy",
+    "rtt-plot": "tutorial.tools.rtt_plot",
+    "rtt-graph": "tutorial.tools.rtt_graph",
+    "rtt-image": "tutorial.tools.rtt_image",
+    "rtt-foxglove": "tutorial.tools.rtt_foxglove",
+    "rtt-bag": "tutorial.bag.cli",
+}
+
+
+@pytest.mark.parametrize("prog", sorted(PROGRAMS))
+@pytest.mark.parametrize("ros_args", [["-r", "foo"], ["-r", "__node:=bad-name"], ["-p", "x"]])
+def test_a_bad_ros_argument_is_one_line_and_status_2(prog, ros_args):
+    """Before, every program but rtt-run and rtt-bag ended in rcl's traceback (RCLInvalidROSArgsError)."""
+    main = importlib.import_module(PROGRAMS[prog]).main
+    own = ["info", "x.mcap"] if prog == "rtt-bag" else ["project/step2.yaml"] if prog == "rtt-run" else []
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), pytest.raises(SystemExit) as exit_:
+        main([prog, *own, "--ros-args", *ros_args])
+    assert exit_.value.code == 2
+    [line] = err.getvalue().splitlines()
+    assert line.startswith(f"{prog}: bad ROS arguments after --ros-args: Failed to parse ROS arguments: "), line
 
 
 def test_plot_and_graph_of_a_running_step2(procs, tmp_path):

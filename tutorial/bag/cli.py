@@ -279,11 +279,7 @@ def recover(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     """``rtt-bag``: parse the command line and run the subcommand; the exit status (main thread)."""
     argv = list(sys.argv if argv is None else argv)
-    try:
-        plain = ros_env.remove_ros_args_or_fail(argv)
-    except ValueError as exc:
-        return _fail(str(exc))
-    args = build_parser().parse_args(plain[1:])
+    args = ros_env.parse_command_line(build_parser(), argv)
     if args.command == "record":
         return record(args, argv)
     if args.command == "play":

@@ -187,6 +187,33 @@ def remove_ros_args_or_fail(args: Sequence[str]) -> list[str]:
         raise ValueError(f"bad ROS arguments after --ros-args: {detail}") from None
 
 
+def parse_command_line(parser, argv: Sequence[str]):
+    """``parser``'s parse of ``argv`` without its ROS arguments; a bad ROS argument exits in one line.
+
+    What a program's ``main`` calls instead of ``parser.parse_args``: rcl's
+    own errors for ``--ros-args -r foo`` would otherwise be a traceback.
+
+    Args:
+        parser: an ``argparse.ArgumentParser``; its ``prog`` starts the error line.
+        argv: ``sys.argv`` style, the program name first.
+
+    Returns:
+        The ``argparse.Namespace`` of the program's own arguments.
+
+    Raises:
+        SystemExit: status 2, after ``<prog>: bad ROS arguments after --ros-args: ...``
+            on stderr (and argparse's own exits for the program's arguments).
+
+    Main thread (argparse may exit); it needs no ``rclpy.init``.
+    """
+    try:
+        plain = remove_ros_args_or_fail(argv)
+    except ValueError as exc:
+        print(f"{parser.prog}: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    return parser.parse_args(plain[1:])
+
+
 def ignore_stop_signals() -> None:
     """Ignore further Ctrl-C and SIGTERM while the program cleans up (main thread, at the start of clean-up).
 

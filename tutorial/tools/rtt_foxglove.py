@@ -31,7 +31,6 @@ def main(argv: list[str] | None = None) -> int:
     """``rtt-foxglove``: serve until stopped; the exit status (main thread)."""
     import rclpy
     from rclpy.signals import SignalHandlerOptions
-    from rclpy.utilities import remove_ros_args
 
     from tutorial.foxglove.bridge import DEFAULT_HOST, DEFAULT_PORT, NODE_NAME, FoxgloveBridge
 
@@ -41,7 +40,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"TCP port (default {DEFAULT_PORT}; 0: any free)")
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="serve only these topics (TF is served in any case)")
     p.add_argument("--duration", type=float, default=None, metavar="SECONDS", help="stop after this long")
-    args = p.parse_args(remove_ros_args(argv)[1:])
+    args = ros_env.parse_command_line(p, argv)
     if not 0 <= args.port <= 65535:
         p.error("--port must be 0 to 65535")
     stop = {"requested": False}

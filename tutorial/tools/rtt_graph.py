@@ -26,7 +26,6 @@ def main(argv: list[str] | None = None) -> int:
     import json
 
     import rclpy
-    from rclpy.utilities import remove_ros_args
 
     argv = list(sys.argv if argv is None else argv)
     p = argparse.ArgumentParser(prog="rtt-graph", description="Show ROS 2 nodes and topics.")
@@ -40,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--output", default=None, help="also draw the graph into this PNG")
     p.add_argument("--all", action="store_true", help="show /rosout and /parameter_events too")
     p.add_argument("--json", action="store_true", help="print the graph as one JSON object")
-    args = p.parse_args(remove_ros_args(argv)[1:])
+    args = ros_env.parse_command_line(p, argv)
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv)
     node = rclpy.create_node(NODE_NAME)

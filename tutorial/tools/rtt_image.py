@@ -165,11 +165,10 @@ def main(argv: list[str] | None = None) -> int:
     import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.signals import SignalHandlerOptions
-    from rclpy.utilities import remove_ros_args
 
     argv = list(sys.argv if argv is None else argv)
     parser = build_parser()
-    args = parser.parse_args(remove_ros_args(argv)[1:])
+    args = ros_env.parse_command_line(parser, argv)
     if args.every <= 0 or args.max_files < 1 or (args.duration is not None and args.duration <= 0):
         parser.error("--every and --duration must be > 0, --max-files >= 1")
     live = has_display() and not args.no_window

@@ -50,7 +50,6 @@ def main(argv: list[str] | None = None) -> int:
     """``rtt-joy``: choose the input source, publish ``/joy`` until stopped; the exit status."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
-    from rclpy.utilities import remove_ros_args
 
     argv = list(sys.argv if argv is None else argv)
     parser = argparse.ArgumentParser(prog="rtt-joy", description="Publish sensor_msgs/Joy on /joy.")
@@ -75,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
         default=joy.AUTOREPEAT,
         help="republish an unchanged state at this rate, Hz (default 20, 0: only on change)",
     )
-    args = parser.parse_args(remove_ros_args(argv)[1:])
+    args = ros_env.parse_command_line(parser, argv)
     if args.rate <= 0 or args.autorepeat < 0:
         parser.error("--rate must be > 0 and --autorepeat >= 0")
     ros_env.use_localhost_by_default()

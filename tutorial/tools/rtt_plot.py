@@ -30,7 +30,6 @@ def main(argv: list[str] | None = None) -> int:
     """``rtt-plot``: record ``/<body>/joint_state`` and plot it (a window, or a PNG); the exit status."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
-    from rclpy.utilities import remove_ros_args
 
     argv = list(sys.argv if argv is None else argv)
     p = argparse.ArgumentParser(prog="rtt-plot", description="Plot joint positions from /<body>/joint_state.")
@@ -38,7 +37,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--duration", type=float, default=10.0, help="seconds to record without a display (default 10)")
     p.add_argument("--output", default="joint_state_plot.png", help="PNG written without a display")
     p.add_argument("--no-window", action="store_true", help="write the PNG even when a display exists")
-    args = p.parse_args(remove_ros_args(argv)[1:])
+    args = ros_env.parse_command_line(p, argv)
     topic = joint_state_topic(args.body)
     live = has_display() and not args.no_window
     import matplotlib

@@ -158,11 +158,7 @@ def _model_key(project, exc: ModelError) -> str:
 def main(argv: list[str] | None = None) -> int:
     """``rtt-run``: parse the command line, run the project, print the summary; the exit status (main thread)."""
     argv = list(sys.argv if argv is None else argv)
-    try:
-        plain = ros_env.remove_ros_args_or_fail(argv)
-    except ValueError as exc:
-        return _fail(str(exc), 2)
-    args = build_parser().parse_args(plain[1:])
+    args = ros_env.parse_command_line(build_parser(), argv)
     if args.duration is not None and not args.duration > 0:
         build_parser().error("--duration must be > 0")
     output = make_output(args.json)
