@@ -301,8 +301,8 @@ MISTAKES = [
     ),
     (
         "8.1",
-        "ReliabilityPolicy.RELIABLE,  # the last",
-        "ReliabilityPolicy.BEST_EFFORT,  # the last",
+        "ReliabilityPolicy.RELIABLE,  # lost states",
+        "ReliabilityPolicy.BEST_EFFORT,  # lost states",
         "the final state arrives",
     ),
     ("8.1", "depth=1,  # the newest", "depth=10,  # the newest", "keep last 1"),
