@@ -76,6 +76,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="also record every /<body>/robot_description, /<body>/odom and /<body>/joint_state, and write "
         "/tf, /tf_static and /robot_description computed from them (what Foxglove and RViz2 draw in 3D)",
     )
+    r.add_argument(
+        "--tf-frame-prefix",
+        default="",
+        metavar="PREFIX",
+        help="with --tf: put PREFIX before every frame of a body, {body} standing for its name: '{body}/' keeps "
+        "several robots' frames apart (Tank2/CHASSIS); give RViz2's RobotModel the same TF prefix",
+    )
 
     i = sub.add_parser("info", help="per topic: type, message count, time span, rate, QoS")
     i.add_argument("file", metavar="FILE.mcap")
@@ -155,6 +162,8 @@ def record(args, argv: list[str]) -> int:
 
     if not args.topics and not args.all and not args.tf:
         return _fail("record: name the topics to record, or pass --all or --tf")
+    if args.tf_frame_prefix and not args.tf:
+        return _fail("record: --tf-frame-prefix needs --tf")
     if args.duration is not None and not (args.duration > 0 and _finite(args.duration)):
         return _fail("record: --duration must be a number of seconds > 0")
     path = args.output or datetime.datetime.now().strftime("rtt_bag_%Y_%m_%d-%H_%M_%S.mcap")
@@ -167,6 +176,7 @@ def record(args, argv: list[str]) -> int:
             overwrite=args.overwrite,
             output=_say,
             tf=args.tf,
+            tf_frame_prefix=args.tf_frame_prefix,
         )
     except (BagWriteError, ValueError) as exc:
         return _fail(f"record: {exc}")

@@ -77,11 +77,13 @@ class BagRecorder:
         tf: also record every body's robot description, odometry and joint
             states, and write ``/tf``, ``/tf_static`` and ``/robot_description``
             computed from them (:mod:`tutorial.urdf.recording`).
+        tf_frame_prefix: with ``tf``, put before every frame of a body;
+            ``{body}`` in it is the body's name (``"{body}/"`` for several robots).
         write_through: the writer's policy (:class:`~tutorial.bag.writer.BagWriter`);
             False only for the benchmark's baseline.
 
     Raises:
-        ValueError: no topics, ``all_topics`` nor ``tf``, or a bad ``compression``.
+        ValueError: no topics, ``all_topics`` nor ``tf``, a bad ``compression`` or ``tf_frame_prefix``.
         tutorial.bag.writer.BagWriteError: the file cannot be created.
 
     The file is created by the constructor; :meth:`start` subscribes.
@@ -107,11 +109,16 @@ class BagRecorder:
         overwrite: bool = False,
         output=print,
         tf: bool = False,
+        tf_frame_prefix: str = "",
         write_through: bool = True,
     ):
         self.topics_wanted = [normalize_topic(t) for t in topics]
         if not self.topics_wanted and not all_topics and not tf:
             raise ValueError("name the topics to record, or record all topics")
+        if tf:
+            from tutorial.urdf.recording import check_frame_prefix
+
+            check_frame_prefix(tf_frame_prefix)  # before the file is made
         self.all_topics = all_topics
         self.output = output
         self.writer = BagWriter(path, compression=compression, overwrite=overwrite, write_through=write_through)
@@ -120,7 +127,7 @@ class BagRecorder:
         if tf:  # the TF computation is its own module's; the recorder only feeds it
             from tutorial.urdf.recording import TfRecording
 
-            self.tf = TfRecording(self.writer, self._say)
+            self.tf = TfRecording(self.writer, self._say, tf_frame_prefix)
         self._given_node = node
         self.node = node
         self.node_name = node_name

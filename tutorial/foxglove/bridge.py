@@ -96,9 +96,13 @@ class FoxgloveBridge:
             TF is computed in any case, from the bodies' descriptions.
         node_name: the ROS node's name.
         output: called with each status line.
+        tf_frame_prefix: put before every frame of a body on ``/tf`` and
+            ``/tf_static``; ``{body}`` in it is the body's name
+            (:class:`tutorial.urdf.recording.TfRecording`).
 
     Raises:
         RuntimeError: the server cannot listen there (the port is taken).
+        ValueError: a ``tf_frame_prefix`` with a ``{...}`` other than ``{body}``.
 
     ``rclpy`` must be initialised first.  Construct, :meth:`start` and
     :meth:`close` on one owner thread.
@@ -111,7 +115,11 @@ class FoxgloveBridge:
         topics=None,
         node_name: str = NODE_NAME,
         output=print,
+        tf_frame_prefix: str = "",
     ):
+        from tutorial.urdf.recording import check_frame_prefix
+
+        self.tf_frame_prefix = check_frame_prefix(tf_frame_prefix)
         self.host, self.requested_port = host, port
         self.topics = None if topics is None else {t if t.startswith("/") else "/" + t for t in topics}
         self.node_name = node_name
@@ -152,7 +160,7 @@ class FoxgloveBridge:
         except Exception as exc:  # noqa: BLE001 - the SDK raises its own error type
             raise RuntimeError(f"cannot serve on {self.host}:{self.requested_port}: {exc}") from None
         self.port = self.server.port
-        self.tf = TfRecording(_ChannelSink(self), self._say)
+        self.tf = TfRecording(_ChannelSink(self), self._say, self.tf_frame_prefix)
         self.node = rclpy.create_node(self.node_name)
         self._say(f"serving ws://{self.host}:{self.port} (foxglove.websocket.v1): open it in Foxglove")
         self._discover()

@@ -23,8 +23,18 @@ received                               written (same log time)
 
 Joint states and odometry that come before their body's description are
 kept (the newest of each) and turned into transforms once it has come.
+
 ``robot_state_publisher`` limits itself to ``publish_frequency`` (20 Hz);
 here every state becomes a transform, so the file holds them all.
+
+Several robots: two tanks have the same link names, so their frames would
+collide in one TF tree.  ``frame_prefix`` does what ``robot_state_publisher``'s
+parameter of that name does, per body: ``"{body}/"`` names Tank2's chassis
+``Tank2/CHASSIS``, on ``/tf_static``, on ``/tf`` and as the odometry's child
+(its parent, ``world``, is shared).  The URDF is unchanged: RViz2's
+RobotModel display takes the same prefix as its "TF Prefix" (a Foxglove
+URDF layer's handling of prefixes was not checked here).  Without a
+prefix, a body whose link names another body already has gets one warning.
 
 Threads: :meth:`TfRecording.on_message` runs on the recorder's spin thread
 (the subscription callbacks, one at a time: a single-threaded executor);
@@ -53,6 +63,19 @@ SOURCES = {
 }
 
 
+def check_frame_prefix(frame_prefix: str) -> str:
+    """``frame_prefix`` if ``{body}`` is its only placeholder (any thread).
+
+    Raises:
+        ValueError: another ``{...}``, or a lone brace; the text says which.
+    """
+    try:
+        frame_prefix.format(body="Tank")
+    except (KeyError, IndexError, ValueError) as exc:
+        raise ValueError(f"bad frame prefix {frame_prefix!r}: only {{body}} may stand in it ({exc!s})") from None
+    return frame_prefix
+
+
 def body_and_kind(topic: str, type_name: str) -> tuple[str, str] | None:
     """``("Tank", "odom")`` for ``/Tank/odom`` of type ``nav_msgs/msg/Odometry``; None for any other topic."""
     parts = topic.split("/")
@@ -70,28 +93,38 @@ class TfRecording:
     Args:
         writer: the :class:`tutorial.bag.writer.BagWriter` of the recording.
         say: called with a line of text for each event worth a status line.
+        frame_prefix: put before every frame of a body (not ``world``);
+            ``{body}`` in it is the body's name (``"{body}/"``); ``""``: none.
+
+    Raises:
+        ValueError: ``frame_prefix`` has a ``{...}`` other than ``{body}``.
 
     Attributes:
         written: messages written per derived topic.
         rejected: descriptions and messages that could not be used, by reason.
+        collisions: ``(body, other)`` for each body whose links share names with
+            an earlier body's, recorded without a ``{body}`` prefix (warned once).
         newest: ``(body, "joint_state" or "odom")`` -> the stamp ``(sec, nanosec)``
             of the newest message turned into transforms (read from any thread:
             each value is replaced whole).
     """
 
-    def __init__(self, writer, say=print):
+    def __init__(self, writer, say=print, frame_prefix: str = ""):
+        check_frame_prefix(frame_prefix)
         # Imported here, on the owner's thread: not in the first callback (yourdfpy takes about 1 s).
         import yourdfpy  # noqa: F401
         from rclpy.qos import QoSProfile  # noqa: F401 - fail here, not in a callback, without rclpy
 
         self.writer = writer
         self.say = say
+        self.frame_prefix = frame_prefix
         self.bodies: dict[str, UrdfKinematics] = {}
         self.pending: dict[str, dict[str, tuple]] = {}  # body -> kind -> (data, log_time) before its description
         self.static: dict[str, list[Transform]] = {}
         self.description_body: str | None = None
         self.written = {TF_TOPIC: 0, TF_STATIC_TOPIC: 0, DESCRIPTION_TOPIC: 0}
         self.rejected: dict[str, int] = {}
+        self.collisions: list[tuple[str, str]] = []  # (body, a body before it with links of the same names)
         self.newest: dict[tuple[str, str], tuple[int, int]] = {}
         self._topics_added: set[str] = set()
 
@@ -128,7 +161,9 @@ class TfRecording:
         first = body not in self.bodies
         self.bodies[body] = kinematics
         stamp = divmod(log_time, 1_000_000_000)
-        self.static[body] = kinematics.static_transforms(stamp)
+        self.static[body] = kinematics.static_transforms(stamp, self._prefix(body))
+        if first and not self.frame_prefix:
+            self._warn_if_frames_collide(body, kinematics)
         every = [t for transforms in self.static.values() for t in transforms]
         self._write(TF_STATIC_TOPIC, tf_qos(static=True), encode_tf_message(every), log_time)
         if self.description_body in (None, body):
@@ -153,7 +188,8 @@ class TfRecording:
             msg = deserialize_message(data, JointState)
             kinematics = self.bodies[body]
             stamp = (msg.header.stamp.sec, msg.header.stamp.nanosec)
-            transforms = kinematics.moving_transforms(kinematics.joint_values(msg.name, msg.position), stamp)
+            values = kinematics.joint_values(msg.name, msg.position)
+            transforms = kinematics.moving_transforms(values, stamp, self._prefix(body))
         else:
             from nav_msgs.msg import Odometry
 
@@ -164,10 +200,28 @@ class TfRecording:
                 self._reject("bad_odometry", f"/{body}/odom: a pose that is not finite, or a frame with no name")
                 return
             stamp = (msg.header.stamp.sec, msg.header.stamp.nanosec)
-            transforms = [Transform(stamp, msg.header.frame_id, msg.child_frame_id, values[:3], values[3:])]
+            child = self._prefix(body) + msg.child_frame_id  # the root link; its parent (world) is shared
+            transforms = [Transform(stamp, msg.header.frame_id, child, values[:3], values[3:])]
         self.newest[(body, kind)] = stamp
         if transforms:
             self._write(TF_TOPIC, tf_qos(), encode_tf_message(transforms), log_time)
+
+    # ---- several bodies -----------------------------------------------------------------
+    def _prefix(self, body: str) -> str:
+        return self.frame_prefix.format(body=body)
+
+    def _warn_if_frames_collide(self, body: str, kinematics: UrdfKinematics) -> None:
+        links = set(kinematics.links)
+        for other, known in self.bodies.items():
+            shared = sorted(links & set(known.links)) if other != body else []
+            if shared:
+                more = f" and {len(shared) - 3} more" if len(shared) > 3 else ""
+                self.collisions.append((body, other))
+                self.say(
+                    f"WARNING: {body} and {other} have links of the same name ({', '.join(shared[:3])}{more}): "
+                    "their TF frames collide; use --tf-frame-prefix '{body}/'"
+                )
+                return
 
     # ---- writing ------------------------------------------------------------------------
     def _write(self, topic: str, qos, data: bytes, log_time: int, type_name: str = TF_MESSAGE_TYPE) -> None:
