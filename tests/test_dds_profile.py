@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from tutorial.controllers.joint_state_publisher import DEFAULT_RATE
-from tutorial.ros.env import PROFILES_VARIABLES, PROJECT_PROFILES, use_project_profiles_by_default
+from tutorial.ros.env import PROFILES_VARIABLE, PROJECT_PROFILES, use_project_profiles_by_default
 
 NS = {"p": "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"}
 
@@ -24,17 +24,23 @@ def test_the_project_profile_is_the_default():
     assert use_project_profiles_by_default(env) == str(PROJECT_PROFILES)
     assert env == {"FASTRTPS_DEFAULT_PROFILES_FILE": str(PROJECT_PROFILES)}
     assert PROJECT_PROFILES.is_file()
+    empty = {PROFILES_VARIABLE: ""}  # set but empty: Fast DDS would fail to open ""
+    assert use_project_profiles_by_default(empty) == str(PROJECT_PROFILES)
 
 
-@pytest.mark.parametrize("variable", PROFILES_VARIABLES)
-def test_a_profile_the_user_named_is_kept(variable):
-    env = {variable: "/home/me/my_profiles.xml"}
+def test_a_profile_the_user_named_is_kept():
+    env = {PROFILES_VARIABLE: "/home/me/my_profiles.xml"}
     assert use_project_profiles_by_default(env) == "/home/me/my_profiles.xml"
-    assert env == {variable: "/home/me/my_profiles.xml"}
+    assert env == {PROFILES_VARIABLE: "/home/me/my_profiles.xml"}
 
 
-def test_importing_tutorial_named_it():
-    assert any(os.environ.get(v) for v in PROFILES_VARIABLES)
+@pytest.mark.cross_process
+def test_importing_tutorial_names_it():
+    """In a process of its own whose environment has no profiles file."""
+    env = {k: v for k, v in os.environ.items() if k != PROFILES_VARIABLE}
+    code = "import os, tutorial; print(os.environ['FASTRTPS_DEFAULT_PROFILES_FILE'])"
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0 and done.stdout.strip() == str(PROJECT_PROFILES), done.stderr
 
 
 def seconds(element) -> float:
@@ -78,7 +84,6 @@ def test_fast_dds_reads_the_profile_without_an_error(tmp_path, profile):
             PROJECT_PROFILES.read_text().replace("<nanosec>", "<nanosecs>", 1).replace("</nanosec>", "</nanosecs>", 1)
         )
     env = dict(os.environ, FASTRTPS_DEFAULT_PROFILES_FILE=str(path))
-    env.pop("FASTDDS_DEFAULT_PROFILES_FILE", None)
     done = subprocess.run(
         [sys.executable, "-c", NODE_WITH_A_RELIABLE_PUBLISHER], env=env, capture_output=True, text=True, timeout=60
     )

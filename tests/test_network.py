@@ -101,14 +101,16 @@ def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa:
 
     before = len(view.records("status"))
     robot.set_loss(20)
-    time.sleep(3.2)  # not synchronisation: the span over which the rate under loss is measured
+    time.sleep(4.2)  # not synchronisation: the span over which the rate under loss is measured (3 statuses)
     robot.set_loss(0)
     lossy = statuses_since(view, before)[1:]  # the first status straddles the change
     rates = [s["rate_hz"] for s in lossy]
     assert rates and min(rates) >= 25, f"at 20 % loss the monitor received {rates} states/s"
     # Reliable, with the project's Fast DDS profile (tutorial/ros/fastdds_profiles.xml: a 5 ms heartbeat), a lost
     # state is repaired before the next one replaces it; with Fast DDS's 3 s default about 40 of 50 came.
-    assert sum(rates) / len(rates) >= 45, f"at 20 % loss the monitor received {rates} states/s of 50"
+    assert len(rates) >= 2 and sum(rates) / len(rates) >= 45, (
+        f"at 20 % loss the monitor received {rates} states/s of 50"
+    )
     assert not view.records("stale"), "20 % loss made the view stale"
 
     stale_before, resumed_before = len(view.records("stale")), len(sim.records("joy_resumed"))

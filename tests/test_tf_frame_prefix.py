@@ -89,7 +89,7 @@ def test_without_a_prefix_colliding_frames_are_warned_once(tank_urdf):
     feed(recording, "Tank", tank_urdf, 1_000_000_000)
     assert recording.collisions == []
     feed(recording, "Tank2", tank_urdf, 2_000_000_000)
-    feed(recording, "Tank2", tank_urdf, 3_000_000_000)  # the description again (a late joiner): no second warning
+    feed(recording, "Tank2", tank_urdf, 3_000_000_000)  # Tank2's description again: no second warning
     assert recording.collisions == [("Tank2", "Tank")]
     [warning] = [line for line in said if line.startswith("WARNING")]
     assert "Tank2 and Tank have links of the same name" in warning and "--tf-frame-prefix '{body}/'" in warning
@@ -97,20 +97,45 @@ def test_without_a_prefix_colliding_frames_are_warned_once(tank_urdf):
     assert "CHASSIS" in children and not any("/" in c for c in children)  # unprefixed, as before
 
 
-@pytest.mark.parametrize("bad", ["{name}/", "{0}/", "{body", "body}"])
-def test_a_prefix_with_another_placeholder_is_refused(bad):
-    with pytest.raises(ValueError, match="only {body} may stand in it"):
+@pytest.mark.parametrize(
+    "bad",
+    ["{name}/", "{0}/", "{}/", "{body", "body}", "{body.x}/", "{body[3]}/", "{body!r}/", "{body:>8}/", "/{body}/"],
+)
+def test_a_bad_prefix_is_refused(bad):
+    with pytest.raises(ValueError, match="bad frame prefix"):
         check_frame_prefix(bad)
     with pytest.raises(ValueError, match="bad frame prefix"):
         TfRecording(ListWriter(), print, frame_prefix=bad)
 
 
-def test_rtt_bag_record_refuses_a_bad_prefix_before_making_a_file(tmp_path, capsys):
+def test_a_prefix_without_body_still_collides_and_is_warned(tank_urdf):
+    writer, said = ListWriter(), []
+    recording = TfRecording(writer, said.append, frame_prefix="robot/")
+    feed(recording, "Tank", tank_urdf, 1_000_000_000)
+    feed(recording, "Tank2", tank_urdf, 2_000_000_000)
+    assert recording.collisions == [("Tank2", "Tank")]
+    _, children, _ = frames(writer)
+    assert "robot/CHASSIS" in children and not any(c.startswith("Tank") for c in children)
+
+
+@pytest.mark.parametrize("program", ["rtt-bag", "rtt-foxglove"])
+def test_the_programs_refuse_a_bad_prefix_before_anything_starts(tmp_path, capsys, program):
+    from tutorial.bag import cli
+    from tutorial.tools import rtt_foxglove
+
+    out = tmp_path / "x.mcap"
+    argv = ["rtt-bag", "record", "--tf", "-o", str(out)] if program == "rtt-bag" else ["rtt-foxglove"]
+    with pytest.raises(SystemExit) as exit_:
+        (cli.main if program == "rtt-bag" else rtt_foxglove.main)([*argv, "--tf-frame-prefix", "{name}/"])
+    assert exit_.value.code == 2
+    assert "argument --tf-frame-prefix: bad frame prefix '{name}/'" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_rtt_bag_record_wants_tf_for_a_prefix(tmp_path, capsys):
     from tutorial.bag import cli
 
     out = tmp_path / "x.mcap"
-    assert cli.main(["rtt-bag", "record", "--tf", "--tf-frame-prefix", "{name}/", "-o", str(out)]) == 2
-    assert "bad frame prefix '{name}/'" in capsys.readouterr().err
     assert cli.main(["rtt-bag", "record", "/joy", "--tf-frame-prefix", "{body}/", "-o", str(out)]) == 2
     assert "--tf-frame-prefix needs --tf" in capsys.readouterr().err
     assert not out.exists()

@@ -43,6 +43,8 @@ _say = functools.partial(print, flush=True)
 
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``rtt-bag`` (ROS arguments are removed before it parses)."""
+    from tutorial.urdf.recording import add_frame_prefix_argument
+
     p = argparse.ArgumentParser(
         prog=PROG,
         description="Record, list and replay ROS 2 bags in MCAP files.",
@@ -76,13 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="also record every /<body>/robot_description, /<body>/odom and /<body>/joint_state, and write "
         "/tf, /tf_static and /robot_description computed from them (what Foxglove and RViz2 draw in 3D)",
     )
-    r.add_argument(
-        "--tf-frame-prefix",
-        default="",
-        metavar="PREFIX",
-        help="with --tf: put PREFIX before every frame of a body, {body} standing for its name: '{body}/' keeps "
-        "several robots' frames apart (Tank2/CHASSIS); give RViz2's RobotModel the same TF prefix",
-    )
+    add_frame_prefix_argument(r)  # with --tf
 
     i = sub.add_parser("info", help="per topic: type, message count, time span, rate, QoS")
     i.add_argument("file", metavar="FILE.mcap")

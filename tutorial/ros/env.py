@@ -137,35 +137,36 @@ def use_localhost_by_default(environ: MutableMapping[str, str] | None = None) ->
     return env.setdefault(DISCOVERY_RANGE_VARIABLE, DEFAULT_DISCOVERY_RANGE)
 
 
-PROFILES_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")  # Fast DDS 2.x, 3.x
+PROFILES_VARIABLE = "FASTRTPS_DEFAULT_PROFILES_FILE"  # the name Fast DDS 2.x (Jazzy's 2.14) reads
 PROJECT_PROFILES = Path(__file__).with_name("fastdds_profiles.xml")
 
 
 def use_project_profiles_by_default(environ: MutableMapping[str, str] | None = None) -> str:
-    """Make this project's Fast DDS profile the default unless the user named one of theirs.
+    """Make this project's Fast DDS profile the default unless the user named a file of theirs.
 
     The profile (``tutorial/ros/fastdds_profiles.xml``, where the reasons and
     the measured figures are) makes reliable writers repair a lost message
     within milliseconds instead of Fast DDS's 3 s heartbeat: on a lossy link
     a 50 Hz monitor then shows nearly every state, not only those the link
     kept.  QoS policies still come from the code.  Another middleware
-    (``RMW_IMPLEMENTATION``) ignores the variable.
+    (``RMW_IMPLEMENTATION``) ignores the variable.  To run without it, name
+    a file of your own (``<profiles xmlns="..."/>`` holds nothing).
 
     Args:
-        environ: the environment to change; ``os.environ`` when None.
+        environ: the environment to change; ``os.environ`` when None.  An
+            empty ``FASTRTPS_DEFAULT_PROFILES_FILE`` counts as not set.
 
     Returns:
         The profiles file now in force (the user's, if one was set).
 
-    Any thread may call this, but it only matters before the process's first
-    ROS 2 node (Fast DDS reads the file once, when it creates a participant).
+    Main thread, before any ROS 2 thread starts (it writes the environment,
+    which C code reads unlocked); it only matters before the process's first
+    node: Fast DDS reads the file once, when it creates a participant.
     """
     env = os.environ if environ is None else environ
-    for name in PROFILES_VARIABLES:
-        if env.get(name):
-            return env[name]
-    env[PROFILES_VARIABLES[0]] = str(PROJECT_PROFILES)
-    return env[PROFILES_VARIABLES[0]]
+    if not env.get(PROFILES_VARIABLE):
+        env[PROFILES_VARIABLE] = str(PROJECT_PROFILES)
+    return env[PROFILES_VARIABLE]
 
 
 def discovery_summary() -> str:

@@ -33,7 +33,7 @@ def main(argv: list[str] | None = None) -> int:
     from rclpy.signals import SignalHandlerOptions
 
     from tutorial.foxglove.bridge import DEFAULT_HOST, DEFAULT_PORT, NODE_NAME, FoxgloveBridge
-    from tutorial.urdf.recording import check_frame_prefix
+    from tutorial.urdf.recording import add_frame_prefix_argument
 
     argv = list(sys.argv if argv is None else argv)
     p = argparse.ArgumentParser(prog=PROG, description="Serve the ROS 2 topics and the robot in 3D to Foxglove.")
@@ -41,20 +41,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"TCP port (default {DEFAULT_PORT}; 0: any free)")
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="serve only these topics (TF is served in any case)")
     p.add_argument("--duration", type=float, default=None, metavar="SECONDS", help="stop after this long")
-    p.add_argument(
-        "--tf-frame-prefix",
-        default="",
-        metavar="PREFIX",
-        help="put PREFIX before every frame of a body on /tf, {body} standing for its name: '{body}/' keeps "
-        "several robots' frames apart (Tank2/CHASSIS)",
-    )
+    add_frame_prefix_argument(p)
     args = ros_env.parse_command_line(p, argv)
     if not 0 <= args.port <= 65535:
         p.error("--port must be 0 to 65535")
-    try:
-        check_frame_prefix(args.tf_frame_prefix)
-    except ValueError as exc:
-        p.error(str(exc))
     stop = {"requested": False}
 
     def request_stop(signum, frame):  # a plain flag: see tutorial.bag.cli._StopRequest

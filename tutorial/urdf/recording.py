@@ -31,9 +31,10 @@ Several robots: two tanks have the same link names, so their frames would
 collide in one TF tree.  ``frame_prefix`` does what ``robot_state_publisher``'s
 parameter of that name does, per body: ``"{body}/"`` names Tank2's chassis
 ``Tank2/CHASSIS``, on ``/tf_static``, on ``/tf`` and as the odometry's child
-(its parent, ``world``, is shared).  The URDF is unchanged: RViz2's
-RobotModel display takes the same prefix as its "TF Prefix" (a Foxglove
-URDF layer's handling of prefixes was not checked here).  Without a
+(its parent, ``world``, is shared).  The URDF is unchanged: a RobotModel
+display in RViz2 takes the body's name as its "TF Prefix" (``Tank2``,
+without the slash: RViz2 puts one between); a Foxglove URDF layer's
+handling of prefixes was not checked here.  Without a ``{body}`` in the
 prefix, a body whose link names another body already has gets one warning.
 
 Threads: :meth:`TfRecording.on_message` runs on the recorder's spin thread
@@ -42,6 +43,8 @@ the :class:`~tutorial.bag.writer.BagWriter` it writes to has its own lock.
 """
 
 from __future__ import annotations
+
+from string import Formatter
 
 from tutorial.interfaces.robot_description import DescriptionError, check_robot_description
 from tutorial.interfaces.tf import (
@@ -64,16 +67,48 @@ SOURCES = {
 
 
 def check_frame_prefix(frame_prefix: str) -> str:
-    """``frame_prefix`` if ``{body}`` is its only placeholder (any thread).
+    """``frame_prefix`` if it is text and ``{body}`` fields only, and does not start with ``/`` (any thread).
 
     Raises:
-        ValueError: another ``{...}``, or a lone brace; the text says which.
+        ValueError: another field (``{name}``, ``{body.x}``, ``{body!r}``...),
+            a lone brace, or a leading ``/`` (tf2 refuses such frame names);
+            the text says which.
     """
     try:
-        frame_prefix.format(body="Tank")
-    except (KeyError, IndexError, ValueError) as exc:
-        raise ValueError(f"bad frame prefix {frame_prefix!r}: only {{body}} may stand in it ({exc!s})") from None
+        fields = [(name, spec, conversion) for _, name, spec, conversion in Formatter().parse(frame_prefix)]
+    except ValueError as exc:  # a lone { or }
+        raise ValueError(f"bad frame prefix {frame_prefix!r}: {exc}") from None
+    if any(name is not None and (name != "body" or spec or conversion) for name, spec, conversion in fields):
+        raise ValueError(f"bad frame prefix {frame_prefix!r}: only {{body}} may stand in it")
+    if frame_prefix.startswith("/"):
+        raise ValueError(f"bad frame prefix {frame_prefix!r}: a TF frame name does not start with /")
     return frame_prefix
+
+
+def per_body(frame_prefix: str) -> bool:
+    """Whether ``frame_prefix`` (checked) names each body's frames apart: it has a ``{body}`` field."""
+    return any(name == "body" for _, name, _, _ in Formatter().parse(frame_prefix))
+
+
+def add_frame_prefix_argument(parser) -> None:
+    """``--tf-frame-prefix PREFIX`` on an ``argparse`` parser, checked as it is parsed (a bad one: exit 2)."""
+    import argparse
+
+    def checked(text: str) -> str:
+        try:
+            return check_frame_prefix(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parser.add_argument(
+        "--tf-frame-prefix",
+        type=checked,
+        default="",
+        metavar="PREFIX",
+        help="put PREFIX before every frame of a body, {body} standing for its name: '{body}/' keeps several "
+        "robots' frames apart (Tank2/CHASSIS); in RViz2 give a RobotModel display the body's name (Tank2, "
+        "no slash: RViz2 adds it) as its TF prefix",
+    )
 
 
 def body_and_kind(topic: str, type_name: str) -> tuple[str, str] | None:
@@ -97,13 +132,13 @@ class TfRecording:
             ``{body}`` in it is the body's name (``"{body}/"``); ``""``: none.
 
     Raises:
-        ValueError: ``frame_prefix`` has a ``{...}`` other than ``{body}``.
+        ValueError: a bad ``frame_prefix`` (:func:`check_frame_prefix`).
 
     Attributes:
         written: messages written per derived topic.
         rejected: descriptions and messages that could not be used, by reason.
         collisions: ``(body, other)`` for each body whose links share names with
-            an earlier body's, recorded without a ``{body}`` prefix (warned once).
+            an earlier body's, recorded without a ``{body}`` in the prefix (warned once).
         newest: ``(body, "joint_state" or "odom")`` -> the stamp ``(sec, nanosec)``
             of the newest message turned into transforms (read from any thread:
             each value is replaced whole).
@@ -162,7 +197,7 @@ class TfRecording:
         self.bodies[body] = kinematics
         stamp = divmod(log_time, 1_000_000_000)
         self.static[body] = kinematics.static_transforms(stamp, self._prefix(body))
-        if first and not self.frame_prefix:
+        if first and not per_body(self.frame_prefix):
             self._warn_if_frames_collide(body, kinematics)
         every = [t for transforms in self.static.values() for t in transforms]
         self._write(TF_STATIC_TOPIC, tf_qos(static=True), encode_tf_message(every), log_time)
