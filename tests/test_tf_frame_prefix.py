@@ -80,6 +80,7 @@ def test_with_a_body_prefix_two_tanks_have_frames_of_their_own(tank_urdf):
     assert all(c.startswith(("Tank/", "Tank2/")) for c in children)
     assert len([c for c in static if c.startswith("Tank/")]) == len([c for c in static if c.startswith("Tank2/")]) > 0
     assert recording.collisions == [] and not [line for line in said if "WARNING" in line]
+    assert any(line.startswith("TF of Tank2: root link Tank2/CHASSIS,") for line in said), said
     assert recording.rejected == {}
 
 
