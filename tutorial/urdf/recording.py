@@ -208,8 +208,8 @@ class TfRecording:
             self._write(DESCRIPTION_TOPIC, robot_description_qos(), data, log_time, "std_msgs/msg/String")
         if first:
             self.say(
-                f"TF of {body}: root link {self._prefix(body)}{kinematics.root}, {len(kinematics.moving)} moving joints, "
-                f"{len(self.static[body])} fixed ones on {TF_STATIC_TOPIC}"
+                f"TF of {body}: root link {self._prefix(body)}{kinematics.root}, "
+                f"{len(kinematics.moving)} moving joints, {len(self.static[body])} fixed ones on {TF_STATIC_TOPIC}"
             )
         for kind, (pending, pending_time) in sorted(self.pending.pop(body, {}).items()):
             self._state(body, kind, pending, pending_time)
