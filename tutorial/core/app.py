@@ -18,6 +18,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections import Counter
 from collections.abc import Callable
 
 import mujoco
@@ -461,7 +462,12 @@ class App:
             self.warned_duplicate = False
 
     def summary(self) -> dict:
-        """Exit summary: times, root poses and joint positions (owner thread, after run)."""
+        """Exit summary: times, root poses and joint positions (owner thread, after run).
+
+        ``controllers`` holds each controller's own summary under its name, or
+        under ``<body>/<name>`` when bodies share a controller's name (two
+        tanks: ``Tank/RttJointStatePublisher``, ``Tank2/RttJointStatePublisher``).
+        """
         record: dict = {"event": "summary", "project": self.project.name, "node": getattr(self, "node_fqn", None)}
         if self.sim is not None:
             record.update(
@@ -495,10 +501,11 @@ class App:
             )
             record["error"] = record["error"] + "\n" + text if record.get("error") else text
         controllers = {}
-        for name, controller, _ in self.controllers:
+        shared = Counter(name for name, _, _ in self.controllers)  # two tanks, two RttJointStatePublisher
+        for name, controller, body_name in self.controllers:
             s = controller.summary()
             if s:
-                controllers[name] = s
+                controllers[f"{body_name}/{name}" if shared[name] > 1 else name] = s
         if controllers:
             record["controllers"] = controllers
         return record
