@@ -64,3 +64,12 @@ def test_plot_and_graph_of_a_running_step2(procs, tmp_path):
     image = matplotlib.image.imread(str(png))
     assert image.shape[0] > 300 and image.shape[1] > 600
     assert sim.wait(60) == 0
+
+
+def test_an_unknown_ros_argument_is_named_and_the_syntax_recalled():
+    from tutorial.ros.env import remove_ros_args_or_fail
+
+    with pytest.raises(ValueError) as error:
+        remove_ros_args_or_fail(["rtt-joy", "--ros-args", "--bogus", "-q"])
+    text = str(error.value)
+    assert text.startswith("bad ROS arguments after --ros-args: unknown: --bogus -q (they are -r FROM:=TO"), text

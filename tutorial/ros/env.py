@@ -26,6 +26,7 @@ ROS installation is sourced but this environment's rclpy still comes first.
 
 from __future__ import annotations
 
+import ast
 import os
 import signal
 import sys
@@ -196,6 +197,9 @@ def init(args: Sequence[str] | None = None):
     return remove_ros_args(list(args) if args is not None else None)
 
 
+ROS_ARGS_HELP = "they are -r FROM:=TO, -p NAME:=VALUE, --params-file FILE, --log-level LEVEL"
+
+
 def remove_ros_args_or_fail(args: Sequence[str]) -> list[str]:
     """The command line without its ROS arguments, for argparse; a bad ROS argument is one clear error.
 
@@ -218,8 +222,14 @@ def remove_ros_args_or_fail(args: Sequence[str]) -> list[str]:
     try:
         return list(remove_ros_args(list(args)))
     except Exception as exc:  # noqa: BLE001 - rclpy's RCLInvalidROSArgsError, UnknownROSArgsError, ...
-        detail = str(exc).split(", at /")[0].splitlines()[0] if str(exc) else type(exc).__name__
-        raise ValueError(f"bad ROS arguments after --ros-args: {detail}") from None
+        if type(exc).__name__ == "UnknownROSArgsError":  # its text is the list of them, as Python writes one
+            try:
+                detail = "unknown: " + " ".join(str(a) for a in ast.literal_eval(str(exc)))
+            except (ValueError, SyntaxError, TypeError):
+                detail = f"unknown: {exc}"
+        else:
+            detail = str(exc).split(", at /")[0].splitlines()[0] if str(exc) else type(exc).__name__
+        raise ValueError(f"bad ROS arguments after --ros-args: {detail} ({ROS_ARGS_HELP})") from None
 
 
 def parse_command_line(parser, argv: Sequence[str]):
