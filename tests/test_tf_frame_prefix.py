@@ -6,6 +6,8 @@ into a list; ``rtt-bag record --tf-frame-prefix`` is checked for its arguments o
 
 from __future__ import annotations
 
+import io
+
 import pytest
 
 from tutorial.interfaces.tf import decode_tf_message
@@ -68,6 +70,14 @@ def frames(writer: ListWriter) -> tuple[set, set, set]:
     return parents, children, static
 
 
+def description_written(writer: ListWriter) -> str:
+    from rclpy.serialization import deserialize_message
+    from std_msgs.msg import String
+
+    [data] = [d for topic, _, d in writer.messages if topic == "/robot_description"]
+    return deserialize_message(data, String).data
+
+
 def test_with_a_body_prefix_two_tanks_have_frames_of_their_own(tank_urdf):
     writer, said = ListWriter(), []
     recording = TfRecording(writer, said.append, frame_prefix="{body}/")
@@ -81,6 +91,14 @@ def test_with_a_body_prefix_two_tanks_have_frames_of_their_own(tank_urdf):
     assert len([c for c in static if c.startswith("Tank/")]) == len([c for c in static if c.startswith("Tank2/")]) > 0
     assert recording.collisions == [] and not [line for line in said if "WARNING" in line]
     assert any(line.startswith("TF of Tank2: root link Tank2/CHASSIS,") for line in said), said
+    # /robot_description is the first body's, its links named as its frames are; its joints keep their names.
+    import yourdfpy
+
+    robot = yourdfpy.URDF.load(
+        io.BytesIO(description_written(writer).encode()), build_scene_graph=False, load_meshes=False
+    )
+    assert robot.link_map and all(name.startswith("Tank/") for name in robot.link_map)
+    assert "TURRET_Y" in robot.joint_map and robot.joint_map["TURRET_Y"].child == "Tank/TURRET_Y"
     assert recording.rejected == {}
 
 
@@ -96,6 +114,7 @@ def test_without_a_prefix_colliding_frames_are_warned_once(tank_urdf):
     assert "Tank2 and Tank have links of the same name" in warning and "--tf-frame-prefix '{body}/'" in warning
     _, children, _ = frames(writer)
     assert "CHASSIS" in children and not any("/" in c for c in children)  # unprefixed, as before
+    assert description_written(writer) == tank_urdf  # the first body's, as it came
 
 
 @pytest.mark.parametrize(

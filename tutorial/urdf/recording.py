@@ -14,8 +14,9 @@ received                               written (same log time)
 =====================================  ===========================================================
 ``/<body>/robot_description``          ``/tf_static``: one ``TFMessage`` with every fixed joint of
                                        every body so far (tf2's static topic keeps only its newest
-                                       message); ``/robot_description``: the same text, for the
-                                       first body (the topic a URDF display reads by default)
+                                       message); ``/robot_description``: the same text (its links
+                                       prefixed, with a frame prefix), for the first body (the
+                                       topic a URDF display reads by default)
 ``/<body>/joint_state``                ``/tf``: the moving joints it names, stamped with its stamp
                                        (:class:`tutorial.urdf.kinematics.UrdfKinematics`)
 ``/<body>/odom``                       ``/tf``: ``world`` -> root link, its pose, its stamp
@@ -31,10 +32,13 @@ Several robots: two tanks have the same link names, so their frames would
 collide in one TF tree.  ``frame_prefix`` does what ``robot_state_publisher``'s
 parameter of that name does, per body: ``"{body}/"`` names Tank2's chassis
 ``Tank2/CHASSIS``, on ``/tf_static``, on ``/tf`` and as the odometry's child
-(its parent, ``world``, is shared).  The URDF is unchanged: a RobotModel
-display in RViz2 takes the body's name as its "TF Prefix" (``Tank2``,
-without the slash: RViz2 puts one between); a Foxglove URDF layer's
-handling of prefixes was not checked here.  Without a ``{body}`` in the
+(its parent, ``world``, is shared).  ``/robot_description`` (one body's)
+is written with the prefix in its link names too, so a display that reads
+it draws that body with no setting of its own; the recorded
+``/<body>/robot_description`` stay as they came: a RobotModel display in
+RViz2 given one of them takes the body's name as its "TF Prefix"
+(``Tank2``, without the slash: RViz2 puts one between); a Foxglove URDF
+layer's handling of prefixes was not checked here.  Without a ``{body}`` in the
 prefix, a body whose link names another body already has gets one warning.
 
 Threads: :meth:`TfRecording.on_message` runs on the recorder's spin thread
@@ -88,6 +92,31 @@ def check_frame_prefix(frame_prefix: str) -> str:
 def per_body(frame_prefix: str) -> bool:
     """Whether ``frame_prefix`` (checked) names each body's frames apart: it has a ``{body}`` field."""
     return any(name == "body" for _, name, _, _ in Formatter().parse(frame_prefix))
+
+
+def prefixed_urdf(text: str, prefix: str) -> str:
+    """The URDF ``text`` with ``prefix`` before every link's name, where it is named and where a joint names it.
+
+    Joint names stay (joint states name joints).  Any thread.
+
+    Raises:
+        ValueError: ``text`` is not XML.
+    """
+    from lxml import etree
+
+    try:
+        robot = etree.fromstring(text.encode("utf-8"))
+    except etree.XMLSyntaxError as exc:
+        raise ValueError(f"not a URDF: {exc}") from None
+    for link in robot.iter("link"):
+        if link.getparent() is robot and link.get("name") is not None:
+            link.set("name", prefix + link.get("name"))
+    for joint in robot.iter("joint"):
+        for end in ("parent", "child"):
+            for element in joint.findall(end):
+                if element.get("link") is not None:
+                    element.set("link", prefix + element.get("link"))
+    return etree.tostring(robot, xml_declaration=True, encoding="utf-8").decode("utf-8")
 
 
 def add_frame_prefix_argument(parser) -> None:
@@ -205,6 +234,10 @@ class TfRecording:
             from tutorial.interfaces.robot_description import robot_description_qos
 
             self.description_body = body
+            if self._prefix(body):  # its links named as its frames are, so a display needs no prefix of its own
+                from rclpy.serialization import serialize_message
+
+                data = serialize_message(String(data=prefixed_urdf(text, self._prefix(body))))
             self._write(DESCRIPTION_TOPIC, robot_description_qos(), data, log_time, "std_msgs/msg/String")
         if first:
             self.say(
