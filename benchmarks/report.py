@@ -145,7 +145,8 @@ def print_report(r: dict) -> None:
 
         print(
             f"\n== publish -> pixel in headless Chromium, {VIEWPORT['width']}x{VIEWPORT['height']} px, SwiftShader "
-            "(ms, p50/p99 per stage; bare: the same commands replayed)"
+            "(ms, p50/p99 per stage; bare: the same transforms replayed to meshcat's own server and page, "
+            "one message each)"
         )
         for case, b in r["browser"].items():
             tut, bare = b["tutorial"], b["bare"]
@@ -155,8 +156,13 @@ def print_report(r: dict) -> None:
                 f"({tut['states_drawn']} states drawn; {stages}); page {tut['frames_per_s']} frames/s, "
                 f"{tut['messages_per_s']} messages/s; "
                 f"bare send->drawn {bare['sent_to_drawn']['p50']}/{bare['sent_to_drawn']['p99']}, "
-                f"{bare['frames_per_s']} frames/s"
+                f"{bare['frames_per_s']} frames/s, {bare['messages_per_s']} messages/s"
             )
+            if tut.get("page"):
+                page = tut["page"]
+                print(
+                    f"    the tutorial's page: multisampling {'on' if page['antialias'] else 'off'}, {page['renderer']}"
+                )
     if r.get("network"):
         from benchmarks.experiments.network import print_table
 

@@ -10,7 +10,10 @@ tapped before the scene is built), prints ``{"event": "meshcat_url", ...}``
 as a JSON line, and writes every command the viewer sent to meshcat to FILE:
 each with its send time (``time.monotonic_ns()``), its type, path and bytes
 (hex), and for a transform the body it moves and the stamp of the state the
-body showed (``benchmarks.experiments.browser`` replays and joins them).
+body showed; for a frame sent as one ``set_transforms`` command, the list
+of the bodies and the list of their stamps (``benchmarks.experiments.browser``
+replays and joins them).  ``--meshcat-no-batch`` runs meshcat's own server
+and page, so the viewer sends one command per transform (the fallback).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from rclpy.signals import SignalHandlerOptions
 from tutorial.core.app import App
 from tutorial.core.project import load_project
 from tutorial.ros import env as ros_env
+from tutorial.view.meshcat_batch import SET_TRANSFORMS, split_batch
 
 
 def main() -> int:
@@ -35,6 +39,7 @@ def main() -> int:
     p.add_argument("--headless", action="store_true")
     p.add_argument("--name", default="rtt_viewer")
     p.add_argument("--record-meshcat", metavar="FILE", help="tap and record every command sent to meshcat")
+    p.add_argument("--meshcat-no-batch", action="store_true", help="meshcat's own server: no set_transforms")
     args = p.parse_args()
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
@@ -42,7 +47,7 @@ def main() -> int:
     if args.record_meshcat:
         from tutorial.view.meshcat_server import start_server
 
-        server = start_server()
+        server = start_server(batch=not args.meshcat_no_batch)
         vis = server.visualizer()
         tape = CommandTape()
         vis.window.zmq_socket = tape.tap(vis.window.zmq_socket)
@@ -117,10 +122,20 @@ class CommandTape:
 
         return Tapped()
 
+    def body_of(self, path: str) -> str | None:
+        return next((part for part in path.split("/") if part in self.probes), None)
+
     def note(self, kind: str, path: str, data: bytes) -> None:
-        body = next((part for part in path.split("/") if part in self.probes), None)
+        now = time.monotonic_ns()  # before the batch is read: the send follows at once
+        if kind == SET_TRANSFORMS:  # a frame: each body it moves, and the stamp each shows
+            bodies = [self.body_of("/".join(parts)) for parts, _ in split_batch(data)]
+            bodies = [b for b in dict.fromkeys(bodies) if b is not None]
+            stamps = [self.probes[b].latest_stamp for b in bodies]
+            self.commands.append([now, kind, path, data.hex(), bodies, stamps])
+            return
+        body = self.body_of(path)
         stamp = self.probes[body].latest_stamp if body is not None else None
-        self.commands.append([time.monotonic_ns(), kind, path, data.hex(), body, stamp])
+        self.commands.append([now, kind, path, data.hex(), body, stamp])
 
 
 if __name__ == "__main__":

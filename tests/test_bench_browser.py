@@ -13,7 +13,7 @@ import zlib
 
 import pytest
 
-from benchmarks.experiments.browser import _match, analyse_bare, analyse_tutorial
+from benchmarks.experiments.browser import _match, analyse_bare, analyse_tutorial, bare_commands
 
 MS = 1_000_000  # ns
 
@@ -77,3 +77,44 @@ def test_bare_page_send_to_drawn():
     out = analyse_bare(run["page"], sent, warmup=0.0)
     assert out["sent_to_page"]["p50"] == pytest.approx(8.0, abs=1e-3)
     assert out["sent_to_drawn"]["p50"] == pytest.approx(11.0, abs=1e-3)
+
+
+def _batched(run: dict) -> dict:
+    """The same run with its three states sent as one set_transforms frame each, of two bodies (Tank, Tank2)."""
+    from tutorial.view.meshcat_batch import pack_batch
+
+    run["views"]["Tank2"] = {"applied": [list(a) for a in run["views"]["Tank"]["applied"]]}
+    tape, msgs = [], []
+    for k, (record, msg) in enumerate(zip(run["tape"], run["page"]["msgs"])):
+        matrix = [float(k)] * 16
+        data = pack_batch(
+            [
+                {"type": "set_transform", "path": "/meshcat/rtt/Tank/CHASSIS", "matrix": matrix},
+                {"type": "set_transform", "path": "/meshcat/rtt/Tank/TURRET_Y", "matrix": matrix},
+                {"type": "set_transform", "path": "/meshcat/rtt/Tank2/CHASSIS", "matrix": matrix},
+            ]
+        )
+        tape.append([record[0], "set_transforms", "", data.hex(), ["Tank", "Tank2"], [record[5], record[5]]])
+        msgs.append([msg[0], zlib.crc32(data)])
+    run["tape"], run["page"]["msgs"] = tape, msgs
+    return run
+
+
+def test_one_page_message_of_a_frame_counts_every_state_in_it():
+    out = analyse_tutorial(_batched(_run(0)), warmup=0.0)
+    assert out["states_drawn"] == 4  # two bodies, each with two states inside the run
+    assert out["publish_to_drawn"]["p50"] == pytest.approx(15.0, abs=1e-3)
+
+
+def test_the_bare_replay_sends_a_frame_as_meshcats_own_single_commands():
+    import umsgpack
+
+    tape = _batched(_run(0))["tape"]
+    bare = bare_commands([[0, "set_object", "/meshcat/rtt/static/geom0", "c0", None, None], *tape])
+    assert bare[0][1] == "set_object"
+    singles = bare[1:]
+    assert len(singles) == 3 * 3 and {c[1] for c in singles} == {"set_transform"}
+    assert [c[0] for c in singles[:3]] == [tape[0][0]] * 3  # a frame's commands leave at the frame's moment
+    first = umsgpack.unpackb(bytes.fromhex(singles[0][3]))
+    assert first == {"type": "set_transform", "path": "/meshcat/rtt/Tank/CHASSIS", "matrix": [0.0] * 16}
+    assert singles[0][2] == "/meshcat/rtt/Tank/CHASSIS"

@@ -27,11 +27,18 @@ machine's wall clock.
 A state the viewer never drew (at 1 kHz it draws at most 60 frames a second,
 the newest state each time) has no drawn moment and is not counted.
 
+The viewer sends each frame as one ``set_transforms`` message
+(:mod:`tutorial.view.meshcat_batch`), to the project's server and page; a
+page message is then joined to every state of its frame.  ``--unbatched``
+runs the viewer on meshcat's own server and page instead, one message per
+transform, as before that command (to compare, in the same conditions).
+
 **The baseline, in the same run**: a bare script replays, to a bare meshcat
-server and page, the exact commands the viewer sent (the scene, then every
-transform, at the moments it sent them): no ROS and no tutorial code on its
-path, only zmq and meshcat's own server (bound to 127.0.0.1).  Its figure is
-send -> drawn.  The page's frames per second are its ``requestAnimationFrame``
+server and page, the exact transforms the viewer sent (the scene, then every
+transform, at the moments it sent them), in meshcat's own protocol (one
+``set_transform`` per body, as meshcat-python sends them): no ROS and no
+tutorial code on its path, only zmq and meshcat's own server and page (bound
+to 127.0.0.1).  Its figure is send -> drawn.  The page's frames per second are its ``requestAnimationFrame``
 callbacks per second.
 """
 
@@ -55,6 +62,7 @@ import numpy as np
 from benchmarks.procs import py, start
 from benchmarks.scale_projects import arm_projects, tanks_projects
 from benchmarks.stats import pct
+from tutorial.view.meshcat_batch import SET_TRANSFORMS, split_batch
 
 FRAME_MS = 1000.0 / 60.0
 STAGES = (  # (key, what happens in it), in order: their sum is publish -> drawn
@@ -170,12 +178,16 @@ class Page:
         return best[1]
 
     def samples(self) -> dict:
-        """``{"msgs": [[ms, crc32], ...], "renders": [ms], "render_ms": [ms], "rafs": [ms], "offset_ns": ns}`` so far.
+        """``{"msgs": [[ms, crc32], ...], "renders": [ms], "render_ms": [ms], "rafs": [ms], "offset_ns": ns,
+        "page": {...} or None}`` so far.
 
-        Times are the page's clock (ms); ``offset_ns`` is :meth:`clock_offset_ns`, read now.
+        Times are the page's clock (ms); ``offset_ns`` is :meth:`clock_offset_ns`, read now; ``page`` is
+        the project's page's ``window.rttPage`` (:mod:`tutorial.view.meshcat_page`), None on meshcat's own.
         """
         samples = self.page.evaluate("window.__rtt")
         samples["offset_ns"] = self.clock_offset_ns()
+        # The project's page says which renderer it got and whether it kept multisampling (meshcat's own: None).
+        samples["page"] = self.page.evaluate("window.rttPage || null")
         return samples
 
     def close(self) -> None:
@@ -221,14 +233,18 @@ def _wait(proc: subprocess.Popen, timeout: float) -> None:
         raise RuntimeError(f"{proc.args} exited {proc.returncode}: {proc.stderr.read()[-2000:]}")
 
 
-def tutorial_run(case: str, seconds: float, directory: Path) -> dict:
-    """One case through the tutorial: simulation, viewer, its page; the raw records of each."""
+def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True) -> dict:
+    """One case through the tutorial: simulation, viewer, its page; the raw records of each.
+
+    ``batch=False`` gives the viewer meshcat's own server and page, so it sends one command per transform.
+    """
     kind, size, rate = CASES[case]
     sim_project, view_project = (tanks_projects if kind == "tanks" else arm_projects)(size, directory)
     sim_probe, view_probe, tape = directory / "sim.json", directory / "view.json", directory / "tape.json"
     viewer = start(
         py("benchmarks.viewer_proc", str(view_project), "--duration", str(seconds + 12.0))
-        + ["--record-meshcat", str(tape)],
+        + ["--record-meshcat", str(tape)]
+        + ([] if batch else ["--meshcat-no-batch"]),
         view_probe,
     )
     procs = [viewer]
@@ -271,15 +287,20 @@ def tutorial_run(case: str, seconds: float, directory: Path) -> dict:
 def bare_run(tape: list, lead_s: float = 1.0) -> tuple[dict, list]:
     """Replay ``tape`` to a bare meshcat server and page, at its moments; the page's samples and the send log.
 
-    The scene's commands (every one before the first transform that names a
-    body) go first, then each transform at its recorded offset from the first.
-    Sends are pipelined as the viewer's are (a DEALER socket, then the replies).
+    The tape is first turned into meshcat's own protocol (:func:`bare_commands`:
+    one ``set_transform`` per body, as meshcat-python sends them), and the
+    server is meshcat's own with its own page (``start_server(batch=False)``,
+    bound to 127.0.0.1).  The scene's commands (every one before the first
+    transform that names a body) go first, then each transform at its
+    recorded offset from the first.  Sends are pipelined (a DEALER socket,
+    then the replies), so a frame's commands leave together.
     """
     import zmq
 
     from tutorial.view.meshcat_server import start_server
 
-    server = start_server()
+    tape = bare_commands(tape)
+    server = start_server(batch=False)
     page = None
     sock = zmq.Context.instance().socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)
@@ -341,6 +362,28 @@ def _match(msgs: list, crcs: list[int]) -> list[tuple[int, int]]:
     return pairs
 
 
+def tape_states(record: list) -> list[tuple[str, int | None]]:
+    """The ``(body, stamp)`` of each state a tape record shows: one for a ``set_transform``, one per body
+    for a frame sent as one ``set_transforms`` (``benchmarks.viewer_proc.CommandTape``)."""
+    body, stamp = record[4], record[5]
+    if record[1] == SET_TRANSFORMS:
+        return list(zip(body, stamp))
+    return [(body, stamp)]
+
+
+def bare_commands(tape: list) -> list[list]:
+    """The tape as meshcat's own protocol: each ``set_transforms`` frame becomes its ``set_transform``
+    commands, at the same moment, in order (what a bare script sends a bare server)."""
+    out = []
+    for record in tape:
+        if record[1] != SET_TRANSFORMS:
+            out.append(record)
+            continue
+        for parts, data in split_batch(bytes.fromhex(record[3])):
+            out.append([record[0], "set_transform", "/" + "/".join(parts), data.hex(), "frame", None])
+    return out
+
+
 def _first_after(times: np.ndarray, t: float) -> float | None:
     i = int(np.searchsorted(times, t, side="left"))
     return float(times[i]) if i < len(times) else None
@@ -354,7 +397,7 @@ def analyse_tutorial(run: dict, warmup: float) -> dict:
     for body, v in run["views"].items():
         for stamp, arrived, done in v["applied"]:
             applied.setdefault((body, stamp), (arrived, done))
-    transforms = [c for c in run["tape"] if c[4] is not None and c[1] == "set_transform"]
+    transforms = [c for c in run["tape"] if c[4] and c[1] in ("set_transform", SET_TRANSFORMS)]
     crcs = [zlib.crc32(bytes.fromhex(c[3])) for c in transforms]
     page = run["page"]
     offset_ns = page["offset_ns"]
@@ -364,27 +407,30 @@ def analyse_tutorial(run: dict, warmup: float) -> dict:
     stages = {k: [] for k in (*(key for key, _ in STAGES), "publish_to_drawn")}
     seen = set()
     for i, k in _match(page["msgs"], crcs):
-        sent_ns, _, _, _, body, stamp = transforms[k]
-        if (body, stamp) in seen or stamp is None or not (start_ns <= sent_ns <= end_ns):
-            continue
-        step = step_wall.get(round(stamp / 1000))
-        arrived_done = applied.get((body, stamp))
+        sent_ns = transforms[k][0]
         received = to_mono(page["msgs"][i][0])
         drawn = _first_after(renders, page["msgs"][i][0])
-        if step is None or arrived_done is None or drawn is None:
+        if not (start_ns <= sent_ns <= end_ns) or drawn is None:
             continue
-        seen.add((body, stamp))
-        arrived, done = arrived_done
         drawn = to_mono(drawn)
-        for key, value in (
-            ("publish_to_callback", arrived - step),
-            ("callback_to_applied", done - arrived),
-            ("applied_to_sent", sent_ns - done),
-            ("sent_to_page", received - sent_ns),
-            ("page_to_drawn", drawn - received),
-            ("publish_to_drawn", drawn - step),
-        ):
-            stages[key].append(value)
+        for body, stamp in tape_states(transforms[k]):  # a frame sent as one message shows several states
+            if (body, stamp) in seen or stamp is None:
+                continue
+            step = step_wall.get(round(stamp / 1000))
+            arrived_done = applied.get((body, stamp))
+            if step is None or arrived_done is None:
+                continue
+            seen.add((body, stamp))
+            arrived, done = arrived_done
+            for key, value in (
+                ("publish_to_callback", arrived - step),
+                ("callback_to_applied", done - arrived),
+                ("applied_to_sent", sent_ns - done),
+                ("sent_to_page", received - sent_ns),
+                ("page_to_drawn", drawn - received),
+                ("publish_to_drawn", drawn - step),
+            ):
+                stages[key].append(value)
     out = {k: pct(v, 1e-6) for k, v in stages.items()}
     out.update(_page_rates(page, start_ns, end_ns, offset_ns), states_drawn=len(seen))
     return out
@@ -422,6 +468,7 @@ def _page_rates(page: dict, start_ns: int, end_ns: int, offset_ns: int) -> dict:
         return round(float((len(t) - 1) / ((t[-1] - t[0]) * 1e-9)), 1) if len(t) > 1 else None
 
     return {
+        "page": page.get("page"),
         "frames_per_s": per_s(page["rafs"]),
         "renders_per_s": per_s(page["renders"]),
         "messages_per_s": per_s([m[0] for m in page["msgs"]]),
@@ -429,12 +476,15 @@ def _page_rates(page: dict, start_ns: int, end_ns: int, offset_ns: int) -> dict:
     }
 
 
-def pixel_latency(cases: list[str], seconds: float, warmup: float) -> dict:
-    """Every case: the tutorial's stages and the bare replay's, in the same run."""
+def pixel_latency(cases: list[str], seconds: float, warmup: float, batch: bool = True) -> dict:
+    """Every case: the tutorial's stages and the bare replay's, in the same run.
+
+    ``batch=False``: the tutorial as before ``set_transforms`` (one message per transform), to compare.
+    """
     out = {}
     for case in cases:
         with tempfile.TemporaryDirectory() as d:
-            run = tutorial_run(case, seconds, Path(d))
+            run = tutorial_run(case, seconds, Path(d), batch)
         samples, sent = bare_run(run["tape"])
         out[case] = {
             "tutorial": analyse_tutorial(run, warmup),
@@ -448,10 +498,15 @@ def main(argv=None) -> int:
     p.add_argument("--seconds", type=float, default=8.0, help="simulated seconds per case (default 8)")
     p.add_argument("--warmup", type=float, default=2.0, help="s left out at the start of each run (default 2)")
     p.add_argument("--cases", nargs="+", choices=list(CASES), default=list(CASES))
+    p.add_argument(
+        "--unbatched",
+        action="store_true",
+        help="the viewer on meshcat's own server: one message per transform, as before set_transforms",
+    )
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
-    r = pixel_latency(args.cases, args.seconds, args.warmup)
+    r = pixel_latency(args.cases, args.seconds, args.warmup, batch=not args.unbatched)
     print(json.dumps(r, indent=1))
     return 0
 

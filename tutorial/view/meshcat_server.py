@@ -1,9 +1,15 @@
-"""Start a meshcat server that listens on 127.0.0.1 only.
+"""Start a meshcat server that listens on 127.0.0.1 only and takes a frame's transforms as one message.
 
 meshcat-python's own server binds its ZeroMQ socket to 127.0.0.1 but serves
 the web page on every interface.  This module runs that same server (its
 ``ZMQWebSocketBridge``) with the web server bound to 127.0.0.1, and makes it
 exit when the process that started it goes away, so no server is left behind.
+
+It also knows one command meshcat's does not: ``set_transforms``, a frame's
+transforms in one message (:mod:`tutorial.view.meshcat_batch`), and serves
+a page that draws it (:mod:`tutorial.view.meshcat_page`; it also leaves out
+multisampling where the browser renders without a GPU).  With ``batch=False`` it is meshcat's server and
+page as they ship, only bound to 127.0.0.1 (the benchmark's bare baseline).
 
 ``python -m tutorial.view.meshcat_server`` prints ``zmq_url=...`` and
 ``web_url=...`` lines, as meshcat's own server does.
@@ -73,8 +79,13 @@ def _quiet_window(zmq_url: str):
     return QuietWindow(zmq_url)
 
 
-def start_server(timeout: float = 20.0) -> MeshcatServer:
+def start_server(timeout: float = 20.0, batch: bool = True) -> MeshcatServer:
     """Start a localhost-only meshcat server in a child process.
+
+    Args:
+        timeout: s to wait for the server's URLs.
+        batch: take ``set_transforms`` and serve the page that draws it; False runs
+            meshcat's own server and page unchanged (still bound to 127.0.0.1).
 
     Returns:
         The running :class:`MeshcatServer`.
@@ -86,7 +97,8 @@ def start_server(timeout: float = 20.0) -> MeshcatServer:
     import time
 
     proc = subprocess.Popen(
-        [sys.executable, "-u", "-m", "tutorial.view.meshcat_server", "--parent", str(os.getpid())],
+        [sys.executable, "-u", "-m", "tutorial.view.meshcat_server", "--parent", str(os.getpid())]
+        + ([] if batch else ["--no-batch"]),
         stdout=subprocess.PIPE,
         bufsize=0,  # unbuffered: select() must see every line that readline() has not taken yet
         stderr=subprocess.DEVNULL,
@@ -115,20 +127,14 @@ def main(argv=None) -> None:
     import argparse
 
     import tornado.ioloop
-    from meshcat.servers.zmqserver import ZMQWebSocketBridge
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--parent", type=int, default=0, help="exit when this process id is gone")
+    parser.add_argument("--no-batch", action="store_true", help="meshcat's own server and page (no set_transforms)")
     args = parser.parse_args(argv)
 
-    class LocalhostBridge(ZMQWebSocketBridge):
-        def make_app(self):
-            app = super().make_app()
-            listen = app.listen
-            app.listen = lambda port, **kw: listen(port, address=HOST, **kw)
-            return app
-
-    bridge = LocalhostBridge(host=HOST)
+    LocalhostBridge, BatchingBridge = _bridge_classes()
+    bridge = (LocalhostBridge if args.no_batch else BatchingBridge)(host=HOST)
     print(f"zmq_url={bridge.zmq_url}", flush=True)
     print(f"web_url={bridge.web_url}", flush=True)
 
@@ -143,6 +149,59 @@ def main(argv=None) -> None:
         bridge.run()
     except KeyboardInterrupt:
         pass
+
+
+def _bridge_classes():
+    """The two server classes, made on first use (meshcat's server module starts zmq when imported)."""
+    import tornado.web
+    from meshcat.servers.zmqserver import ZMQWebSocketBridge, find_node
+
+    from tutorial.view import meshcat_batch, meshcat_page
+
+    class LocalhostBridge(ZMQWebSocketBridge):
+        """meshcat's server with its web server bound to 127.0.0.1 (the tornado IO loop's thread)."""
+
+        def make_app(self):
+            app = super().make_app()
+            listen = app.listen
+            app.listen = lambda port, **kw: listen(port, address=HOST, **kw)
+            return app
+
+    class PageHandler(tornado.web.RequestHandler):
+        def get(self):
+            self.set_header("Content-Type", "text/html; charset=utf-8")
+            self.set_header("Cache-Control", "no-store, no-cache, must-revalidate, max-age=0")
+            self.write(meshcat_page.PAGE_HTML)
+
+    class BatchingBridge(LocalhostBridge):
+        """:class:`LocalhostBridge` that also takes ``set_transforms`` (the tornado IO loop's thread).
+
+        Everything runs on the server's one IO loop thread, as meshcat's own
+        handlers do, so the scene tree needs no lock.
+        """
+
+        def make_app(self):
+            app = super().make_app()
+            # Ahead of meshcat's own /static/ files: the page (its script and the rest stay meshcat's).
+            app.wildcard_router.rules.insert(0, tornado.web.url(r"/static/(?:index\.html)?", PageHandler))
+            return app
+
+        def handle_zmq(self, frames):
+            if frames[0] != meshcat_batch.SET_TRANSFORMS.encode():
+                return super().handle_zmq(frames)
+            try:
+                if len(frames) != 3:
+                    raise meshcat_batch.BadBatch("expected 3 frames")
+                commands = meshcat_batch.split_batch(frames[2])
+            except meshcat_batch.BadBatch as error:  # told to the sender; nothing stored, nothing forwarded
+                self.zmq_socket.send(f"error: {error}".encode())
+                return
+            for path, data in commands:  # as meshcat's server stores a set_transform, for pages that open later
+                find_node(self.tree, path).transform = data
+            self.forward_to_websockets(frames)  # one WebSocket message for the whole frame
+            self.zmq_socket.send(b"ok")
+
+    return LocalhostBridge, BatchingBridge
 
 
 if __name__ == "__main__":

@@ -9,13 +9,20 @@ A body without joints rides in the frame of the body it is welded to (the
 tank's tracks in the chassis'), so a frame sends one transform for each part
 that moves on its own: three for a tank, not five.
 
-A frame's transforms are *pipelined*: meshcat-python waits for the server's
-reply after every command (a zmq REQ socket), which costs a round trip
-between processes per body, 20 ms a frame for a 24-joint arm.  The scene
-sends a frame's commands through its own zmq DEALER socket to the same
-server, then collects all the replies: one wait per frame.  The commands
-and the server are meshcat's own; they are packed by ``msgpack``'s C
-extension, byte for byte what meshcat-python's own packer makes.
+A frame's transforms go out as *one message*: meshcat-python sends one
+command per transform and waits for the server's reply after each (a zmq
+REQ socket), which costs a round trip between processes per body (20 ms a
+frame for a 24-joint arm) and the page one WebSocket message per body.
+The scene sends a frame's ``set_transform`` commands, each as meshcat
+lowers it, inside one ``set_transforms`` command
+(:mod:`tutorial.view.meshcat_batch`) through its own zmq DEALER socket to
+the same server, then waits for the one reply.  A server that does not
+know the command (meshcat's own, when a notebook passes its own
+``meshcat.Visualizer``) answers with an error; the scene then sends that
+frame, and every later one, as single commands, all in flight at once,
+and collects their replies: still one wait per frame.  Commands are packed
+by ``msgpack``'s C extension, byte for byte what meshcat-python's own
+packer makes.
 
 Geoms in group 3 and above are hidden, as in MuJoCo's own viewer (the tank's
 road wheels live there, inside the track covers).
@@ -29,6 +36,8 @@ from __future__ import annotations
 import msgpack
 import mujoco
 import numpy as np
+
+from tutorial.view.meshcat_batch import SET_TRANSFORMS, pack_batch
 
 HIDDEN_GEOM_GROUP = 3
 POSE_TOLERANCE = 1e-7  # m, and rotation-matrix entries: a body that moved less is not sent again
@@ -200,15 +209,12 @@ class Scene:
         now = np.concatenate((data.xpos[ids], data.xmat[ids]), axis=1)  # (bodies, 12)
         changed = np.flatnonzero(~(np.abs(now - self._sent) <= POSE_TOLERANCE).all(axis=1))
         self._sent[changed] = now[changed]
-        for i in changed:
-            pose = _pose(now[i, :3], now[i, 3:])
-            if self._pipe is not None:
-                self._pipe.send(self._paths[i].path, pose)
-            else:
-                self._paths[i].set_transform(pose)
-        sent = len(changed)
         if self._pipe is not None:
-            self._pipe.wait()
+            self._pipe.send_frame([(self._paths[i].path, _pose(now[i, :3], now[i, 3:])) for i in changed])
+        else:
+            for i in changed:
+                self._paths[i].set_transform(_pose(now[i, :3], now[i, 3:]))
+        sent = len(changed)
         self.frames += 1
         self.transforms_sent += sent
         return sent
@@ -234,10 +240,12 @@ class Scene:
 
 
 class _Pipeline:
-    """Many meshcat ``set_transform`` commands in flight at once, then one wait.
+    """A frame's ``set_transform`` commands sent at once, then one wait for the server.
 
     The server's socket is REP: a DEALER talks to it by putting an empty
-    frame before each request, and gets ``[b"", reply]`` back.
+    frame before each request, and gets ``[b"", reply]`` back, in order.
+    ``batch`` says whether the server takes ``set_transforms``: True until
+    it answers one with anything but ``ok``.
     Owned by the thread that owns the Scene.
     """
 
@@ -247,22 +255,41 @@ class _Pipeline:
         self.socket = zmq.Context.instance().socket(zmq.DEALER)
         self.socket.setsockopt(zmq.LINGER, 0)
         self.socket.connect(zmq_url)
-        self.in_flight = 0
+        self.batch = True
+        self.messages = 0  # sent to the server (a frame is one while batch holds)
 
-    def send(self, path, matrix: np.ndarray) -> None:
+    def send_frame(self, transforms: list, timeout_ms: int = 5000) -> None:
+        """Send ``[(meshcat path, 4x4 pose), ...]`` and wait until the server has applied them all.
+
+        Raises:
+            RuntimeError: the server did not answer within ``timeout_ms``, or refused a single command.
+        """
         from meshcat.commands import SetTransform
 
-        command = SetTransform(matrix, path).lower()
-        self.socket.send_multipart([b"", b"set_transform", command["path"].encode(), pack_command(command)])
-        self.in_flight += 1
+        if not transforms:
+            return
+        commands = [SetTransform(matrix, path).lower() for path, matrix in transforms]
+        if self.batch:
+            self.socket.send_multipart([b"", SET_TRANSFORMS.encode(), b"", pack_batch(commands)])
+            self.messages += 1
+            if self._replies(1, timeout_ms) == [b"ok"]:
+                return
+            self.batch = False  # meshcat's own server: "error: unrecognized comand"; it applied nothing
+        for command in commands:
+            self.socket.send_multipart([b"", b"set_transform", command["path"].encode(), pack_command(command)])
+        self.messages += len(commands)
+        replies = self._replies(len(commands), timeout_ms)
+        refused = [r for r in replies if r != b"ok"]
+        if refused:
+            raise RuntimeError(f"the meshcat server refused a transform: {refused[0][:80]!r}")
 
-    def wait(self, timeout_ms: int = 5000) -> None:
-        """Collect the replies of everything sent (the server has applied them all)."""
-        while self.in_flight:
+    def _replies(self, n: int, timeout_ms: int) -> list[bytes]:
+        out = []
+        while len(out) < n:
             if not self.socket.poll(timeout_ms):
                 raise RuntimeError(f"the meshcat server did not answer within {timeout_ms:d} ms")
-            self.socket.recv_multipart()
-            self.in_flight -= 1
+            out.append(self.socket.recv_multipart()[-1])
+        return out
 
     def close(self) -> None:
         self.socket.close()
