@@ -23,13 +23,14 @@ import json
 import sys
 import time
 
+import msgpack
 import rclpy
 from rclpy.signals import SignalHandlerOptions
 
 from tutorial.core.app import App
 from tutorial.core.project import load_project
 from tutorial.ros import env as ros_env
-from tutorial.view.meshcat_batch import SET_TRANSFORMS, split_batch
+from tutorial.view.meshcat_batch import SET_TRANSFORMS
 
 
 def main() -> int:
@@ -114,8 +115,10 @@ class CommandTape:
             def send_multipart(self, frames, *a, **k):
                 # A DEALER's frames start with an empty delimiter; a REQ's do not.
                 kind, path, data = (frames[1:] if frames[0] == b"" else frames)[:3]
-                tape.note(kind.decode(), path.decode(), data)
-                return socket.send_multipart(frames, *a, **k)
+                sent_ns = time.monotonic_ns()
+                result = socket.send_multipart(frames, *a, **k)
+                tape.note(sent_ns, kind.decode(), path.decode(), data)  # after the send: no delay in its path
+                return result
 
             def __getattr__(self, name):
                 return getattr(socket, name)
@@ -125,17 +128,17 @@ class CommandTape:
     def body_of(self, path: str) -> str | None:
         return next((part for part in path.split("/") if part in self.probes), None)
 
-    def note(self, kind: str, path: str, data: bytes) -> None:
-        now = time.monotonic_ns()  # before the batch is read: the send follows at once
+    def note(self, sent_ns: int, kind: str, path: str, data: bytes) -> None:
+        """Record one command sent at ``sent_ns`` (``time.monotonic_ns()``), with the states it shows."""
         if kind == SET_TRANSFORMS:  # a frame: each body it moves, and the stamp each shows
-            bodies = [self.body_of("/".join(parts)) for parts, _ in split_batch(data)]
+            bodies = [self.body_of(c["path"]) for c in msgpack.unpackb(data)["commands"]]
             bodies = [b for b in dict.fromkeys(bodies) if b is not None]
             stamps = [self.probes[b].latest_stamp for b in bodies]
-            self.commands.append([now, kind, path, data.hex(), bodies, stamps])
+            self.commands.append([sent_ns, kind, path, data.hex(), bodies, stamps])
             return
         body = self.body_of(path)
         stamp = self.probes[body].latest_stamp if body is not None else None
-        self.commands.append([now, kind, path, data.hex(), body, stamp])
+        self.commands.append([sent_ns, kind, path, data.hex(), body, stamp])
 
 
 if __name__ == "__main__":

@@ -83,7 +83,10 @@ def _batched(run: dict) -> dict:
     """The same run with its three states sent as one set_transforms frame each, of two bodies (Tank, Tank2)."""
     from tutorial.view.meshcat_batch import pack_batch
 
-    run["views"]["Tank2"] = {"applied": [list(a) for a in run["views"]["Tank"]["applied"]]}
+    # Tank2's states arrive 0.5 ms later than Tank's and are applied 0.5 ms later: its stages differ.
+    run["views"]["Tank2"] = {
+        "applied": [[stamp, a + MS // 2, d + MS // 2] for stamp, a, d in run["views"]["Tank"]["applied"]]
+    }
     tape, msgs = [], []
     for k, (record, msg) in enumerate(zip(run["tape"], run["page"]["msgs"])):
         matrix = [float(k)] * 16
@@ -103,7 +106,11 @@ def _batched(run: dict) -> dict:
 def test_one_page_message_of_a_frame_counts_every_state_in_it():
     out = analyse_tutorial(_batched(_run(0)), warmup=0.0)
     assert out["states_drawn"] == 4  # two bodies, each with two states inside the run
-    assert out["publish_to_drawn"]["p50"] == pytest.approx(15.0, abs=1e-3)
+    assert out["publish_to_drawn"]["p50"] == pytest.approx(15.0, abs=1e-3)  # one message: drawn together
+    # each body's own moments, not the first body's for all: Tank 1.0 ms to its callback, Tank2 1.5 ms
+    assert out["publish_to_callback"]["max"] == pytest.approx(1.5, abs=1e-3)
+    assert out["publish_to_callback"]["p50"] == pytest.approx(1.25, abs=1e-3)
+    assert out["applied_to_sent"]["p50"] == pytest.approx(1.75, abs=1e-3)
 
 
 def test_the_bare_replay_sends_a_frame_as_meshcats_own_single_commands():

@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 from tutorial.core.world import ModelEntry, build_world
 from tutorial.view import meshcat_page
-from tutorial.view.meshcat_batch import BadBatch, pack_batch, split_batch
+from tutorial.view.meshcat_batch import MAX_COMMANDS, MAX_PATH_CHARS, MAX_PATH_PARTS, BadBatch, pack_batch, split_batch
 
 from browser import chromium
 from conftest import MODEL
@@ -60,6 +60,17 @@ def test_each_inner_command_is_stored_as_meshcat_python_packs_it_alone():
     assert [data for _, data in split] == [umsgpack.packb(c) for c in commands]
 
 
+GOOD = {"type": "set_transform", "path": "/meshcat/a", "matrix": [0.0] * 16}
+
+
+def batch_of(*commands) -> bytes:
+    return umsgpack.packb({"type": "set_transforms", "commands": list(commands)})
+
+
+def transform(**changes) -> dict:
+    return dict(GOOD, **changes)
+
+
 @pytest.mark.unit
 @pytest.mark.parametrize(
     "data",
@@ -68,20 +79,17 @@ def test_each_inner_command_is_stored_as_meshcat_python_packs_it_alone():
         umsgpack.packb([1, 2, 3]),
         umsgpack.packb({"type": "set_transform", "commands": []}),
         umsgpack.packb({"type": "set_transforms", "commands": "no"}),
-        umsgpack.packb({"type": "set_transforms", "commands": [{"type": "delete", "path": "/a"}]}),
-        umsgpack.packb(
-            {"type": "set_transforms", "commands": [{"type": "set_transform", "path": 3, "matrix": [0.0] * 16}]}
-        ),
-        umsgpack.packb(
-            {"type": "set_transforms", "commands": [{"type": "set_transform", "path": "/a", "matrix": [0.0] * 15}]}
-        ),
-        umsgpack.packb(
-            {"type": "set_transforms", "commands": [{"type": "set_transform", "path": "/a", "matrix": [True] * 16}]}
-        ),
-        umsgpack.packb(
-            {"type": "set_transforms", "commands": [{"type": "set_transform", "path": "/a", "matrix": ["1"] * 16}]}
-        ),
+        batch_of({"type": "delete", "path": "/a"}),
+        batch_of(transform(path=3)),
+        batch_of(transform(matrix=[0.0] * 15)),
+        batch_of(transform(matrix=[True] * 16)),
+        batch_of(transform(matrix=["1"] * 16)),
+        batch_of(GOOD, transform(matrix=None)),  # a good command first: the batch is still refused whole
+        batch_of(transform(path="/a" * (MAX_PATH_PARTS + 1))),  # deeper than the server walks
+        batch_of(transform(path="/" + "x" * MAX_PATH_CHARS)),
+        batch_of(*[GOOD] * (MAX_COMMANDS + 1)),
     ],
+    ids=lambda d: f"{len(d)}B",
 )
 def test_a_bad_batch_is_refused_whole(data):
     with pytest.raises(BadBatch):
@@ -97,6 +105,54 @@ def test_any_bytes_are_a_batch_or_a_bad_batch(data):
     except BadBatch:
         return
     assert all(isinstance(path, list) and isinstance(packed, bytes) for path, packed in split)
+
+
+_INT = st.integers(-(2**63), 2**63 - 1)  # what msgpack can hold
+_ANY = st.one_of(
+    st.none(),
+    st.booleans(),
+    _INT,
+    st.floats(),
+    st.text(max_size=40),
+    st.lists(st.floats(), max_size=20),
+    st.lists(_INT, min_size=16, max_size=16),
+)
+_COMMAND = st.one_of(
+    st.fixed_dictionaries({"type": st.just("set_transform"), "path": _ANY, "matrix": _ANY}),
+    st.fixed_dictionaries(
+        {
+            "type": st.just("set_transform"),
+            "path": st.text(max_size=80),
+            "matrix": st.lists(st.one_of(st.floats(), _INT, st.booleans()), min_size=16, max_size=16),
+        }
+    ),
+    st.dictionaries(st.text(max_size=8), _ANY, max_size=4),
+    _ANY,
+)
+
+
+@pytest.mark.unit
+@examples(60)
+@given(st.lists(_COMMAND, max_size=6))
+def test_any_commands_in_a_well_formed_batch_are_taken_whole_or_refused_whole(commands):
+    try:
+        split = split_batch(batch_of(*commands))
+    except BadBatch:
+        assert not all(
+            isinstance(c, dict)
+            and c.get("type") == "set_transform"
+            and isinstance(c.get("path"), str)
+            and isinstance(c.get("matrix"), list)
+            and len(c["matrix"]) == 16
+            and not any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in c["matrix"])
+            and len(c["path"]) <= MAX_PATH_CHARS
+            for c in commands
+        )
+        return
+    assert len(split) == len(commands)
+    for (path, packed), command in zip(split, commands):
+        assert path == [part for part in command["path"].split("/") if part]
+        assert umsgpack.unpackb(packed) == command
 
 
 # ---- the project's server, and meshcat's own (a process each, no ROS) ----------------------------------
@@ -131,7 +187,7 @@ def stored_transforms(server) -> dict[str, list[float]]:
 
 
 @pytest.fixture
-def server_of(request):
+def server_of():
     servers = []
 
     def start(batch: bool):
@@ -174,27 +230,48 @@ def test_the_scene_sends_a_frame_as_one_message_where_it_can_and_every_pose_arri
         scene.close()
 
 
-@pytest.mark.cross_process
-def test_a_bad_batch_is_answered_with_an_error_and_the_server_goes_on(server_of):
+def ask(server, frames: list[bytes]) -> bytes:
+    """One request to the server's zmq socket, its reply (10 s at most)."""
     import zmq
 
-    server = server_of(True)
     sock = zmq.Context.instance().socket(zmq.REQ)
     sock.setsockopt(zmq.LINGER, 0)
     sock.connect(server.zmq_url)
     try:
-        for frames in ([b"set_transforms", b"", b"\xc1"], [b"set_transforms", b""]):
-            sock.send_multipart(frames)
-            assert sock.poll(10000)
-            assert sock.recv().startswith(b"error: ")
-        good = pack_batch([lowered("/meshcat/box", pose(0.75))])
-        sock.send_multipart([b"set_transforms", b"", good])
-        assert sock.poll(10000)
-        assert sock.recv() == b"ok"
+        sock.send_multipart(frames)
+        assert sock.poll(10000), f"no reply to {frames[0][:20]!r}"
+        return sock.recv()
     finally:
         sock.close()
+
+
+@pytest.mark.cross_process
+def test_a_bad_batch_is_answered_with_an_error_stores_nothing_and_the_server_goes_on(server_of):
+    server = server_of(True)
+    deep = lowered("/meshcat" + "/a" * 3000, pose(1.0))  # deeper than Python's recursion limit
+    for frames in (
+        [b"set_transforms", b"", b"\xc1"],
+        [b"set_transforms", b""],
+        [b"set_transforms", b"", pack_batch([lowered("/meshcat/early", pose(0.5)), deep])],
+    ):
+        assert ask(server, frames).startswith(b"error: ")
+    assert "/meshcat/early" not in stored_transforms(server)  # a refused batch is refused whole
+    assert ask(server, [b"set_transforms", b"", pack_batch([lowered("/meshcat/box", pose(0.75))])]) == b"ok"
     assert stored_transforms(server)["/meshcat/box"][12] == 0.75  # column-major: x is the 13th number
     assert server.process.poll() is None
+
+
+@pytest.mark.cross_process
+@pytest.mark.parametrize("batch", [True, False], ids=["project_server", "meshcats_own_server"])
+def test_what_meshcats_own_handler_cannot_take_gets_an_error_not_a_dead_server(server_of, batch):
+    from meshcat.commands import SetTransform
+
+    server = server_of(batch)
+    deep = "/meshcat" + "/a" * 3000
+    single = umsgpack.packb(SetTransform(np.eye(4), type("P", (), {"lower": lambda self: deep})()).lower())
+    for frames in ([b"\xff\xfe", b"", b""], [b"set_transform", deep.encode(), single]):
+        assert ask(server, frames).startswith(b"error: ")
+    assert ask(server, [b"url"]) == server.web_url.encode()  # still answering
 
 
 @pytest.mark.cross_process
@@ -205,8 +282,9 @@ def test_meshcats_own_server_serves_meshcats_own_page_and_the_project_server_its
     with open(f"{z.VIEWER_ROOT}/{z.VIEWER_HTML}", "rb") as f:
         assert own == f.read()
     ours = urllib.request.urlopen(server_of(True).web_url, timeout=10).read().decode()
-    assert ours == meshcat_page.PAGE_HTML
-    assert 'src="main.min.js"' in ours
+    assert ours == meshcat_page.with_page_script(own.decode())
+    assert ours.startswith(own.decode()[: own.decode().rfind("</body>")])  # meshcat's page, unchanged, then ours
+    assert ours.count("<script>") == own.decode().count("<script>") + 1
 
 
 # ---- the page, in a real browser ----------------------------------------------------------------------
@@ -277,3 +355,103 @@ def test_the_page_leaves_out_multisampling_on_a_software_renderer_unless_asked(s
         page.wait_for_function("window.rttPage !== undefined")
         assert page.evaluate("window.rttPage.antialias") is True
         assert page.evaluate(attributes) is True
+
+
+# ---- the scene's socket: its fallback, a refusal, a timeout (a stand-in server in a thread) ------------
+
+
+class StandInServer:
+    """A zmq REP socket on 127.0.0.1 answering each request from ``replies`` in turn; a thread of its own.
+
+    A reply may be an ``threading.Event``-gated one: ``(event, reply)`` waits for the event (10 s at most)
+    before answering.  Requests are kept; exceptions in the thread are collected in ``errors``.
+    """
+
+    def __init__(self, replies: list):
+        import threading
+
+        import zmq
+
+        self.socket = zmq.Context.instance().socket(zmq.REP)
+        self.socket.setsockopt(zmq.LINGER, 0)
+        port = self.socket.bind_to_random_port("tcp://127.0.0.1")
+        self.url = f"tcp://127.0.0.1:{port}"
+        self.replies, self.requests, self.errors = list(replies), [], []
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self) -> None:
+        try:
+            for reply in self.replies:
+                if not self.socket.poll(10000):
+                    return
+                self.requests.append(self.socket.recv_multipart())
+                if isinstance(reply, tuple):
+                    event, reply = reply
+                    assert event.wait(10), "the test never released the late reply"
+                self.socket.send(reply)
+        except Exception as error:  # collected: the test asserts there were none
+            self.errors.append(error)
+
+    def close(self) -> None:
+        self.thread.join(15)
+        self.socket.close()
+        assert not self.thread.is_alive() and not self.errors, self.errors
+
+
+FRAME = [("/meshcat/rtt/a", pose(1.0)), ("/meshcat/rtt/b", pose(2.0))]
+
+
+@pytest.mark.unit
+def test_meshcats_unknown_command_answer_turns_batching_off_and_the_frame_goes_as_singles():
+    from tutorial.view.scene import _Pipeline
+
+    server = StandInServer([b"error: unrecognized comand", b"ok", b"ok", b"ok", b"ok"])
+    pipe = _Pipeline(server.url)
+    try:
+        pipe.send_frame(FRAME)
+        pipe.send_frame(FRAME)
+    finally:
+        pipe.close()
+        server.close()
+    assert pipe.batch is False and pipe.messages == 1 + 2 + 2
+    assert [r[0] for r in server.requests] == [b"set_transforms", b"set_transform", b"set_transform"] + [
+        b"set_transform"
+    ] * 2
+
+
+@pytest.mark.unit
+def test_any_other_refusal_of_a_frame_is_raised_not_hidden_by_a_fallback():
+    from tutorial.view.scene import _Pipeline
+
+    server = StandInServer([b"error: not msgpack within the limits: ExtraData"])
+    pipe = _Pipeline(server.url)
+    try:
+        with pytest.raises(RuntimeError, match="refused a frame"):
+            pipe.send_frame(FRAME)
+        assert pipe.batch is True
+    finally:
+        pipe.close()
+        server.close()
+
+
+@pytest.mark.unit
+def test_after_a_timeout_a_late_reply_is_not_taken_for_the_next_frames():
+    import threading
+
+    from tutorial.view.scene import _Pipeline
+
+    release = threading.Event()
+    # The first frame's reply comes late, and says something the next frame must never read as its own.
+    server = StandInServer([(release, b"error: the first frame's late reply"), b"ok"])
+    pipe = _Pipeline(server.url)
+    try:
+        with pytest.raises(RuntimeError, match="did not answer"):
+            pipe.send_frame(FRAME, timeout_ms=200)
+        release.set()
+        pipe.send_frame(FRAME, timeout_ms=10000)  # its own reply: ok
+        assert pipe.batch is True
+    finally:
+        release.set()
+        pipe.close()
+        server.close()

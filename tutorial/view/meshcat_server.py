@@ -154,12 +154,20 @@ def main(argv=None) -> None:
 def _bridge_classes():
     """The two server classes, made on first use (meshcat's server module starts zmq when imported)."""
     import tornado.web
-    from meshcat.servers.zmqserver import ZMQWebSocketBridge, find_node
+    import zmq
+    from meshcat.servers.zmqserver import VIEWER_HTML, VIEWER_ROOT, ZMQWebSocketBridge, find_node
 
     from tutorial.view import meshcat_batch, meshcat_page
 
     class LocalhostBridge(ZMQWebSocketBridge):
-        """meshcat's server with its web server bound to 127.0.0.1 (the tornado IO loop's thread)."""
+        """meshcat's server with its web server bound to 127.0.0.1 (the tornado IO loop's thread).
+
+        A command meshcat's own handler cannot take (a frame that is not
+        UTF-8, a path deeper than Python's recursion limit) would end its
+        handler without a reply, and a REP socket that never replies never
+        reads again: every later client would wait forever.  Here it is
+        answered with ``error: ...`` instead, and the server goes on.
+        """
 
         def make_app(self):
             app = super().make_app()
@@ -167,11 +175,24 @@ def _bridge_classes():
             app.listen = lambda port, **kw: listen(port, address=HOST, **kw)
             return app
 
+        def handle_zmq(self, frames):
+            try:
+                super().handle_zmq(frames)
+            except Exception as error:  # any input: one error reply, never a dead socket
+                try:
+                    self.zmq_socket.send(f"error: {type(error).__name__}".encode())
+                except zmq.ZMQError:  # the handler had replied before it failed: nothing more to send
+                    pass
+
     class PageHandler(tornado.web.RequestHandler):
+        """``GET /static/``: meshcat's own ``index.html`` with the project's script added (:mod:`.meshcat_page`)."""
+
         def get(self):
+            with open(f"{VIEWER_ROOT}/{VIEWER_HTML}", encoding="utf-8") as f:
+                page = meshcat_page.with_page_script(f.read())
             self.set_header("Content-Type", "text/html; charset=utf-8")
             self.set_header("Cache-Control", "no-store, no-cache, must-revalidate, max-age=0")
-            self.write(meshcat_page.PAGE_HTML)
+            self.write(page)
 
     class BatchingBridge(LocalhostBridge):
         """:class:`LocalhostBridge` that also takes ``set_transforms`` (the tornado IO loop's thread).
@@ -182,11 +203,14 @@ def _bridge_classes():
 
         def make_app(self):
             app = super().make_app()
-            # Ahead of meshcat's own /static/ files: the page (its script and the rest stay meshcat's).
+            # Ahead of meshcat's own /static/ files (tornado takes the first rule that matches; the
+            # Application has no public call to put a rule first): the page.  Every other file,
+            # meshcat's script among them, is still meshcat's own.
             app.wildcard_router.rules.insert(0, tornado.web.url(r"/static/(?:index\.html)?", PageHandler))
             return app
 
         def handle_zmq(self, frames):
+            """One zmq request: ``set_transforms`` here, everything else as meshcat's server does."""
             if frames[0] != meshcat_batch.SET_TRANSFORMS.encode():
                 return super().handle_zmq(frames)
             try:
@@ -198,7 +222,8 @@ def _bridge_classes():
                 return
             for path, data in commands:  # as meshcat's server stores a set_transform, for pages that open later
                 find_node(self.tree, path).transform = data
-            self.forward_to_websockets(frames)  # one WebSocket message for the whole frame
+            if commands:
+                self.forward_to_websockets(frames)  # one WebSocket message for the whole frame
             self.zmq_socket.send(b"ok")
 
     return LocalhostBridge, BatchingBridge

@@ -245,24 +245,34 @@ class _Pipeline:
     The server's socket is REP: a DEALER talks to it by putting an empty
     frame before each request, and gets ``[b"", reply]`` back, in order.
     ``batch`` says whether the server takes ``set_transforms``: True until
-    it answers one with anything but ``ok``.
+    it answers one with meshcat's ``error: unrecognized comand``.
     Owned by the thread that owns the Scene.
     """
 
-    def __init__(self, zmq_url: str):
-        import zmq
+    UNKNOWN_COMMAND = b"error: unrecognized"  # how meshcat's own server answers a command it does not know
 
-        self.socket = zmq.Context.instance().socket(zmq.DEALER)
-        self.socket.setsockopt(zmq.LINGER, 0)
-        self.socket.connect(zmq_url)
+    def __init__(self, zmq_url: str):
+        self.zmq_url = zmq_url
+        self.socket = None
+        self._connect()
         self.batch = True
         self.messages = 0  # sent to the server (a frame is one while batch holds)
 
+    def _connect(self) -> None:
+        import zmq
+
+        if self.socket is not None:
+            self.socket.close()
+        self.socket = zmq.Context.instance().socket(zmq.DEALER)
+        self.socket.setsockopt(zmq.LINGER, 0)
+        self.socket.connect(self.zmq_url)
+
     def send_frame(self, transforms: list, timeout_ms: int = 5000) -> None:
-        """Send ``[(meshcat path, 4x4 pose), ...]`` and wait until the server has applied them all.
+        """Send ``[(meshcat path, 4x4 pose in m), ...]`` and wait until the server has applied them all.
 
         Raises:
-            RuntimeError: the server did not answer within ``timeout_ms``, or refused a single command.
+            RuntimeError: the server did not answer within ``timeout_ms`` (the socket is then made
+                anew, so a late reply is never taken for a later frame's), or it refused a command.
         """
         from meshcat.commands import SetTransform
 
@@ -272,21 +282,24 @@ class _Pipeline:
         if self.batch:
             self.socket.send_multipart([b"", SET_TRANSFORMS.encode(), b"", pack_batch(commands)])
             self.messages += 1
-            if self._replies(1, timeout_ms) == [b"ok"]:
+            [reply] = self._replies(1, timeout_ms)
+            if reply == b"ok":
                 return
-            self.batch = False  # meshcat's own server: "error: unrecognized comand"; it applied nothing
+            if not reply.startswith(self.UNKNOWN_COMMAND):  # the project's server refused it: a bug, said aloud
+                raise RuntimeError(f"the meshcat server refused a frame: {reply[:200]!r}")
+            self.batch = False  # meshcat's own server: it applied nothing; single commands from now on
         for command in commands:
             self.socket.send_multipart([b"", b"set_transform", command["path"].encode(), pack_command(command)])
         self.messages += len(commands)
-        replies = self._replies(len(commands), timeout_ms)
-        refused = [r for r in replies if r != b"ok"]
+        refused = [r for r in self._replies(len(commands), timeout_ms) if r != b"ok"]
         if refused:
-            raise RuntimeError(f"the meshcat server refused a transform: {refused[0][:80]!r}")
+            raise RuntimeError(f"the meshcat server refused a transform: {refused[0][:200]!r}")
 
     def _replies(self, n: int, timeout_ms: int) -> list[bytes]:
         out = []
         while len(out) < n:
             if not self.socket.poll(timeout_ms):
+                self._connect()  # the replies still owed would come late and be read as the next frame's
                 raise RuntimeError(f"the meshcat server did not answer within {timeout_ms:d} ms")
             out.append(self.socket.recv_multipart()[-1])
         return out
