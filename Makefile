@@ -39,7 +39,7 @@ test-fast: $(VENV)/.installed
 # many as make test's fixed set (RTT_FUZZ_FACTOR=N changes that); failures are kept in .hypothesis/ and
 # tried first next time (tests/fuzzing.py).
 fuzz: $(VENV)/.installed
-	RTT_FUZZ=1 RTT_TEST_MODE=1 $(PY) -m pytest tests/test_fuzz_files.py tests/test_fuzz_messages.py -q
+	RTT_FUZZ=1 RTT_TEST_MODE=1 $(PY) -m pytest tests/test_fuzz_files.py tests/test_fuzz_messages.py tests/test_meshcat_server.py -m unit -q
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
