@@ -274,6 +274,29 @@ def test_what_meshcats_own_handler_cannot_take_gets_an_error_not_a_dead_server(s
     assert ask(server, [b"url"]) == server.web_url.encode()  # still answering
 
 
+@pytest.mark.unit
+def test_a_page_that_closed_meanwhile_is_skipped_and_the_others_still_get_the_frame():
+    from types import SimpleNamespace
+
+    import tornado.websocket
+
+    from tutorial.view.meshcat_server import _bridge_classes
+
+    class Page:
+        def __init__(self, closed: bool):
+            self.closed, self.got = closed, []
+
+        def write_message(self, data, binary=False):
+            if self.closed:
+                raise tornado.websocket.WebSocketClosedError()
+            self.got.append((data, binary))
+
+    gone, open_page = Page(closed=True), Page(closed=False)
+    LocalhostBridge, _ = _bridge_classes()
+    LocalhostBridge.forward_to_websockets(SimpleNamespace(websocket_pool={gone, open_page}), [b"k", b"", b"frame"])
+    assert open_page.got == [(b"frame", True)]
+
+
 @pytest.mark.cross_process
 def test_meshcats_own_server_serves_meshcats_own_page_and_the_project_server_its_page(server_of):
     import meshcat.servers.zmqserver as z

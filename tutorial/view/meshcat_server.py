@@ -8,8 +8,10 @@ exit when the process that started it goes away, so no server is left behind.
 It also knows one command meshcat's does not: ``set_transforms``, a frame's
 transforms in one message (:mod:`tutorial.view.meshcat_batch`), and serves
 a page that draws it (:mod:`tutorial.view.meshcat_page`; it also leaves out
-multisampling where the browser renders without a GPU).  With ``batch=False`` it is meshcat's server and
-page as they ship, only bound to 127.0.0.1 (the benchmark's bare baseline).
+multisampling where the browser renders without a GPU).  With
+``batch=False`` it is meshcat's server and page as they ship, only bound to
+127.0.0.1 and answering what meshcat's handler cannot take with an error
+(the benchmark's bare baseline).
 
 ``python -m tutorial.view.meshcat_server`` prints ``zmq_url=...`` and
 ``web_url=...`` lines, as meshcat's own server does.
@@ -154,6 +156,7 @@ def main(argv=None) -> None:
 def _bridge_classes():
     """The two server classes, made on first use (meshcat's server module starts zmq when imported)."""
     import tornado.web
+    import tornado.websocket
     import zmq
     from meshcat.servers.zmqserver import VIEWER_HTML, VIEWER_ROOT, ZMQWebSocketBridge, find_node
 
@@ -176,12 +179,29 @@ def _bridge_classes():
             return app
 
         def handle_zmq(self, frames):
+            """One zmq request, taken by :meth:`take`; whatever it raises is answered, never left unanswered."""
             try:
-                super().handle_zmq(frames)
+                self.take(frames)
             except Exception as error:  # any input: one error reply, never a dead socket
                 try:
                     self.zmq_socket.send(f"error: {type(error).__name__}".encode())
                 except zmq.ZMQError:  # the handler had replied before it failed: nothing more to send
+                    pass
+
+        def take(self, frames):
+            """One zmq request, as meshcat's server takes it."""
+            ZMQWebSocketBridge.handle_zmq(self, frames)
+
+        def forward_to_websockets(self, frames):
+            """Send a command's bytes to every open page; a page that closed meanwhile is skipped.
+
+            (Its ``on_close`` takes it out of the pool; until then, writing to it
+            raises, which in meshcat's own loop would leave the request unanswered.)
+            """
+            for websocket in list(self.websocket_pool):
+                try:
+                    websocket.write_message(frames[2], binary=True)
+                except tornado.websocket.WebSocketClosedError:
                     pass
 
     class PageHandler(tornado.web.RequestHandler):
@@ -209,10 +229,10 @@ def _bridge_classes():
             app.wildcard_router.rules.insert(0, tornado.web.url(r"/static/(?:index\.html)?", PageHandler))
             return app
 
-        def handle_zmq(self, frames):
+        def take(self, frames):
             """One zmq request: ``set_transforms`` here, everything else as meshcat's server does."""
             if frames[0] != meshcat_batch.SET_TRANSFORMS.encode():
-                return super().handle_zmq(frames)
+                return super().take(frames)
             try:
                 if len(frames) != 3:
                     raise meshcat_batch.BadBatch("expected 3 frames")
