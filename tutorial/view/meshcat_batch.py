@@ -2,11 +2,12 @@
 
 meshcat's protocol has one message per command, so a frame that moves
 three bodies costs the server three forwards and the page three WebSocket
-messages, each a task on the page's busy main thread.  On a machine
-without a GPU the page rasterizes on the same cores as the simulation,
-and those tasks were most of the time from the viewer's send to the
-pixel (``make bench``'s publish-to-pixel experiment; the book's Benchmarks
-page).
+messages, each a task on the page's main thread.  On a machine without a
+GPU the page rasterizes on the same cores as the simulation, and those
+tasks added to the time from the viewer's send to the pixel: with eight
+tanks, one message a frame (and no multisampling, see
+:mod:`tutorial.view.meshcat_page`) took the p50 from 67 to 31-38 ms
+(``make bench``'s publish-to-pixel experiment; the book's Benchmarks page).
 
 ``set_transforms`` holds a frame's ``set_transform`` commands, each exactly
 as meshcat-python lowers it::
@@ -19,9 +20,10 @@ command in its scene tree, as if it had come alone (a page that opens
 later is sent the newest pose of each body, by meshcat's own code), and
 forwards the whole as one WebSocket message.  The page it serves
 (:mod:`tutorial.view.meshcat_page`) hands each inner command to
-meshcat's own ``handle_command``.  meshcat's own server does not know the command: it
-answers ``error: ...`` and forwards nothing, and the scene then sends one
-command per transform again (:class:`tutorial.view.scene.Scene`).
+meshcat's own ``handle_command``.  meshcat's own server does not know the
+command: it answers ``error: unrecognized comand`` and forwards nothing,
+and the scene then sends one command per transform again
+(:class:`tutorial.view.scene.Scene`).
 
 Every function here may be called from any thread.
 """
