@@ -146,6 +146,7 @@ def test_any_commands_in_a_well_formed_batch_are_taken_whole_or_refused_whole(co
             and len(c["matrix"]) == 16
             and not any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in c["matrix"])
             and len(c["path"]) <= MAX_PATH_CHARS
+            and c["path"].count("/") <= MAX_PATH_PARTS
             for c in commands
         )
         return

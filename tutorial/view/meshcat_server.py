@@ -204,12 +204,13 @@ def _bridge_classes():
                 except tornado.websocket.WebSocketClosedError:
                     pass
 
+    with open(f"{VIEWER_ROOT}/{VIEWER_HTML}", encoding="utf-8") as f:
+        page = meshcat_page.with_page_script(f.read())  # made once: the files are the installed package's
+
     class PageHandler(tornado.web.RequestHandler):
         """``GET /static/``: meshcat's own ``index.html`` with the project's script added (:mod:`.meshcat_page`)."""
 
         def get(self):
-            with open(f"{VIEWER_ROOT}/{VIEWER_HTML}", encoding="utf-8") as f:
-                page = meshcat_page.with_page_script(f.read())
             self.set_header("Content-Type", "text/html; charset=utf-8")
             self.set_header("Cache-Control", "no-store, no-cache, must-revalidate, max-age=0")
             self.write(page)
