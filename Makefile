@@ -6,6 +6,7 @@
 #       make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
+#       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
 #       make export (write the controllers from the notebooks that build them),
 #       make run-notebooks (run every notebook and save its outputs, the ones nbval checks).
 
@@ -13,7 +14,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast fuzz lint notebooks book bench export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab fuzz lint notebooks book bench export run-notebooks venv clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -34,6 +35,12 @@ test: $(VENV)/.installed lint
 # The unit tier only: no ROS, no process, no browser.
 test-fast: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m unit -q
+
+# Every notebook's Run All in JupyterLab, as a learner runs it (tests/test_jupyterlab.py; make test runs the
+# setup check and the two notebooks a learner works in with the mouse, and nbval runs every notebook).
+test-lab: $(VENV)/.installed
+	bash scripts/ensure-chromium.sh
+	RTT_LAB_ALL=1 $(PY) -m pytest tests/test_jupyterlab.py -q
 
 # The property-based tests (hypothesis) of tests/test_fuzz_*.py at length: random examples, 100 times as
 # many as make test's fixed set (RTT_FUZZ_FACTOR=N changes that); failures are kept in .hypothesis/ and

@@ -162,7 +162,8 @@ def print_report(r: dict) -> None:
             if tut.get("page"):
                 page = tut["page"]
                 print(
-                    f"    the tutorial's page: multisampling {'on' if page['antialias'] else 'off'}, {page['renderer']}"
+                    f"    the tutorial's page: multisampling {'on' if page['antialias'] else 'off'}, "
+                    f"{page.get('detail', 'full')} detail, {page['renderer']}"
                 )
     if r.get("network"):
         from benchmarks.experiments.network import print_table

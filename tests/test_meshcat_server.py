@@ -381,6 +381,37 @@ def test_the_page_leaves_out_multisampling_on_a_software_renderer_unless_asked(s
         assert page.evaluate(attributes) is True
 
 
+@pytest.mark.browser
+@pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
+def test_the_page_draws_round_shapes_with_fewer_triangles_on_a_software_renderer_unless_asked(server_of):
+    import meshcat.geometry as g
+
+    from jupyterlab import browser
+
+    server = server_of(True)
+    vis = server.visualizer()  # set before the pages open: each page gets the server's stored objects
+    vis["s"].set_object(g.Sphere(0.1))
+    vis["c"].set_object(g.Cylinder(0.2, 0.1))
+    vis["b"].set_object(g.Box([0.1, 0.2, 0.3]))
+    parameters = """['s', 'c', 'b'].map(n => {
+        const p = viewer.scene_tree.find(['meshcat', n, '<object>']).object.geometry.parameters;
+        return [p.widthSegments, p.heightSegments, p.radialSegments, p.width, p.height, p.depth];
+    })"""
+    loaded = "window.viewer && viewer.scene_tree.find(['meshcat', 'b', '<object>']).object.isMesh"
+    with browser(480, 380) as page:
+        page.goto(server.web_url)
+        page.wait_for_function(loaded)
+        assert page.evaluate("window.rttPage.detail") == "low"  # SwiftShader: this machine has no GPU
+        sphere, cylinder, box = page.evaluate(parameters)
+        assert sphere[:2] == [12, 8] and cylinder[2] == 16
+        assert box[3:] == [0.1, 0.2, 0.3]  # a box has no segments to spare: as sent
+        page.goto(server.web_url + "?detail=full")  # the server kept meshcat's own counts for every page
+        page.wait_for_function(loaded)
+        assert page.evaluate("window.rttPage.detail") == "full"
+        sphere, cylinder, box = page.evaluate(parameters)
+        assert sphere[:2] == [20, 20] and cylinder[2] == 50
+
+
 # ---- the scene's socket: its fallback, a refusal, a timeout (a stand-in server in a thread) ------------
 
 

@@ -32,6 +32,10 @@ The viewer sends each frame as one ``set_transforms`` message
 page message is then joined to every state of its frame.  ``--unbatched``
 runs the viewer on meshcat's own server and page instead, one message per
 transform, as before that command (to compare, in the same conditions).
+On this machine the project's page draws without multisampling and with
+fewer triangles for round shapes (:mod:`tutorial.view.meshcat_page`);
+``--full-detail`` keeps meshcat's triangle counts (``?detail=full``), to
+compare.
 
 **The baseline, in the same run**: a bare script replays, to a bare meshcat
 server and page, the exact transforms the viewer sent (the scene, then every
@@ -186,7 +190,7 @@ class Page:
         """
         samples = self.page.evaluate("window.__rtt")
         samples["offset_ns"] = self.clock_offset_ns()
-        # The project's page says which renderer it got and whether it kept multisampling (meshcat's own: None).
+        # The project's page: its renderer, multisampling and detail (meshcat's own page: None).
         samples["page"] = self.page.evaluate("window.rttPage || null")
         return samples
 
@@ -233,10 +237,12 @@ def _wait(proc: subprocess.Popen, timeout: float) -> None:
         raise RuntimeError(f"{proc.args} exited {proc.returncode}: {proc.stderr.read()[-2000:]}")
 
 
-def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True) -> dict:
+def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True, query: str = "") -> dict:
     """One case through the tutorial: simulation, viewer, its page; the raw records of each.
 
     ``batch=False`` gives the viewer meshcat's own server and page, so it sends one command per transform.
+    ``query`` is added to the page's address (``"?detail=full"``: the project's page keeps meshcat's
+    triangle counts, :mod:`tutorial.view.meshcat_page`).
     """
     kind, size, rate = CASES[case]
     sim_project, view_project = (tanks_projects if kind == "tanks" else arm_projects)(size, directory)
@@ -251,7 +257,7 @@ def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True)
     page = None
     try:
         url = _meshcat_url(_lines(viewer), 60)
-        page = Page(url)
+        page = Page(url + query)
         sim = start(
             py("tutorial.tools.rtt_run", str(sim_project), "--headless", "--duration", str(seconds), "--json")
             + ["--ros-args", "-p", f"RttJointStatePublisher.rate:={rate}"],
@@ -476,15 +482,16 @@ def _page_rates(page: dict, start_ns: int, end_ns: int, offset_ns: int) -> dict:
     }
 
 
-def pixel_latency(cases: list[str], seconds: float, warmup: float, batch: bool = True) -> dict:
+def pixel_latency(cases: list[str], seconds: float, warmup: float, batch: bool = True, query: str = "") -> dict:
     """Every case: the tutorial's stages and the bare replay's, in the same run.
 
-    ``batch=False``: the tutorial as before ``set_transforms`` (one message per transform), to compare.
+    ``batch=False``: the tutorial as before ``set_transforms`` (one message per transform), to compare;
+    ``query``: added to the tutorial page's address (:func:`tutorial_run`).
     """
     out = {}
     for case in cases:
         with tempfile.TemporaryDirectory() as d:
-            run = tutorial_run(case, seconds, Path(d), batch)
+            run = tutorial_run(case, seconds, Path(d), batch, query)
         samples, sent = bare_run(run["tape"])
         out[case] = {
             "tutorial": analyse_tutorial(run, warmup),
@@ -503,10 +510,16 @@ def main(argv=None) -> int:
         action="store_true",
         help="the viewer on meshcat's own server: one message per transform, as before set_transforms",
     )
+    p.add_argument(
+        "--full-detail",
+        action="store_true",
+        help="the project's page keeps meshcat's triangle counts on a software renderer (?detail=full), to compare",
+    )
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
-    r = pixel_latency(args.cases, args.seconds, args.warmup, batch=not args.unbatched)
+    query = "?detail=full" if args.full_detail else ""
+    r = pixel_latency(args.cases, args.seconds, args.warmup, batch=not args.unbatched, query=query)
     print(json.dumps(r, indent=1))
     return 0
 

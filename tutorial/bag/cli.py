@@ -31,7 +31,6 @@ import datetime
 import functools
 import json
 import math
-import signal
 import sys
 import time
 
@@ -113,29 +112,6 @@ def _finite(value: float | None) -> bool:
     return value is None or math.isfinite(value)
 
 
-class _StopRequest:
-    """Set by the SIGINT/SIGTERM handler, read by the main loop.
-
-    A plain attribute, not a ``threading.Event``: a signal handler runs on
-    the main thread between two bytecodes, possibly inside ``Event.wait``
-    holding the event's lock, and ``Event.set`` would take it again.
-    """
-
-    def __init__(self, on_stop=None):
-        self.requested = False
-        self._on_stop = on_stop
-
-    def __call__(self, signum, frame) -> None:
-        self.requested = True
-        if self._on_stop is not None:
-            self._on_stop()
-
-    def install(self) -> _StopRequest:
-        signal.signal(signal.SIGINT, self)
-        signal.signal(signal.SIGTERM, self)
-        return self
-
-
 def _fail(text: str, status: int = 2) -> int:
     print(f"{PROG}: {text}", file=sys.stderr, flush=True)
     return status
@@ -176,7 +152,7 @@ def record(args, argv: list[str]) -> int:
         )
     except (BagWriteError, ValueError) as exc:
         return _fail(f"record: {exc}")
-    stop = _StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
+    stop = ros_env.StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
     deadline = None if args.duration is None else time.monotonic() + args.duration
     try:
         _init_ros(argv)
@@ -243,7 +219,7 @@ def play(args, argv: list[str]) -> int:
     except (BagError, ValueError) as exc:
         return _fail(f"play: {exc}")
     _say_not_closed("play", player.info)
-    _StopRequest(player.request_stop).install()
+    ros_env.StopRequest(player.request_stop).install()
     _init_ros(argv)
     try:
         player.play()

@@ -259,6 +259,43 @@ def parse_command_line(parser, argv: Sequence[str]):
     return parser.parse_args(plain[1:])
 
 
+class StopRequest:
+    """Ctrl-C or SIGTERM as a request: set by the signal handler, read by the program's main loop.
+
+    ``install()`` (main thread) makes SIGINT and SIGTERM set ``requested``
+    and call ``on_stop`` (if given), instead of raising ``KeyboardInterrupt``
+    wherever the main thread happens to be: inside rclpy's executor, an
+    interrupted call leaves a half-made object whose clean-up prints a
+    traceback later.  Pair it with ``rclpy.init(...,
+    signal_handler_options=SignalHandlerOptions.NO)``, so rclpy does not
+    install its own handler over this one.
+
+    A plain attribute, not a ``threading.Event``: a signal handler runs on
+    the main thread between two bytecodes, possibly inside ``Event.wait``
+    holding the event's lock, and ``Event.set`` would take it again.
+    ``on_stop`` runs in the handler, so it must be as plain (set a flag).
+    """
+
+    def __init__(self, on_stop=None):
+        self.requested = False
+        self._on_stop = on_stop
+
+    def __call__(self, signum, frame) -> None:
+        self.requested = True
+        if self._on_stop is not None:
+            self._on_stop()
+
+    def install(self) -> StopRequest:
+        """Handle SIGINT and SIGTERM from now on (main thread only); ``self``.
+
+        Raises:
+            ValueError: called from a thread other than the main thread.
+        """
+        signal.signal(signal.SIGINT, self)
+        signal.signal(signal.SIGTERM, self)
+        return self
+
+
 def ignore_stop_signals() -> None:
     """Ignore further Ctrl-C and SIGTERM while the program cleans up (main thread, at the start of clean-up).
 

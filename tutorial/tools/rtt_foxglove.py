@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import functools
-import signal
 import sys
 import time
 
@@ -45,13 +44,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ros_env.parse_command_line(p, argv)
     if not 0 <= args.port <= 65535:
         p.error("--port must be 0 to 65535")
-    stop = {"requested": False}
-
-    def request_stop(signum, frame):  # a plain flag: see tutorial.bag.cli._StopRequest
-        stop["requested"] = True
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
+    stop = ros_env.StopRequest().install()
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     bridge = FoxgloveBridge(
@@ -65,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{PROG}: {exc}", file=sys.stderr, flush=True)
             return 2
         deadline = None if args.duration is None else time.monotonic() + args.duration
-        while not stop["requested"] and (deadline is None or time.monotonic() < deadline):
+        while not stop.requested and (deadline is None or time.monotonic() < deadline):
             if bridge.error is not None:
                 print(f"{PROG}: stopped: {bridge.error!r}", file=sys.stderr, flush=True)
                 status = 1

@@ -50,6 +50,7 @@ def main(argv: list[str] | None = None) -> int:
     """``rtt-joy``: choose the input source, publish ``/joy`` until stopped; the exit status."""
     import rclpy
     from rclpy.executors import ExternalShutdownException
+    from rclpy.signals import SignalHandlerOptions
 
     argv = list(sys.argv if argv is None else argv)
     parser = argparse.ArgumentParser(prog="rtt-joy", description="Publish sensor_msgs/Joy on /joy.")
@@ -80,14 +81,17 @@ def main(argv: list[str] | None = None) -> int:
     ros_env.use_localhost_by_default()
     with contextlib.ExitStack() as stack:
         source, what = choose_source(args, stack)
-        rclpy.init(args=argv)
+        # Ctrl-C and SIGTERM end the loop below: raised as KeyboardInterrupt inside spin_once, they
+        # could leave one of rclpy's tasks half made, whose clean-up then printed a traceback.
+        stop = ros_env.StopRequest().install()
+        rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         node = rclpy.create_node(NODE_NAME)
         pub = JoyPublisher(node, source, rate=args.rate, autorepeat=args.autorepeat, duration=args.duration)
         print(f"[{node.get_fully_qualified_name()}] publishing {joy.TOPIC} from {what}", flush=True)
         try:
-            while rclpy.ok() and not pub.done:
+            while rclpy.ok() and not pub.done and not stop.requested:
                 rclpy.spin_once(node, timeout_sec=0.1)
-        except (KeyboardInterrupt, ExternalShutdownException):
+        except ExternalShutdownException:
             pass
         finally:
             ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up

@@ -4,7 +4,7 @@ The page is meshcat's own ``index.html``, as the installed meshcat ships
 it, with :data:`PAGE_SCRIPT` added at the end of its body
 (:func:`with_page_script`).  The script runs right after meshcat's own,
 which has made the ``viewer`` and opened its WebSocket, before the first
-message is handled and before the first frame is drawn.  It does two
+message is handled and before the first frame is drawn.  It does three
 things:
 
 - **it draws ``set_transforms``**, a frame's transforms in one message
@@ -22,39 +22,73 @@ things:
   (meshcat reads ``viewer.renderer`` each time it draws, resizes or
   captures; its camera controls are on the page's pane, not the canvas).
   ``?antialias=1`` or ``?antialias=0`` (also ``true``/``false``,
-  ``yes``/``no``, ``on``/``off``) in the page's address decides instead.
-  ``window.rttPage`` says what was chosen:
-  ``{renderer: "...", software: true, antialias: false}``.
+  ``yes``/``no``, ``on``/``off``) in the page's address decides instead;
+- **it draws round shapes with fewer triangles on a software renderer**
+  (low detail).  meshcat asks three.js for 20 x 20 segments a sphere and
+  50 a cylinder: a capsule is about 1,700 triangles, and the 48-joint
+  arm's 48 capsules are 83,000, which SwiftShader drew at 40 frames/s on
+  the idle machine and at 16 to 30 while the simulation and the viewer
+  ran.  Low detail caps the counts at :data:`COARSE_SEGMENTS` (a capsule
+  about 400 triangles; the arm then drew 60 frames/s, the idle machine's
+  per-frame CPU for 8 tanks fell by a quarter).  The page changes its
+  own copy of each ``set_object`` before meshcat's loader reads it; the
+  server keeps meshcat's counts, so each page chooses for itself.  Boxes
+  and meshes are drawn as sent.  ``?detail=full`` or ``?detail=low``
+  decides instead.
 
-The page runs in the browser; this module only holds the script and adds
-it (any thread), for :mod:`tutorial.view.meshcat_server`.
+``window.rttPage`` says what was chosen:
+``{renderer: "...", software: true, antialias: false, detail: "low"}``.
+
+The last two are :data:`LIGHTEN_SCRIPT`'s ``rttLighten(viewer, search)``,
+which the notebooks' recordings (:mod:`tutorial.notebook.replay`) call on
+each of their viewers too.
+
+The page runs in the browser; this module only holds the scripts and adds
+them (any thread), for :mod:`tutorial.view.meshcat_server`.
 """
 
 from __future__ import annotations
 
-PAGE_SCRIPT = """// ros-tank-tutorial's additions to meshcat's page (tutorial/view/meshcat_page.py)
-(function () {
-  if (typeof viewer === "undefined" || typeof MeshCat === "undefined") {
-    return;  // meshcat's script did not run: nothing to add to
-  }
-  // A frame's transforms in one message: each goes to meshcat's own handler.
-  const handleOne = viewer.handle_command.bind(viewer);
-  viewer.handle_command = function (cmd) {
-    if (cmd.type === "set_transforms") {
-      cmd.commands.forEach(handleOne);
-    } else {
-      handleOne(cmd);
-    }
-  };
-  // No multisampling where WebGL runs on the CPU, unless the address asks for it.
+import json
+
+# Low detail (see the module's docstring): the most segments a round shape gets, by three.js geometry type.
+COARSE_SEGMENTS = {
+    "SphereGeometry": {"widthSegments": 12, "heightSegments": 8},
+    "CylinderGeometry": {"radialSegments": 16},
+}
+
+LIGHTEN_SCRIPT = """// ros-tank-tutorial: lighter where WebGL runs on the CPU (tutorial/view/meshcat_page.py)
+function rttLighten(viewer, search) {
+  // Which renderer WebGL got, and what the address's query (search) asks for.
   const THREE = MeshCat.THREE;
   const old = viewer.renderer;
   const gl = old.getContext();
   const info = gl.getExtension("WEBGL_debug_renderer_info");
   const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
   const software = /swiftshader|llvmpipe|softpipe|software|microsoft basic render/i.test(name);
-  const asked = new URLSearchParams(location.search).get("antialias");
-  const antialias = asked === null ? !software : !/^(0|false|no|off)$/i.test(asked);
+  const query = new URLSearchParams(search);
+  const askedAntialias = query.get("antialias");
+  const antialias = askedAntialias === null ? !software : !/^(0|false|no|off)$/i.test(askedAntialias);
+  const askedDetail = query.get("detail");
+  const detail = askedDetail === "full" || askedDetail === "low" ? askedDetail : software ? "low" : "full";
+  // Low detail: each set_object's round shapes get at most COARSE's segments, in this page's copy
+  // of the command, before meshcat's own handler (and its loader) reads it.
+  if (detail === "low") {
+    const COARSE = __COARSE__;
+    const handle = viewer.handle_command.bind(viewer);
+    viewer.handle_command = function (cmd) {
+      const geometries = cmd.type === "set_object" && cmd.object && cmd.object.geometries;
+      for (const g of Array.isArray(geometries) ? geometries : []) {
+        const most = COARSE[g.type] || {};
+        for (const key in most) {
+          if (typeof g[key] === "number" && g[key] > most[key]) g[key] = most[key];
+        }
+      }
+      handle(cmd);
+    };
+  }
+  // No multisampling: a renderer without it in place of meshcat's (meshcat reads viewer.renderer
+  // each time it draws, resizes or captures; its camera controls are on the pane, not the canvas).
   if (!antialias && gl.getContextAttributes().antialias) {
     const renderer = new THREE.WebGLRenderer({antialias: false, alpha: true});
     renderer.shadowMap.enabled = old.shadowMap.enabled;
@@ -68,9 +102,30 @@ PAGE_SCRIPT = """// ros-tank-tutorial's additions to meshcat's page (tutorial/vi
     viewer.renderer = renderer;
     viewer.set_dirty();
   }
-  window.rttPage = {renderer: name, software: software, antialias: antialias};
+  return {renderer: name, software: software, antialias: antialias, detail: detail};
+}
+""".replace("__COARSE__", json.dumps(COARSE_SEGMENTS))
+
+PAGE_SCRIPT = (
+    LIGHTEN_SCRIPT
+    + """// ros-tank-tutorial's additions to meshcat's page (tutorial/view/meshcat_page.py)
+(function () {
+  if (typeof viewer === "undefined" || typeof MeshCat === "undefined") {
+    return;  // meshcat's script did not run: nothing to add to
+  }
+  window.rttPage = rttLighten(viewer, location.search);
+  // A frame's transforms in one message: each goes to the viewer's handler, one by one.
+  const handleOne = viewer.handle_command.bind(viewer);
+  viewer.handle_command = function (cmd) {
+    if (cmd.type === "set_transforms") {
+      cmd.commands.forEach(handleOne);
+    } else {
+      handleOne(cmd);
+    }
+  };
 })();
 """
+)
 
 
 def with_page_script(index_html: str) -> str:
