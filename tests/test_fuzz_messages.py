@@ -201,7 +201,10 @@ def test_rtt_plot_takes_any_joint_state():
 
     from tutorial.view.plots import JointStateHistory, draw
 
-    history = JointStateHistory(FakeNode(), "/Tank/joint_state")
+    # The examples share one history, as one run's messages do; at most 50 samples of it, so that each
+    # example draws a bounded plot (unbounded, make fuzz's 2,000 examples drew ever more lines and
+    # ran past pytest's 300 s on a slow hour) and the dropping of the oldest samples is exercised too.
+    history = JointStateHistory(FakeNode(), "/Tank/joint_state", max_samples=50)
     fig, ax = plt.subplots()
 
     @examples(20)
