@@ -105,7 +105,7 @@ def count() -> int:
     from tutorial.ros import env as ros_env
 
     stop = []
-    signal.signal(signal.SIGINT, lambda *a: stop.append(1))  # a plain list: see tutorial/bag/cli.py
+    signal.signal(signal.SIGINT, lambda *a: stop.append(1))  # a plain list: see tutorial.ros.env.StopRequest
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("bench_bag_count")

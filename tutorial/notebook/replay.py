@@ -45,6 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tutorial.view.meshcat_page import LIGHTEN_SCRIPT
+
 DECIMALS = 4  # animation values: 0.1 mm, 1e-4 of a unit quaternion
 _UUID = re.compile(r"^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")
 
@@ -300,8 +302,6 @@ def page_html(scenes: Sequence[ViewRecording], labels: Sequence[str] = (), title
         for i, label in enumerate(list(labels) + [""] * (len(scenes) - len(labels)))
     )
     encoded = [[base64.b64encode(c).decode("ascii") for c in s.commands()] for s in scenes]
-    from tutorial.view.meshcat_page import LIGHTEN_SCRIPT
-
     return _PAGE.format(
         title=html.escape(title),
         lighten=LIGHTEN_SCRIPT,  # defines rttLighten (no "</" in it: it cannot end the <script>)
