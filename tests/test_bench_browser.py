@@ -125,3 +125,32 @@ def test_the_bare_replay_sends_a_frame_as_meshcats_own_single_commands():
     first = umsgpack.unpackb(bytes.fromhex(singles[0][3]))
     assert first == {"type": "set_transform", "path": "/meshcat/rtt/Tank/CHASSIS", "matrix": [0.0] * 16}
     assert singles[0][2] == "/meshcat/rtt/Tank/CHASSIS"
+
+
+def test_page_cost_reads_only_the_page_main_threads_slices_of_a_trace():
+    from benchmarks.experiments.page_cost import SLICES, main_thread_ms
+
+    main, gpu = (1, 10), (2, 20)
+
+    def slice_(where, name, dur_us, ph="X"):
+        return {"pid": where[0], "tid": where[1], "ph": ph, "name": name, "dur": dur_us}
+
+    trace = {
+        "traceEvents": [
+            {"pid": 1, "tid": 10, "ph": "M", "name": "thread_name", "args": {"name": "CrRendererMain"}},
+            {"pid": 2, "tid": 20, "ph": "M", "name": "thread_name", "args": {"name": "CrGpuMain"}},
+            slice_(main, "ProxyMain::BeginMainFrame", 10_000),
+            slice_(main, "ProxyMain::BeginMainFrame", 12_000),
+            slice_(main, "GLES2::ReadPixels", 7_000),
+            slice_(main, "GLES2::ReadPixels", 8_000),
+            slice_(gpu, "GLES2::ReadPixels", 50_000),  # another thread: not the page's wait
+            slice_(main, "GLES2::ReadPixels", 90_000, ph="B"),  # not a complete event: no duration to add
+            slice_(main, "RunTask", 1_000),  # not one of the slices reported
+        ]
+    }
+    got = main_thread_ms(trace)
+    assert set(got) == set(SLICES)
+    assert got["main frame"] == {"n": 2, "mean_ms": 11.0}
+    assert got["waiting for the GPU process (ReadPixels)"] == {"n": 2, "mean_ms": 7.5}
+    assert got["animation-frame callbacks (meshcat's render)"] == {"n": 0, "mean_ms": None}
+    assert main_thread_ms({}) == {label: {"n": 0, "mean_ms": None} for label in SLICES}

@@ -397,6 +397,7 @@ def test_the_page_draws_round_shapes_with_fewer_triangles_on_a_software_renderer
         const p = viewer.scene_tree.find(['meshcat', n, '<object>']).object.geometry.parameters;
         return [p.widthSegments, p.heightSegments, p.radialSegments, p.width, p.height, p.depth];
     })"""
+    sides = "['s', 'c', 'b'].map(n => viewer.scene_tree.find(['meshcat', n, '<object>']).object.material.side)"
     loaded = "window.viewer && viewer.scene_tree.find(['meshcat', 'b', '<object>']).object.isMesh"
     with browser(480, 380) as page:
         page.goto(server.web_url)
@@ -405,11 +406,57 @@ def test_the_page_draws_round_shapes_with_fewer_triangles_on_a_software_renderer
         sphere, cylinder, box = page.evaluate(parameters)
         assert sphere[:2] == [12, 8] and cylinder[2] == 16
         assert box[3:] == [0.1, 0.2, 0.3]  # a box has no segments to spare: as sent
+        assert page.evaluate(sides) == [FRONT_SIDE] * 3  # closed shapes: their back faces are never seen
         page.goto(server.web_url + "?detail=full")  # the server kept meshcat's own counts for every page
         page.wait_for_function(loaded)
         assert page.evaluate("window.rttPage.detail") == "full"
         sphere, cylinder, box = page.evaluate(parameters)
         assert sphere[:2] == [20, 20] and cylinder[2] == 50
+        assert page.evaluate(sides) == [DOUBLE_SIDE] * 3  # meshcat's materials, as sent
+
+
+FRONT_SIDE, DOUBLE_SIDE = 0, 2  # three.js's THREE.FrontSide, THREE.DoubleSide (meshcat-python sends 2)
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
+def test_the_page_paints_meshcats_background_once_under_the_canvas_and_it_looks_the_same(server_of):
+    import io
+
+    from PIL import Image
+
+    from jupyterlab import browser
+
+    server = server_of(True)
+
+    def shot(page) -> np.ndarray:
+        return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB"), dtype=int)
+
+    def captured(page) -> np.ndarray:
+        url = page.evaluate("viewer.capture_image()")  # meshcat's "save image": the canvas alone
+        return np.asarray(Image.open(io.BytesIO(base64.b64decode(url.split(",", 1)[1]))).convert("RGB"), dtype=int)
+
+    with browser(480, 380) as page:
+        page.goto(server.web_url + "?detail=full")  # meshcat's own: a textured quad drawn each frame
+        page.wait_for_function("window.rttPage !== undefined")
+        assert page.evaluate("viewer.scene.background !== null")
+        meshcats, meshcats_image = shot(page), captured(page)
+        page.goto(server.web_url)  # low detail on this machine: a CSS gradient under a transparent canvas
+        page.wait_for_function("window.rttPage !== undefined")
+        assert page.evaluate("window.rttPage.detail") == "low"
+        assert page.evaluate("viewer.scene.background") is None
+        assert "linear-gradient" in page.evaluate("viewer.renderer.domElement.style.background")
+        ours, our_image = shot(page), captured(page)
+        assert page.evaluate("viewer.scene.background") is None  # the capture put meshcat's back only for itself
+        # The same gradient, top (light sky blue) to bottom (midnight blue), to a unit of rounding.
+        assert tuple(ours[0, 0]) != tuple(ours[-1, 0])
+        assert np.abs(ours - meshcats).max() <= 2
+        assert np.abs(our_image - meshcats_image).max() <= 2  # a saved image keeps its background too
+        page.evaluate("viewer.set_property(['Background'], 'visible', false)")  # meshcat's own control
+        assert page.evaluate("viewer.renderer.domElement.style.background") == ""
+        page.evaluate("viewer.set_property(['Background'], 'top_color', [1, 0, 0])")
+        page.evaluate("viewer.set_property(['Background'], 'visible', true)")
+        assert "rgb(255, 0, 0)" in page.evaluate("viewer.renderer.domElement.style.background")
 
 
 # ---- the scene's socket: its fallback, a refusal, a timeout (a stand-in server in a thread) ------------
