@@ -393,11 +393,13 @@ def test_the_page_draws_round_shapes_with_fewer_triangles_on_a_software_renderer
     vis["s"].set_object(g.Sphere(0.1))
     vis["c"].set_object(g.Cylinder(0.2, 0.1))
     vis["b"].set_object(g.Box([0.1, 0.2, 0.3]))
+    vis["t"].set_object(g.Sphere(0.1), g.MeshLambertMaterial(opacity=0.5, transparent=True))
+    vis["o"].set_object(g.Box([0.1, 0.1, 0.1]), g.MeshLambertMaterial(depthTest=False))
     parameters = """['s', 'c', 'b'].map(n => {
         const p = viewer.scene_tree.find(['meshcat', n, '<object>']).object.geometry.parameters;
         return [p.widthSegments, p.heightSegments, p.radialSegments, p.width, p.height, p.depth];
     })"""
-    sides = "['s', 'c', 'b'].map(n => viewer.scene_tree.find(['meshcat', n, '<object>']).object.material.side)"
+    sides = "'scbto'.split('').map(n => viewer.scene_tree.find(['meshcat', n, '<object>']).object.material.side)"
     loaded = "window.viewer && viewer.scene_tree.find(['meshcat', 'b', '<object>']).object.isMesh"
     with browser(480, 380) as page:
         page.goto(server.web_url)
@@ -406,13 +408,15 @@ def test_the_page_draws_round_shapes_with_fewer_triangles_on_a_software_renderer
         sphere, cylinder, box = page.evaluate(parameters)
         assert sphere[:2] == [12, 8] and cylinder[2] == 16
         assert box[3:] == [0.1, 0.2, 0.3]  # a box has no segments to spare: as sent
-        assert page.evaluate(sides) == [FRONT_SIDE] * 3  # closed shapes: their back faces are never seen
+        # Opaque closed shapes: their back faces are never seen.  The see-through sphere and the box drawn
+        # over everything (depthTest off) keep both sides: their back faces show through.
+        assert page.evaluate(sides) == [FRONT_SIDE] * 3 + [DOUBLE_SIDE] * 2
         page.goto(server.web_url + "?detail=full")  # the server kept meshcat's own counts for every page
         page.wait_for_function(loaded)
         assert page.evaluate("window.rttPage.detail") == "full"
         sphere, cylinder, box = page.evaluate(parameters)
         assert sphere[:2] == [20, 20] and cylinder[2] == 50
-        assert page.evaluate(sides) == [DOUBLE_SIDE] * 3  # meshcat's materials, as sent
+        assert page.evaluate(sides) == [DOUBLE_SIDE] * 5  # meshcat's materials, as sent
 
 
 FRONT_SIDE, DOUBLE_SIDE = 0, 2  # three.js's THREE.FrontSide, THREE.DoubleSide (meshcat-python sends 2)
@@ -423,40 +427,69 @@ FRONT_SIDE, DOUBLE_SIDE = 0, 2  # three.js's THREE.FrontSide, THREE.DoubleSide (
 def test_the_page_paints_meshcats_background_once_under_the_canvas_and_it_looks_the_same(server_of):
     import io
 
+    import meshcat.geometry as g
     from PIL import Image
 
     from jupyterlab import browser
 
     server = server_of(True)
+    vis = server.visualizer()  # boxes: the same triangles in both details, so only sides and background differ
+    vis["opaque"].set_object(g.Box([0.4, 0.4, 0.4]), g.MeshLambertMaterial(color=0xCC3333))
+    vis["opaque"].set_transform(pose(0.0, 0.6))
+    glass = g.MeshLambertMaterial(color=0x3333CC, opacity=0.5, transparent=True)
+    vis["glass"].set_object(g.Box([0.6, 0.6, 0.6]), glass)
+    loaded = "window.rttPage !== undefined && viewer.scene_tree.find(['meshcat', 'glass', '<object>']).object.isMesh"
 
-    def shot(page) -> np.ndarray:
-        return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB"), dtype=int)
+    def picture(data: bytes) -> np.ndarray:
+        return np.asarray(Image.open(io.BytesIO(data)).convert("RGBA"), dtype=int)
 
     def captured(page) -> np.ndarray:
         url = page.evaluate("viewer.capture_image()")  # meshcat's "save image": the canvas alone
-        return np.asarray(Image.open(io.BytesIO(base64.b64decode(url.split(",", 1)[1]))).convert("RGB"), dtype=int)
+        return picture(base64.b64decode(url.split(",", 1)[1]))
+
+    # The canvas right after one render, in the same task (before the browser may clear it); as a frame
+    # of meshcat's animation recording when `recording`.
+    rendered = """(recording) => {
+        viewer.animator.recording = recording;
+        try { viewer.render(); return viewer.renderer.domElement.toDataURL(); }
+        finally { viewer.animator.recording = false; }
+    }"""
 
     with browser(480, 380) as page:
         page.goto(server.web_url + "?detail=full")  # meshcat's own: a textured quad drawn each frame
-        page.wait_for_function("window.rttPage !== undefined")
+        page.wait_for_function(loaded)
         assert page.evaluate("viewer.scene.background !== null")
-        meshcats, meshcats_image = shot(page), captured(page)
-        page.goto(server.web_url)  # low detail on this machine: a CSS gradient under a transparent canvas
-        page.wait_for_function("window.rttPage !== undefined")
-        assert page.evaluate("window.rttPage.detail") == "low"
+        meshcats, meshcats_image = picture(page.screenshot()), captured(page)
+        page.goto(server.web_url + "?detail=low")  # a CSS gradient under a transparent canvas
+        page.wait_for_function(loaded)
         assert page.evaluate("viewer.scene.background") is None
         assert "linear-gradient" in page.evaluate("viewer.renderer.domElement.style.background")
-        ours, our_image = shot(page), captured(page)
+        ours, our_image = picture(page.screenshot()), captured(page)
         assert page.evaluate("viewer.scene.background") is None  # the capture put meshcat's back only for itself
-        # The same gradient, top (light sky blue) to bottom (midnight blue), to a unit of rounding.
+        # The same picture, to a unit of rounding: the gradient, top (light sky blue) to bottom (midnight
+        # blue); the opaque box from the front only; the see-through box with its back faces showing.
         assert tuple(ours[0, 0]) != tuple(ours[-1, 0])
         assert np.abs(ours - meshcats).max() <= 2
         assert np.abs(our_image - meshcats_image).max() <= 2  # a saved image keeps its background too
+        # A frame of meshcat's animation recording is read from the canvas: it gets meshcat's background;
+        # a frame on screen leaves the canvas see-through over the CSS gradient.
+        recorded = picture(base64.b64decode(page.evaluate(rendered, True).split(",", 1)[1]))
+        on_screen = picture(base64.b64decode(page.evaluate(rendered, False).split(",", 1)[1]))
+        assert np.abs(recorded[0, 0] - meshcats_image[0, 0]).max() <= 2 and recorded[0, 0, 3] == 255
+        assert on_screen[0, 0, 3] == 0
+        # meshcat's background texture is made once for a pair of colours, not once a picture.
+        textures = "viewer.renderer.info.memory.textures"
+        before = page.evaluate(textures)
+        for _ in range(5):
+            captured(page)
+        assert page.evaluate(textures) == before
         page.evaluate("viewer.set_property(['Background'], 'visible', false)")  # meshcat's own control
         assert page.evaluate("viewer.renderer.domElement.style.background") == ""
         page.evaluate("viewer.set_property(['Background'], 'top_color', [1, 0, 0])")
         page.evaluate("viewer.set_property(['Background'], 'visible', true)")
         assert "rgb(255, 0, 0)" in page.evaluate("viewer.renderer.domElement.style.background")
+        assert tuple(captured(page)[0, 0, :3]) == (255, 0, 0)  # the new colours' texture, the old one let go
+        assert page.evaluate(textures) == before
 
 
 # ---- the scene's socket: its fallback, a refusal, a timeout (a stand-in server in a thread) ------------

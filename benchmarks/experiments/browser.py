@@ -155,11 +155,16 @@ class Page:
 
         assert url.startswith("http://127.0.0.1:"), url
         self._pw = sync_playwright().start()
-        self._browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        self.page = self._browser.new_page(viewport=VIEWPORT)
-        self.page.add_init_script(PAGE_PROBE)
-        self.page.goto(url)
-        self.page.wait_for_function("window.viewer && window.viewer.__rtt_hooked", timeout=timeout_s * 1000)
+        self._browser = None
+        try:
+            self._browser = self._pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+            self.page = self._browser.new_page(viewport=VIEWPORT)
+            self.page.add_init_script(PAGE_PROBE)
+            self.page.goto(url)
+            self.page.wait_for_function("window.viewer && window.viewer.__rtt_hooked", timeout=timeout_s * 1000)
+        except BaseException:  # no browser or Playwright left behind by a page that did not open
+            self.close()
+            raise
 
     def clock_offset_ns(self, tries: int = 20) -> int:
         """The page's clock minus ``time.monotonic_ns()``, ns: subtract it from a page time (in ns) to compare.
@@ -195,7 +200,8 @@ class Page:
         return samples
 
     def close(self) -> None:
-        self._browser.close()
+        if self._browser is not None:
+            self._browser.close()
         self._pw.stop()
 
 

@@ -10,12 +10,15 @@ page is made to draw every animation frame.  For each page setting
 (``?detail=low`` and ``?detail=full``, :mod:`tutorial.view.meshcat_page`)
 it prints:
 
-- **CPU per Chromium process**, cores, over ``--seconds`` (``psutil``):
-  the GPU process (where SwiftShader rasterizes WebGL without a GPU), the
-  renderer (the page's JavaScript and its main thread) and the others;
-- **the page's frames/s** (its ``requestAnimationFrame`` callbacks);
+- **Chromium's CPU by kind of process**, cores, over ``--seconds``
+  (``psutil``, the processes of the browser this run started): the GPU
+  process (where SwiftShader rasterizes WebGL without a GPU), the
+  renderers (the page's JavaScript and its main thread) and the others;
+- **the page's frames/s** (its ``requestAnimationFrame`` callbacks), over
+  those seconds and again while it is traced (tracing slows the page);
 - **where the page's main thread spends a frame**, from a Chromium trace
-  (``Browser.start_tracing``) of two seconds: the whole main frame
+  (``Browser.start_tracing``) of two seconds, the mean of each slice (one a
+  frame): the whole main frame
   (``ProxyMain::BeginMainFrame``), the animation-frame callbacks (meshcat's
   render, in JavaScript) and the wait for the GPU process inside the
   commit (``GLES2::ReadPixels``: without GPU compositing, Chromium copies
@@ -48,7 +51,9 @@ TRACE_CATEGORIES = ["devtools.timeline", "blink", "gpu", "cc", "viz", "toplevel"
 
 
 def main_thread_ms(trace: dict) -> dict:
-    """Per-frame mean (ms) and count of each of :data:`SLICES` on the page's main thread of a Chromium trace.
+    """Count and mean duration (ms) of each of :data:`SLICES` on the page's main thread of a Chromium trace.
+
+    Each of them runs once a frame, so a mean is per frame.
 
     Args:
         trace: a Chromium trace, ``{"traceEvents": [...]}`` (complete events, ``ph == "X"``, ``dur`` in µs;
@@ -80,21 +85,34 @@ def main_thread_ms(trace: dict) -> dict:
 
 
 def _chromium_cpu_s() -> dict:
-    """CPU seconds so far of every Chromium process, summed by kind: ``gpu``, ``renderer``, ``other``."""
+    """``{pid: (kind, CPU seconds so far)}`` of the Chromium processes this process started (through Playwright).
+
+    ``kind`` is ``gpu``, ``renderer`` or ``other``.  Only descendants of this process: another job's
+    browser is not counted.
+    """
     import psutil
 
-    seconds = defaultdict(float)
-    for proc in psutil.process_iter():
+    seconds = {}
+    for proc in psutil.Process().children(recursive=True):
         try:
             cmd = " ".join(proc.cmdline())
             if "chromium" not in cmd:
                 continue
             kind = "gpu" if "--type=gpu-process" in cmd else "renderer" if "--type=renderer" in cmd else "other"
             t = proc.cpu_times()
-            seconds[kind] += t.user + t.system
-        except Exception:  # a process that ended meanwhile (psutil.NoSuchProcess, AccessDenied): not counted
+            seconds[proc.pid] = (kind, t.user + t.system)
+        except psutil.Error:  # a process that ended meanwhile: not counted
             continue
     return seconds
+
+
+def _cores(before: dict, after: dict, seconds: float) -> dict:
+    """Cores by kind between two :func:`_chromium_cpu_s` readings, over the processes in both."""
+    cores = defaultdict(float)
+    for pid, (kind, t1) in after.items():
+        if pid in before:
+            cores[kind] += (t1 - before[pid][1]) / seconds
+    return {kind: round(c, 2) for kind, c in sorted(cores.items())}
 
 
 def page_cost(model: str, count: int, details: list[str], seconds: float) -> dict:
@@ -103,8 +121,12 @@ def page_cost(model: str, count: int, details: list[str], seconds: float) -> dic
     Runs on the calling thread (Playwright's sync API and the meshcat socket are both that thread's).
 
     Returns:
-        ``{detail: {"cores": {kind: cores}, "frames_per_s": f, "draw_calls": n, "triangles": n,
-        "main_thread": main_thread_ms(...), "page": window.rttPage}}``.
+        ``{detail: {"cores": {kind: cores}, "frames_per_s": f, "traced_frames_per_s": f, "draw_calls": n,
+        "triangles": n, "main_thread": main_thread_ms(...), "page": window.rttPage}}``.
+
+    Raises:
+        RuntimeError: the meshcat server did not start; playwright's ``TimeoutError``: the page did not
+        load or draw within 30 s.
     """
     import mujoco
 
@@ -123,35 +145,49 @@ def page_cost(model: str, count: int, details: list[str], seconds: float) -> dic
     try:
         Scene(server.visualizer(), m).build(d)
         for detail in details:
-            page = Page(server.web_url + f"?detail={detail}")
+            page = Page(server.web_url + f"?detail={detail}")  # closes its browser itself if it fails to open
             try:
-                p = page.page
-                p.wait_for_function("window.rttPage !== undefined")
-                # Every animation frame draws (meshcat draws only after a change): the cost of a busy page.
-                p.evaluate("(() => { const f = () => { viewer.set_dirty(); requestAnimationFrame(f); }; f(); })()")
-                # Settled: shaders compiled and the first 30 frames out, before anything is counted.
-                p.wait_for_function("window.__rtt.rafs.length > 30", timeout=30000)
-                info = "viewer.renderer.info.render"
-                calls, triangles = p.evaluate(f"[{info}.calls, {info}.triangles]")
-                cpu0, raf0, t0 = _chromium_cpu_s(), p.evaluate("window.__rtt.rafs.length"), time.monotonic()
-                time.sleep(seconds)
-                cpu1, raf1, t1 = _chromium_cpu_s(), p.evaluate("window.__rtt.rafs.length"), time.monotonic()
-                page._browser.start_tracing(page=p, categories=TRACE_CATEGORIES)
-                time.sleep(2.0)
-                trace = json.loads(page._browser.stop_tracing())
-                out[detail] = {
-                    "cores": {k: round((cpu1[k] - cpu0.get(k, 0.0)) / (t1 - t0), 2) for k in sorted(cpu1)},
-                    "frames_per_s": round((raf1 - raf0) / (t1 - t0), 1),
-                    "draw_calls": calls,
-                    "triangles": triangles,
-                    "main_thread": main_thread_ms(trace),
-                    "page": p.evaluate("window.rttPage"),
-                }
+                out[detail] = _measure(page, seconds)
             finally:
                 page.close()
     finally:
         server.close()
     return out
+
+
+def _measure(page, seconds: float) -> dict:
+    """One page setting of :func:`page_cost`: the page draws every frame; its cost, then a trace."""
+    p = page.page
+    rafs = "window.__rtt.rafs.length"
+    p.wait_for_function("window.rttPage !== undefined")
+    # Every animation frame draws (meshcat draws only after a change): the cost of a busy page.
+    p.evaluate("(() => { const f = () => { viewer.set_dirty(); requestAnimationFrame(f); }; f(); })()")
+    # Settled: 30 frames drawn since, and the scene complete (the same triangles 10 frames apart).
+    p.wait_for_function(f"{rafs} > {p.evaluate(rafs) + 30}", timeout=30000)
+    info = "viewer.renderer.info.render"
+    deadline = time.monotonic() + 30.0
+    while True:
+        calls, triangles = p.evaluate(f"[{info}.calls, {info}.triangles]")
+        p.wait_for_function(f"{rafs} > {p.evaluate(rafs) + 10}", timeout=30000)
+        if p.evaluate(f"{info}.triangles") == triangles > 0 or time.monotonic() > deadline:
+            break
+    cpu0, raf0, t0 = _chromium_cpu_s(), p.evaluate(rafs), time.monotonic()
+    time.sleep(seconds)  # the measuring window itself, not a wait for anything
+    cpu1, raf1, t1 = _chromium_cpu_s(), p.evaluate(rafs), time.monotonic()
+    page._browser.start_tracing(page=p, categories=TRACE_CATEGORIES)
+    raf2, t2 = p.evaluate(rafs), time.monotonic()
+    time.sleep(2.0)  # the traced window
+    raf3, t3 = p.evaluate(rafs), time.monotonic()
+    trace = json.loads(page._browser.stop_tracing())
+    return {
+        "cores": _cores(cpu0, cpu1, t1 - t0),
+        "frames_per_s": round((raf1 - raf0) / (t1 - t0), 1),
+        "traced_frames_per_s": round((raf3 - raf2) / (t3 - t2), 1),
+        "draw_calls": calls,
+        "triangles": triangles,
+        "main_thread": main_thread_ms(trace),
+        "page": p.evaluate("window.rttPage"),
+    }
 
 
 def report(result: dict) -> str:
@@ -160,12 +196,13 @@ def report(result: dict) -> str:
     for detail, r in result.items():
         cores = ", ".join(f"{k} {v:.2f}" for k, v in r["cores"].items())
         lines.append(
-            f"detail={detail}: {r['frames_per_s']} frames/s, {r['draw_calls']} draw calls, "
+            f"detail={detail}: {r['frames_per_s']} frames/s ({r['traced_frames_per_s']} while traced), "
+            f"{r['draw_calls']} draw calls, "
             f"{r['triangles']} triangles; Chromium cores: {cores}"
         )
         for label, s in r["main_thread"].items():
             mean = "-" if s["mean_ms"] is None else f"{s['mean_ms']:.2f} ms"
-            lines.append(f"    main thread, {label}: {mean} a frame ({s['n']} frames)")
+            lines.append(f"    main thread, {label}: {mean} a frame ({s['n']} frames traced)")
     return "\n".join(lines)
 
 

@@ -22,7 +22,8 @@ for identical runs.
 
 In the browser, each pane's viewer is made lighter where WebGL runs on the
 CPU, as the live page is (``rttLighten``, :mod:`tutorial.view.meshcat_page`:
-no multisampling, fewer triangles for round shapes), and draws only while
+no multisampling, fewer triangles for round shapes, opaque closed shapes
+from the front only, the background painted once), and draws only while
 the page is in sight.  A recording loops its animation for as long as it is
 open, and a browser draws an offscreen frame's animation as well: on this
 GPU-less machine one 900 x 380 recording took Chromium 1.8 cores with

@@ -33,16 +33,19 @@ things:
   per-frame CPU for 8 tanks fell by a quarter).  The page changes its
   own copy of each ``set_object`` before meshcat's loader reads it; the
   server keeps meshcat's counts, so each page chooses for itself.  Boxes
-  and meshes are drawn as sent.  Low detail also draws closed shapes
-  (boxes, spheres, cylinders) from the front only: meshcat's materials
-  are two-sided, so each face was rasterized and lit a second time from
-  behind, where it is never seen; and it paints meshcat's background
-  gradient once, as CSS under a transparent canvas, where meshcat draws
-  it as a textured quad over the whole canvas every frame (a saved image,
-  ``capture_image``, still gets meshcat's own).  The picture is the same
-  to a unit of rounding; on the idle machine, drawing every frame, the
-  arm's page then took 1.1 cores instead of 1.5, eight tanks' 0.9 instead
-  of 1.35.  ``?detail=full`` or ``?detail=low`` decides instead.
+  and meshes keep their triangles.  Low detail also draws opaque closed
+  shapes (whole boxes, spheres, cylinders) from the front only: meshcat's
+  materials are two-sided, so each face was rasterized and lit a second
+  time from behind, where it is never seen (a see-through material, or
+  one drawn over everything, keeps both sides: its back faces show).  And
+  it paints meshcat's background gradient once, as CSS under a
+  transparent canvas, where meshcat draws it as a textured quad over the
+  whole canvas every frame; a frame read back as a picture (meshcat's
+  ``capture_image``, its animation recording) is drawn with meshcat's own.
+  Screenshots of the tank and the arm are the same to a unit of rounding;
+  on the idle machine, drawing every frame, Chromium's GPU process took
+  1.1 cores for the arm's page instead of 1.5, 0.9 for eight tanks'
+  instead of 1.35.  ``?detail=full`` or ``?detail=low`` decides instead.
 
 ``window.rttPage`` says what was chosen:
 ``{renderer: "...", software: true, antialias: false, detail: "low"}``.
@@ -79,13 +82,20 @@ function rttLighten(viewer, search) {
   const antialias = askedAntialias === null ? !software : !/^(0|false|no|off)$/i.test(askedAntialias);
   const askedDetail = query.get("detail");
   const detail = askedDetail === "full" || askedDetail === "low" ? askedDetail : software ? "low" : "full";
+  // A whole box, sphere or cylinder (three.js's own parameters; absent ones are three.js's defaults).
+  const whole = (value, full) => value === undefined || value >= full - 1e-9;
+  const closedShape = (g) =>
+    !!g &&
+    (/^Box(Buffer)?Geometry$/.test(g.type) ||
+      (/^Sphere(Buffer)?Geometry$/.test(g.type) && whole(g.phiLength, 2 * Math.PI) && whole(g.thetaLength, Math.PI)) ||
+      (/^Cylinder(Buffer)?Geometry$/.test(g.type) && !g.openEnded && whole(g.thetaLength, 2 * Math.PI)));
   // Low detail: in this page's copy of each set_object, before meshcat's own handler (and its
-  // loader) reads it, round shapes get at most COARSE's segments, and closed shapes (box, sphere,
-  // cylinder) are drawn from the front only: their back faces are never seen, and meshcat's
-  // materials are two-sided, which rasterizes and lights every face a second time.
+  // loader) reads it, round shapes get at most COARSE's segments, and opaque closed shapes are drawn
+  // from the front only: their back faces are never seen, and meshcat's materials are two-sided, which
+  // rasterizes and lights every face a second time.  A see-through material (or one drawn over
+  // everything, depthTest off) keeps both sides: there the back faces show through the front ones.
   if (detail === "low") {
     const COARSE = __COARSE__;
-    const CLOSED = /^(Box|Sphere|Cylinder)(Buffer)?Geometry$/;
     const handle = viewer.handle_command.bind(viewer);
     viewer.handle_command = function (cmd) {
       const o = cmd.type === "set_object" && cmd.object;
@@ -96,9 +106,10 @@ function rttLighten(viewer, search) {
           if (typeof g[key] === "number" && g[key] > most[key]) g[key] = most[key];
         }
       }
-      if (geometries.length > 0 && geometries.every((g) => g && CLOSED.test(g.type))) {
+      if (geometries.length > 0 && geometries.every(closedShape)) {
         for (const m of Array.isArray(o.materials) ? o.materials : []) {
-          if (m && m.side === THREE.DoubleSide) m.side = THREE.FrontSide;
+          const opaque = m && !m.transparent && !(m.opacity < 1) && m.depthTest !== false;
+          if (opaque && m.side === THREE.DoubleSide) m.side = THREE.FrontSide;
         }
       }
       handle(cmd);
@@ -122,33 +133,63 @@ function rttLighten(viewer, search) {
   if (detail === "low") {
     // meshcat draws its background gradient as a textured quad over the whole canvas, each frame.
     // Here the canvas is left transparent over a CSS gradient of the same two colours, painted once.
-    const textureBackground = viewer.show_background.bind(viewer);  // meshcat's own
+    // A frame that is read back as a picture (meshcat's capture_image, its animation recording) is
+    // drawn with meshcat's own background, whose texture is made once for each pair of colours.
+    const meshcatsShow = viewer.show_background.bind(viewer);
+    const render = viewer.render.bind(viewer);
     const captureImage = viewer.capture_image.bind(viewer);
-    let shown = false;
+    let shown = false;  // the Background is on (meshcat's own control)
+    let picture = false;  // this frame is read back as a picture
+    let texture = null;
+    let textureColours = "";
+    const drop = (v) => {  // the scene's background texture, unless it is the one kept
+      if (v.scene.background && v.scene.background !== texture && v.scene.background.dispose) {
+        v.scene.background.dispose();
+      }
+      v.scene.background = null;
+    };
+    const meshcatsTexture = (v) => {
+      const node = v.scene_tree.find(["Background"]).object;
+      const colours = JSON.stringify([node.top_color, node.bottom_color]);
+      if (texture === null || colours !== textureColours) {
+        drop(v);
+        if (texture) texture.dispose();
+        meshcatsShow();  // makes meshcat's texture for these colours and sets it as the background
+        texture = v.scene.background;
+        textureColours = colours;
+      }
+      return texture;
+    };
     viewer.show_background = function () {
       const node = this.scene_tree.find(["Background"]).object;  // its colours are 0-255, as meshcat keeps them
       const rgb = (c) => "rgb(" + c.map((x) => Math.round(x)).join(",") + ")";
-      this.scene.background = null;
+      drop(this);
       this.renderer.domElement.style.background =
         "linear-gradient(" + rgb(node.top_color) + ", " + rgb(node.bottom_color) + ")";
       shown = true;
       this.set_dirty();
     };
     viewer.hide_background = function () {
-      this.scene.background = null;
+      drop(this);
       this.renderer.domElement.style.background = "";
       shown = false;
       this.set_dirty();
     };
-    // An image of the canvas alone would have no background: meshcat's own, for that one frame.
+    viewer.render = function () {
+      if (!shown || !(picture || this.animator.recording)) return render();
+      this.scene.background = meshcatsTexture(this);
+      try {
+        return render();
+      } finally {
+        this.scene.background = null;
+      }
+    };
     viewer.capture_image = function () {
-      if (!shown) return captureImage();
-      textureBackground();
+      picture = true;
       try {
         return captureImage();
       } finally {
-        this.scene.background = null;
-        this.set_dirty();
+        picture = false;
       }
     };
     if (viewer.scene.background) viewer.show_background();
