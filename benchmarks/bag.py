@@ -104,8 +104,8 @@ def count() -> int:
 
     from tutorial.ros import env as ros_env
 
-    stop = []
-    signal.signal(signal.SIGINT, lambda *a: stop.append(1))  # a plain list: see tutorial.ros.env.StopRequest
+    stop = ros_env.StopRequest()
+    signal.signal(signal.SIGINT, stop)  # SIGINT only (the harness sends it); SIGTERM keeps its default
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node("bench_bag_count")
@@ -117,7 +117,7 @@ def count() -> int:
     node.create_subscription(JointState, TOPIC, on_message, _qos(), raw=True)
     spin = ros_env.SpinThread(node).start()
     print(json.dumps({"event": "ready"}), flush=True)
-    while not stop:
+    while not stop.requested:
         time.sleep(0.05)
     spin.stop()
     print(json.dumps({"event": "done", "received": received[0]}), flush=True)
@@ -134,15 +134,15 @@ def record(path: str, compression: str, write_through: bool) -> int:
     from tutorial.bag.record import BagRecorder
     from tutorial.ros import env as ros_env
 
-    stop = []
-    signal.signal(signal.SIGINT, lambda *a: stop.append(1))
+    stop = ros_env.StopRequest()
+    signal.signal(signal.SIGINT, stop)  # SIGINT only, as count()
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     recorder = BagRecorder(
         path, [TOPIC], compression=compression, overwrite=True, output=None, write_through=write_through
     ).start()
     print(json.dumps({"event": "ready"}), flush=True)
-    while not stop and not recorder.failure:
+    while not stop.requested and not recorder.failure:
         time.sleep(0.05)
     stats = recorder.close()
     print(
