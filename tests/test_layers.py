@@ -134,7 +134,7 @@ def test_the_check_catches_each_kind_of_wrong_import(name, source, expected):
     "name, source",
     [
         ("tutorial.controllers.joint_state_subscriber", "from ..interfaces.joint_state import joint_state_qos"),
-        ("tutorial.exercises.step2", "from tutorial.controllers.tank_controller import RttTankController"),
+        ("tutorial.exercises.step2_joint_state_publisher", "from tutorial.controllers.tank_controller import RttTankController"),
         ("tutorial.notebook.runs", "from tutorial.core.app import App"),
         ("tutorial.tools.rtt_joy", "from tutorial.tools import rtt_run"),
     ],

@@ -1,5 +1,6 @@
-"""The notebooks' exercises and their checks: one module per step, a grader shared by all.
+"""The notebooks' exercises and their checks: one module per notebook, named after it
+(``step1_tank_controller`` for ``01_step1_tank_controller.ipynb``), a grader shared by all.
 
-A notebook imports the check of each exercise from its step's module, e.g.
-``from tutorial.exercises.step1 import check_dpad_steering``.
+A notebook imports the check of each exercise from its notebook's module, e.g.
+``from tutorial.exercises.step1_tank_controller import check_dpad_steering``.
 """

@@ -1,7 +1,7 @@
 """Checks for the notebooks' exercises: run the learner's code on cases, say one clear line.
 
-Each exercise has a check function (in :mod:`tutorial.exercises.step1`,
-``step2``, ...) that takes what the learner wrote (a function or a class),
+Each exercise has a check function (in :mod:`tutorial.exercises.step1_tank_controller`,
+``step2_joint_state_publisher``, ...: one module per notebook) that takes what the learner wrote (a function or a class),
 runs it on cases and returns a :class:`Result`.  A notebook's check cell
 ends with that call, so the cell shows one line:
 
