@@ -46,6 +46,8 @@ def exercise(number: str) -> dict:
         "target": call.group(2),
         "module": MODULES[step],
         "step": int(step),
+        # the checks' module is named after the notebook: 01_step1_tank_controller -> step1_tank_controller
+        "checks": path.stem.split("_", 1)[1],
     }
 
 
@@ -62,7 +64,7 @@ def grade(ex: dict, *sources: str):
         # The cell's own check call is left out: the test makes it, to see its Result.
         source = re.sub(rf"^{ex['check']}\({ex['target']}\)\s*$", "", source, flags=re.M)
         exec(compile(source, f"<exercise {ex['target']}>", "exec"), namespace)
-    check = getattr(importlib.import_module(f"tutorial.exercises.step{ex['step']}"), ex["check"])
+    check = getattr(importlib.import_module(f"tutorial.exercises.{ex['checks']}"), ex["check"])
     return check(namespace[ex["target"]])
 
 
