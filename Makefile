@@ -48,9 +48,11 @@ test-lab: $(VENV)/.installed
 fuzz: $(VENV)/.installed
 	RTT_FUZZ=1 RTT_TEST_MODE=1 $(PY) -m pytest tests/test_fuzz_files.py tests/test_fuzz_messages.py tests/test_meshcat_server.py -m unit -q
 
+# ruff, then the library's layers (import-linter's contracts in pyproject.toml; tests/test_layers.py proves them)
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
+	$(VENV)/bin/lint-imports --no-logo
 
 # The notebooks carry recorded 3D views (scripts in their outputs): trusting the project's own
 # notebooks lets JupyterLab show them; an untrusted notebook shows those outputs empty.

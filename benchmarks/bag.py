@@ -103,8 +103,10 @@ def count() -> int:
     from sensor_msgs.msg import JointState
 
     from tutorial.ros import env as ros_env
+    from tutorial.ros import program as ros_program
+    from tutorial.ros import spin as ros_spin
 
-    stop = ros_env.StopRequest()
+    stop = ros_program.StopRequest()
     signal.signal(signal.SIGINT, stop)  # SIGINT only (the harness sends it); SIGTERM keeps its default
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
@@ -115,7 +117,7 @@ def count() -> int:
         received[0] += 1
 
     node.create_subscription(JointState, TOPIC, on_message, _qos(), raw=True)
-    spin = ros_env.SpinThread(node).start()
+    spin = ros_spin.SpinThread(node).start()
     print(json.dumps({"event": "ready"}), flush=True)
     while not stop.requested:
         time.sleep(0.05)
@@ -133,8 +135,9 @@ def record(path: str, compression: str, write_through: bool) -> int:
 
     from tutorial.bag.record import BagRecorder
     from tutorial.ros import env as ros_env
+    from tutorial.ros import program as ros_program
 
-    stop = ros_env.StopRequest()
+    stop = ros_program.StopRequest()
     signal.signal(signal.SIGINT, stop)  # SIGINT only, as count()
     ros_env.use_localhost_by_default()
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)

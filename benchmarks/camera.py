@@ -2,7 +2,7 @@
 
 The Step 6 project (Step 2 plus the camera publisher at 30 Hz) against the
 Step 2 project as the baseline, in interleaved rounds (step2, step6, step2,
-...), each run as ``rtt-run`` runs it (an :class:`tutorial.core.app.App`, headless,
+...), each run as ``rtt-run`` runs it (an :class:`tutorial.app.app.App`, headless,
 in this process, which records every step's lateness):
 
 * real time (``--seconds``, 20 by default): real-time factor, step lateness
@@ -98,7 +98,7 @@ def load(project: str):
 
 def run_project(project: str, seconds: float, realtime: bool) -> dict:
     """One headless run of a project in this process; its figures."""
-    from tutorial.core.app import App
+    from tutorial.app.app import App
 
     app = App(
         load(project),

@@ -5,7 +5,7 @@
 
 A publisher process sends ``--messages`` JointStates ``--gap`` s apart, each
 numbered in ``header.frame_id``.  Two subscriber processes read the same
-stream at the same time, each spun by :class:`tutorial.ros.env.SpinThread`:
+stream at the same time, each spun by :class:`tutorial.ros.spin.SpinThread`:
 one on rclpy's ``SingleThreadedExecutor``, one on its ``EventsExecutor``.
 The publisher starts only after both subscribers' own sides have matched
 (their *matched* events), so no message can be lost to discovery.  With
@@ -74,9 +74,10 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float, busy: bool)
     from sensor_msgs.msg import JointState
 
     from tutorial.ros import env as ros_env
+    from tutorial.ros import spin as ros_spin
 
     ros_env.init()
-    node = rclpy.create_node("delivery_sub_" + os.environ[ros_env.EXECUTOR_VARIABLE])
+    node = rclpy.create_node("delivery_sub_" + os.environ[ros_spin.EXECUTOR_VARIABLE])
     log: list[tuple[int, int]] = []
 
     def matched(status):
@@ -90,7 +91,7 @@ def subscriber(out: Path, depth: int, messages: int, timeout: float, busy: bool)
         _qos(depth),
         event_callbacks=SubscriptionEventCallbacks(matched=matched),
     )
-    spin = ros_env.SpinThread(node).start()
+    spin = ros_spin.SpinThread(node).start()
     _wait_for(out.parent / "done", timeout, busy)
     # The publisher is done once the last message is acknowledged; wait (at most 2 s)
     # until the executor has also handed it to the callback.  Nothing comes after the

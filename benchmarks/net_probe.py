@@ -26,6 +26,7 @@ import rclpy
 from rclpy.signals import SignalHandlerOptions
 
 from tutorial.ros import env as ros_env
+from tutorial.ros import spin as ros_spin
 from tutorial.view.images import ImageReceiver
 
 
@@ -80,7 +81,7 @@ def main(argv=None) -> int:
                     sizes[topic].append((time.monotonic_ns(), len(data)))
 
             node.create_subscription(message_type(kind), topic, on_message, qos, raw=True)
-    spin = ros_env.SpinThread(node).start()
+    spin = ros_spin.SpinThread(node).start()
     stop = threading.Event()  # Ctrl-C (the benchmark's SIGINT) ends listening early; the file is still written
     signal.signal(signal.SIGINT, lambda signum, frame: stop.set())
     print("probe: subscribed", flush=True)

@@ -27,7 +27,7 @@ import msgpack
 import rclpy
 from rclpy.signals import SignalHandlerOptions
 
-from tutorial.core.app import App
+from tutorial.app.app import App
 from tutorial.core.project import load_project
 from tutorial.ros import env as ros_env
 from tutorial.view.meshcat_batch import SET_TRANSFORMS

@@ -7,21 +7,21 @@ ROOT = Path(__file__).resolve().parent.parent
 PROJECT = ROOT / "project"
 sys.path.insert(0, str(ROOT))  # run from a clone without installing, too
 
-from tutorial.ros.launch import Node  # noqa: E402
+from tutorial.ros.launch import NodeProcess  # noqa: E402
 
 
-def joy_node(args, script: str = "drive") -> Node:
+def joy_node(args, script: str = "drive") -> NodeProcess:
     """The joystick: with --demo the demo ``script`` (``drive`` or ``wall``), else a gamepad or the keyboard."""
-    return Node("rtt_joy", "tutorial.tools.rtt_joy", ["--demo", "--script", script] if args.demo else [])
+    return NodeProcess("rtt_joy", "tutorial.tools.rtt_joy", ["--demo", "--script", script] if args.demo else [])
 
 
-def simulation_node(args, project: str) -> Node:
+def simulation_node(args, project: str) -> NodeProcess:
     """The simulation (``rtt``), required: when it ends, the launch ends."""
     extra = (["--headless"] if args.headless else []) + (["--duration", str(args.duration)] if args.duration else [])
-    return Node("rtt", "tutorial.tools.rtt_run", [str(PROJECT / project), *extra], required=True)
+    return NodeProcess("rtt", "tutorial.tools.rtt_run", [str(PROJECT / project), *extra], required=True)
 
 
-def record_nodes(args, topics: list[str]) -> list[Node]:
+def record_nodes(args, topics: list[str]) -> list[NodeProcess]:
     """With ``--record FILE.mcap``: ``rtt-bag record`` of the step's ``topics`` as node ``rtt_bag``; else none.
 
     With ``--tf`` too, it also records what Foxglove and RViz2 need to draw the
@@ -37,4 +37,4 @@ def record_nodes(args, topics: list[str]) -> list[Node]:
     if not args.record:
         return []
     tf = ["--tf"] if getattr(args, "tf", False) else []  # and the robot description, odometry, /tf
-    return [Node("rtt_bag", "tutorial.bag", ["record", *topics, *tf, "-o", args.record])]
+    return [NodeProcess("rtt_bag", "tutorial.tools.rtt_bag", ["record", *topics, *tf, "-o", args.record])]

@@ -8,7 +8,7 @@ import sys
 
 from _common import joy_node, record_nodes, simulation_node
 
-from tutorial.ros.launch import LaunchDescription, Node, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, NodeProcess, launch_parser, run
 
 
 def generate_launch_description(args) -> LaunchDescription:
@@ -18,7 +18,7 @@ def generate_launch_description(args) -> LaunchDescription:
             *record_nodes(args, ["/joy", "/Tank/joint_state"]),  # first: up before the publishers start
             joy_node(args),
             simulation_node(args, "step2.yaml"),
-            Node("rtt_plot", "tutorial.tools.rtt_plot", ["--body", "Tank", *plot_args]),
+            NodeProcess("rtt_plot", "tutorial.tools.rtt_plot", ["--body", "Tank", *plot_args]),
         ]
     )
 

@@ -10,7 +10,7 @@ import sys
 
 from _common import PROJECT, joy_node, record_nodes, simulation_node
 
-from tutorial.ros.launch import LaunchDescription, Node, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, NodeProcess, launch_parser, run
 
 TOPICS = ["/joy", "/Tank/joint_state", "/Tank/imu"]  # what --record records
 
@@ -22,7 +22,7 @@ def generate_launch_description(args) -> LaunchDescription:
             *record_nodes(args, TOPICS),  # first: up before the publishers start
             joy_node(args, script="wall"),  # ram the wall ahead: the viewer shakes
             simulation_node(args, "step4.yaml"),
-            Node("rtt_viewer", "tutorial.tools.rtt_run", viewer_args),
+            NodeProcess("rtt_viewer", "tutorial.tools.rtt_run", viewer_args),
         ]
     )
 

@@ -10,7 +10,7 @@ import sys
 
 from _common import joy_node, record_nodes, simulation_node
 
-from tutorial.ros.launch import LaunchDescription, Node, launch_parser, run
+from tutorial.ros.launch import LaunchDescription, NodeProcess, launch_parser, run
 
 TOPICS = ["/joy", "/Tank/joint_state", "/Tank/camera/image"]  # --record: pictures are 230 KB, 30 a second
 
@@ -21,7 +21,7 @@ def generate_launch_description(args) -> LaunchDescription:
             *record_nodes(args, TOPICS),
             joy_node(args),
             simulation_node(args, "step6.yaml"),
-            Node("rtt_image", "tutorial.tools.rtt_image", ["/Tank/camera/image", "--output", args.image_output]),
+            NodeProcess("rtt_image", "tutorial.tools.rtt_image", ["/Tank/camera/image", "--output", args.image_output]),
         ]
     )
 

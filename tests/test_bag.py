@@ -7,13 +7,18 @@ import sys
 import pytest
 import yaml
 
-from tutorial.bag import cli, definitions, qos
-from tutorial.bag.definitions import UnknownMessageType
+from tutorial.bag import qos
 from tutorial.bag.info import bag_info, format_info
-from tutorial.bag.reader import BagError, check_file, iter_raw, joint_series
+from tutorial.bag.reader import BagError, check_file, iter_raw
+from tutorial.bag.series import joint_series
 from tutorial.bag.writer import BagWriter
+from tutorial.interfaces import definitions
+from tutorial.interfaces.definitions import UnknownMessageType
+from tutorial.tools import rtt_bag
 
 from conftest import ROOT, module_command, wait_until
+
+RTT_BAG = "tutorial.tools.rtt_bag"  # rtt-bag, run as python -m
 
 SEP = "\n" + "=" * 80 + "\n"
 INFINITE = {"sec": 9223372036, "nsec": 854775807}
@@ -263,7 +268,7 @@ def test_all_topics_takes_late_publishers_but_not_hidden_topics(ros, node, tmp_p
     from std_msgs.msg import String
 
     from tutorial.bag.record import BagRecorder
-    from tutorial.ros.env import SpinThread
+    from tutorial.ros.spin import SpinThread
 
     own = ros.create_node("test_bag_own_node")
     spin = SpinThread(own).start()
@@ -311,7 +316,7 @@ def test_player_keeps_the_timing_and_honours_rate_offset_topics_and_loop(ros, no
     from sensor_msgs.msg import Joy
 
     from tutorial.bag.play import BagPlayer
-    from tutorial.ros.env import SpinThread
+    from tutorial.ros.spin import SpinThread
 
     bag = timed_bag(tmp_path / "timed.mcap")
     lock = threading.Lock()  # the spin thread appends, the test thread reads
@@ -415,7 +420,7 @@ def test_a_bad_file_gives_one_clear_line_and_status_2(tmp_path, capsys, command)
         if command == "recover" and name == "corrupt":
             continue  # recover reads around a damaged chunk: below
         extra = ["-o", str(tmp_path / "out.mcap")] if command == "recover" else []
-        assert cli.main(["rtt-bag", command, str(path), *extra]) == 2, name
+        assert rtt_bag.main(["rtt-bag", command, str(path), *extra]) == 2, name
         out, err = capsys.readouterr()
         assert out == "", (name, out)
         lines = err.splitlines()
@@ -430,7 +435,11 @@ def test_a_bad_file_is_one_line_from_the_real_program_too(tmp_path):
 
     path = bad_bags(tmp_path)["garbage"]
     done = subprocess.run(
-        module_command("tutorial.bag", "info", str(path)), capture_output=True, text=True, timeout=60, cwd=ROOT
+        module_command(RTT_BAG, "info", str(path)),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=ROOT,
     )
     assert done.returncode == 2 and done.stdout == ""
     assert done.stderr.splitlines() == [f"rtt-bag: info: {path}: not an MCAP file (no MCAP magic at its start)"]
@@ -483,14 +492,14 @@ def test_a_file_that_was_not_closed_is_read_to_its_last_whole_chunk(tmp_path, ca
     with pytest.raises(BagError, match="truncated MCAP file"):
         check_file(killed)  # not whole: who needs a whole file is told
 
-    assert cli.main(["rtt-bag", "info", str(killed)]) == 0
+    assert rtt_bag.main(["rtt-bag", "info", str(killed)]) == 0
     out, err = capsys.readouterr()
     assert err.splitlines() == [
         f"rtt-bag: info: {killed}: not closed (the recording was cut short: killed, or the disk filled): "
         f"{n} messages recovered from its complete records ({info.recovery.stop}); rtt-bag recover writes a closed copy"
     ]
     assert f"Messages:          {n}" in out and "Not closed:" in out
-    assert cli.main(["rtt-bag", "info", str(killed), "--json"]) == 0
+    assert rtt_bag.main(["rtt-bag", "info", str(killed), "--json"]) == 0
     reported = json.loads(capsys.readouterr().out)
     assert reported["closed"] is False and reported["recovery"]["messages"] == n
 
@@ -532,7 +541,7 @@ def test_recover_writes_a_whole_indexed_file_of_what_could_be_read(tmp_path, cap
     killed = cut(good, tmp_path / "killed.mcap", 2 / 3)
     before = killed.read_bytes()
     out = tmp_path / "whole.mcap"
-    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(out)]) == 0
+    assert rtt_bag.main(["rtt-bag", "recover", str(killed), "-o", str(out)]) == 0
     line = capsys.readouterr().out.strip()
     assert line.startswith(f"[rtt-bag] {killed} (not closed): 1539 messages recovered") and "closed and indexed" in line
     assert killed.read_bytes() == before  # the input is only read
@@ -549,19 +558,19 @@ def test_recover_writes_a_whole_indexed_file_of_what_could_be_read(tmp_path, cap
     assert bag["message_count"] == 1539 and bag["topics_with_message_count"][0]["message_count"] == 1539
     assert channel.metadata["offered_qos_profiles"] == EXPECTED_OFFER  # the channel's QoS kept
     # Once more over an existing file: refused, then allowed.
-    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(out)]) == 2
+    assert rtt_bag.main(["rtt-bag", "recover", str(killed), "-o", str(out)]) == 2
     assert "exists already" in capsys.readouterr().err
-    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(killed)]) == 2
+    assert rtt_bag.main(["rtt-bag", "recover", str(killed), "-o", str(killed)]) == 2
     assert "the copy must go to another file" in capsys.readouterr().err
-    assert cli.main(["rtt-bag", "recover", str(killed), "-o", str(out), "--overwrite"]) == 0
+    assert rtt_bag.main(["rtt-bag", "recover", str(killed), "-o", str(out), "--overwrite"]) == 0
 
 
 def test_recover_skips_a_damaged_chunk_and_keeps_the_rest(tmp_path, capsys):
     corrupt = bad_bags(tmp_path)["corrupt"]  # the second of four chunks is damaged
-    assert cli.main(["rtt-bag", "info", str(corrupt)]) == 2  # a closed file that lies is refused ...
+    assert rtt_bag.main(["rtt-bag", "info", str(corrupt)]) == 2  # a closed file that lies is refused ...
     assert "rtt-bag recover copies what can still be read" in capsys.readouterr().err
     out = tmp_path / "whole.mcap"
-    assert cli.main(["rtt-bag", "recover", str(corrupt), "-o", str(out)]) == 0  # ... and recovered
+    assert rtt_bag.main(["rtt-bag", "recover", str(corrupt), "-o", str(out)]) == 0  # ... and recovered
     assert "1 damaged chunk skipped" in capsys.readouterr().out
     assert recovered_by_stock_readers(out) == {"/Tank/joint_state": 2000 - (1026 - 513)}
     assert [m.log_time for m in iter_raw(out)][512:514] == [1_512_000_000, 2_026_000_000]  # the second chunk gone
@@ -569,9 +578,9 @@ def test_recover_skips_a_damaged_chunk_and_keeps_the_rest(tmp_path, capsys):
 
 def test_an_unknown_message_type_is_listed_but_not_played(tmp_path, capsys):
     path = good_bag(tmp_path / "unknown.mcap", type_name="nope_msgs/msg/Thing", n=3)
-    assert cli.main(["rtt-bag", "info", str(path)]) == 0
+    assert rtt_bag.main(["rtt-bag", "info", str(path)]) == 0
     assert "nope_msgs/msg/Thing" in capsys.readouterr().out
-    assert cli.main(["rtt-bag", "info", str(path), "--json"]) == 0
+    assert rtt_bag.main(["rtt-bag", "info", str(path), "--json"]) == 0
     [topic] = json.loads(capsys.readouterr().out)["topics"]
     assert (topic["topic"], topic["type"], topic["count"], topic["rate_hz"]) == (
         "/Tank/joint_state",
@@ -579,20 +588,20 @@ def test_an_unknown_message_type_is_listed_but_not_played(tmp_path, capsys):
         3,
         pytest.approx(1000.0),
     )
-    assert cli.main(["rtt-bag", "play", str(path)]) == 2
+    assert rtt_bag.main(["rtt-bag", "play", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.splitlines() == [
         f"rtt-bag: play: {path}: cannot play /Tank/joint_state: message type "
         "nope_msgs/msg/Thing is not installed here (no Python module nope_msgs.msg)"
     ]
-    assert cli.main(["rtt-bag", "play", str(tmp_path / "unknown.mcap"), "--topics", "/nothing"]) == 2
+    assert rtt_bag.main(["rtt-bag", "play", str(tmp_path / "unknown.mcap"), "--topics", "/nothing"]) == 2
     assert "no messages on /nothing" in capsys.readouterr().err
 
 
 def test_record_refuses_an_existing_file(tmp_path, capsys):
     path = good_bag(tmp_path / "kept.mcap", n=3)
     before = path.read_bytes()
-    assert cli.main(["rtt-bag", "record", "/joy", "-o", str(path)]) == 2
+    assert rtt_bag.main(["rtt-bag", "record", "/joy", "-o", str(path)]) == 2
     assert capsys.readouterr().err.splitlines() == [
         f"rtt-bag: record: {path} exists already; choose another name or pass --overwrite"
     ]
@@ -606,7 +615,7 @@ def test_a_stopped_recording_is_a_whole_file(procs, node, tmp_path, sig):
     from sensor_msgs.msg import JointState
 
     path = tmp_path / "stopped.mcap"
-    rec = procs(module_command("tutorial.bag", "record", "/bag_test/stop", "-o", str(path)))
+    rec = procs(module_command(RTT_BAG, "record", "/bag_test/stop", "-o", str(path)))
     pub = node.create_publisher(JointState, "/bag_test/stop", 100)
     rec.wait_for_line(lambda line: "subscribed to /bag_test/stop" in line, timeout=30)
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=10)
@@ -628,7 +637,7 @@ def test_a_stopped_recording_is_a_whole_file(procs, node, tmp_path, sig):
 
 def test_duration_ends_a_recording_by_itself(procs, tmp_path):
     path = tmp_path / "short.mcap"
-    rec = procs(module_command("tutorial.bag", "record", "/bag_test/nothing", "-o", str(path), "--duration", "1"))
+    rec = procs(module_command(RTT_BAG, "record", "/bag_test/nothing", "-o", str(path), "--duration", "1"))
     assert rec.wait(30) == 0, rec.err
     assert "wrote 0 of 0 messages received" in rec.out
     assert bag_info(path).count == 0

@@ -6,9 +6,11 @@ import pytest
 
 from tutorial.bag.info import bag_info
 from tutorial.bag.qos import offer_for_recorded
-from tutorial.bag.reader import joint_series
+from tutorial.bag.series import joint_series
 
 from conftest import module_command, publishers_seen, wait_until
+
+RTT_BAG = "tutorial.tools.rtt_bag"  # rtt-bag, run as python -m
 
 
 def is_stale(line: str) -> bool:
@@ -18,7 +20,7 @@ def is_stale(line: str) -> bool:
 def test_a_replayed_drive_drives_the_viewer_as_the_live_one_did(procs, tmp_path):
     bag = tmp_path / "drive.mcap"
     # 1. Record a demo drive: the recorder first, so it is in the graph when the publishers appear.
-    rec = procs(module_command("tutorial.bag", "record", "/joy", "/Tank/joint_state", "-o", str(bag)))
+    rec = procs(module_command(RTT_BAG, "record", "/joy", "/Tank/joint_state", "-o", str(bag)))
     rec.wait_for_line(lambda line: "recording /joy /Tank/joint_state" in line, timeout=30)
     joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "9"))
     sim = procs(
@@ -54,7 +56,7 @@ def test_a_replayed_drive_drives_the_viewer_as_the_live_one_did(procs, tmp_path)
             "__node:=rtt_viewer",
         )
     )
-    play = procs(module_command("tutorial.bag", "play", str(bag), "--rate", "2", "--delay", "1"))
+    play = procs(module_command(RTT_BAG, "play", str(bag), "--rate", "2", "--delay", "1"))
     assert wait_until(lambda: publishers_seen(view) >= 1, timeout=30), view.out
     stale_before = view.count(is_stale)  # the player is still playing
     assert play.wait(60) == 0, play.err

@@ -21,10 +21,10 @@ import pytest
 from tutorial.controllers.camera_image_publisher import RttCameraImagePublisher, body_cameras
 from tutorial.core.body import Body
 from tutorial.core.controller import ControllerConfig, ControllerIO
+from tutorial.core.period import PeriodAccumulator
 from tutorial.core.project import load_project
 from tutorial.core.world import build_world
 from tutorial.interfaces.image import camera_image_topic, fill_image, image_to_array
-from tutorial.interfaces.timing import PeriodAccumulator
 
 from conftest import PROJECT, ROOT, module_command, wait_until
 

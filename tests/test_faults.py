@@ -29,6 +29,8 @@ from tutorial.ros.shm import SHM_DIR, fast_dds_shm_files, remove_unused_fast_dds
 
 from conftest import ROOT, module_command, publishers_seen, wait_until
 
+RTT_BAG = "tutorial.tools.rtt_bag"  # rtt-bag, run as python -m
+
 pytestmark = pytest.mark.cross_process
 
 STALE_DEADLINE = 1.5  # s from a SIGKILLed simulation to the viewer's stale line (issue 18)
@@ -374,9 +376,7 @@ MAX_LOST = 1.0  # s of messages a killed recorder may lose (issue 26)
 
 def run_bag(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
     """``rtt-bag ARGS`` as a process; its exit status and output."""
-    return subprocess.run(
-        module_command("tutorial.bag", *args), capture_output=True, text=True, timeout=timeout, cwd=ROOT
-    )
+    return subprocess.run(module_command(RTT_BAG, *args), capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
 def test_recorder_killed_loses_less_than_a_second_and_its_file_is_read_played_and_recovered(nodes, tmp_path):
@@ -387,7 +387,7 @@ def test_recorder_killed_loses_less_than_a_second_and_its_file_is_read_played_an
 
     sim = nodes.simulation()
     path = tmp_path / "killed.mcap"
-    rec = nodes.start("tutorial.bag", "record", "/Tank/joint_state", "-o", str(path))
+    rec = nodes.start(RTT_BAG, "record", "/Tank/joint_state", "-o", str(path))
     rec.wait_for_line(lambda line: "subscribed to /Tank/joint_state" in line, timeout=60)
     time.sleep(RECORD_SECONDS)  # the fault's timing: the recording runs this long, then the kill
     killed_ns = time.time_ns()
@@ -471,7 +471,9 @@ def test_recorder_stops_with_one_line_when_the_disk_is_full_and_its_file_stays_r
         path = tmp_path / "limited.mcap"
         extra = {"preexec_fn": limit_file_size(2 * 1024 * 1024)}
     pub = node.create_publisher(JointState, "/bag_test/flood", 10)
-    rec = nodes.start("tutorial.bag", "record", "/bag_test/flood", "-o", str(path), "--compression", "none", **extra)
+    rec = nodes.start(
+        "tutorial.tools.rtt_bag", "record", "/bag_test/flood", "-o", str(path), "--compression", "none", **extra
+    )
     rec.wait_for_line(lambda line: "subscribed to /bag_test/flood" in line, timeout=60)
     assert wait_until(lambda: pub.get_subscription_count() >= 1, timeout=30)
     rng = random.Random(26)

@@ -6,8 +6,9 @@ import time
 
 import pytest
 
-import tutorial.core.app as app_module
-from tutorial.core.app import FRAME_RATE, App
+import tutorial.app.frames as frames_module
+from tutorial.app.app import App
+from tutorial.app.frames import FRAME_RATE
 from tutorial.core.project import load_project
 
 from conftest import MODEL
@@ -66,8 +67,8 @@ def test_a_complete_burst_is_drawn_at_once(viewer, monkeypatch):
     move_all(app)  # every tank has moved once: each is expected in every burst
     wait_for_frames(app, frames, 1)
     frames.clear()
-    monkeypatch.setattr(app_module, "SETTLE", 5.0)  # the settle wait must play no part
-    monkeypatch.setattr(app_module, "SETTLE_MAX", 5.0)
+    monkeypatch.setattr(frames_module, "SETTLE", 5.0)  # the settle wait must play no part
+    monkeypatch.setattr(frames_module, "SETTLE_MAX", 5.0)
     for name in ("Tank1", "Tank2"):  # the states of one step, one per robot: not all in yet
         app.loop.call_later(move, app, name, key=object())
         app.step(timeout=0)
@@ -86,8 +87,8 @@ def test_an_arrow_that_has_ever_changed_is_part_of_the_burst(viewer, monkeypatch
     arrow.set((0.0, 0.0, 0.0), (0.1, 0.0, 0.0))
     wait_for_frames(app, frames, 1)
     frames.clear()
-    monkeypatch.setattr(app_module, "SETTLE", 5.0)
-    monkeypatch.setattr(app_module, "SETTLE_MAX", 5.0)
+    monkeypatch.setattr(frames_module, "SETTLE", 5.0)
+    monkeypatch.setattr(frames_module, "SETTLE_MAX", 5.0)
     move_all(app)  # the joint states are in, the IMU's message is not
     step_for(app, 0.2)
     assert frames == [] and not app.burst_complete()
@@ -100,8 +101,8 @@ def test_an_incomplete_burst_is_drawn_once_after_it_settles(viewer, monkeypatch)
     app, frames = viewer
     move_all(app)  # every tank has moved once: each is expected in every burst
     wait_for_frames(app, frames, 1)
-    monkeypatch.setattr(app_module, "SETTLE", 0.3)  # long, so a slow machine cannot split the burst
-    monkeypatch.setattr(app_module, "SETTLE_MAX", 2.0)
+    monkeypatch.setattr(frames_module, "SETTLE", 0.3)  # long, so a slow machine cannot split the burst
+    monkeypatch.setattr(frames_module, "SETTLE_MAX", 2.0)
     last_change = time.monotonic()  # before the step that sees the last change: the frame comes >= 0.3 s after
     for name in ("Tank1", "Tank2"):  # Tank3's state does not come
         app.loop.call_later(move, app, name, key=object())
@@ -118,12 +119,12 @@ def test_a_steady_stream_is_still_drawn_and_at_most_frame_rate_times_a_second(vi
     move_all(app)
     wait_for_frames(app, frames, 1)
     frames.clear()  # from here on only Tank1 moves: no burst is ever complete
-    monkeypatch.setattr(app_module, "SETTLE", 0.2)  # every change would put the frame off again ...
-    monkeypatch.setattr(app_module, "SETTLE_MAX", 0.25)  # ... but not past this
+    monkeypatch.setattr(frames_module, "SETTLE", 0.2)  # every change would put the frame off again ...
+    monkeypatch.setattr(frames_module, "SETTLE_MAX", 0.25)  # ... but not past this
     step_for(app, 1.0, post=move)
     assert 2 <= len(frames) <= 1.0 / 0.25 + 1, frames
-    monkeypatch.setattr(app_module, "SETTLE", 0.002)
-    monkeypatch.setattr(app_module, "SETTLE_MAX", 0.005)
+    monkeypatch.setattr(frames_module, "SETTLE", 0.002)
+    monkeypatch.setattr(frames_module, "SETTLE_MAX", 0.005)
     frames.clear()
     step_for(app, 1.0, post=move)
     assert 10 <= len(frames) <= FRAME_RATE + 2, len(frames)

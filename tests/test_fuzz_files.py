@@ -19,12 +19,13 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tutorial.bag import cli as bag_cli
 from tutorial.bag.info import bag_info
-from tutorial.bag.reader import BagError, iter_raw, joint_series, read_messages
+from tutorial.bag.reader import BagError, iter_raw, read_messages
 from tutorial.bag.recover import recover
+from tutorial.bag.series import joint_series
 from tutorial.core.project import ProjectError, load_project
 from tutorial.core.world import ModelEntry, ModelError, build_world
+from tutorial.tools import rtt_bag as bag_cli
 
 from conftest import MODEL, PROJECT
 from fuzzing import examples
@@ -334,7 +335,7 @@ def test_rtt_bag_command_lines_end_in_a_status(tmp_path_factory, monkeypatch, co
 @examples(30)
 @given(args=st.lists(ARG_TOKENS, max_size=6))
 def test_rtt_bag_record_arguments_parse_or_exit_2(args):
-    from tutorial.ros.env import parse_command_line
+    from tutorial.ros.program import parse_command_line
 
     def parse(argv):
         parse_command_line(bag_cli.build_parser(), argv)

@@ -199,7 +199,7 @@ def test_rtt_plot_takes_any_joint_state():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from tutorial.view.plots import JointStateHistory, draw
+    from tutorial.view.joint_plot import JointStateHistory, draw
 
     # The examples share one history, as one run's messages do; at most 50 samples of it, so that each
     # example draws a bounded plot (unbounded, make fuzz's 2,000 examples drew ever more lines and

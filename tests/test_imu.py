@@ -208,7 +208,7 @@ def test_a_free_root_has_its_position_at_the_start_of_its_qpos():
 @pytest.fixture
 def viewer(node):
     """The Step 5 project opened in this process, headless: the App and its IMU subscriber."""
-    from tutorial.core.app import App
+    from tutorial.app.app import App
     from tutorial.core.project import load_project
 
     records = []
@@ -328,7 +328,8 @@ def test_period_mean_is_the_mean_of_what_was_added_and_starts_over():
 
 
 def test_the_stamp_is_the_simulation_time_split_by_step_2s_stamp_parts():
-    from tutorial.interfaces.timing import PeriodAccumulator, stamp_parts
+    from tutorial.core.period import PeriodAccumulator
+    from tutorial.interfaces.timing import stamp_parts
 
     controller, node, _ = run_publisher(2.0, rate=3.0)  # a period that is no whole number of steps
     accumulator = PeriodAccumulator(0.001, 3.0)
@@ -372,8 +373,8 @@ def recorded_arrows(visible_per_frame, fps=15.0):
     """A recording of the tank at rest with one red arrow, visible or not in each frame; its commands."""
     import umsgpack
 
+    from tutorial.core.overlays import Overlays
     from tutorial.notebook import replay
-    from tutorial.view.overlays import Overlays
 
     model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
     data = mujoco.MjData(model)
@@ -418,8 +419,8 @@ def test_a_recording_draws_the_arrows_and_animates_them_with_the_bodies():
 
 
 def test_a_recording_is_the_same_bytes_twice_and_refuses_a_wrong_number_of_snapshots():
+    from tutorial.core.overlays import Overlays
     from tutorial.notebook import replay
-    from tutorial.view.overlays import Overlays
 
     first, _ = recorded_arrows([True, False, True])
     second, _ = recorded_arrows([True, False, True])

@@ -26,7 +26,7 @@ def read_available(fd, timeout=0.1) -> bytes:
 def test_keys_become_stick_values_on_joy(node):
     from sensor_msgs.msg import Joy
 
-    from tutorial.ros.env import SpinThread
+    from tutorial.ros.spin import SpinThread
 
     received = []
     node.create_subscription(Joy, "/joy", lambda msg: received.append(list(msg.axes)), 10)

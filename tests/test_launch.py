@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tutorial.ros.launch import Launch, LaunchDescription, Node
+from tutorial.ros.launch import Launch, LaunchDescription, NodeProcess
 
 from conftest import ROOT, wait_until
 
@@ -80,8 +80,10 @@ def test_a_failing_node_fails_the_launch_and_stops_the_others():
     launch = Launch(
         LaunchDescription(
             [
-                Node("rtt_joy", "tutorial.tools.rtt_joy", ["--demo"]),
-                Node("broken", "tutorial.tools.rtt_run", ["/nonexistent/project.yaml", "--headless"], required=True),
+                NodeProcess("rtt_joy", "tutorial.tools.rtt_joy", ["--demo"]),
+                NodeProcess(
+                    "broken", "tutorial.tools.rtt_run", ["/nonexistent/project.yaml", "--headless"], required=True
+                ),
             ]
         ),
         out=out,

@@ -1,18 +1,16 @@
-"""The library's layers: who may import whom, read from the source (no import is run).
+"""The library's layers are import-linter's contracts (``pyproject.toml``, ``[tool.importlinter]``).
 
-* a step module (``tutorial/controllers/*.py``, written from a notebook)
-  imports the library and never another step module, so editing one
-  step's notebook cannot change another step;
-* the library never imports a step module: project files name them and the
-  project loader imports them by name (only the notebook helpers and the
-  exercises, which sit above the steps, may);
-* nothing but the programs themselves imports ``tutorial.tools`` (the
-  ``rtt-*`` mains): what a program and a notebook share lives in the library.
+``make lint`` runs ``lint-imports`` on the tree.  These tests prove that each
+contract catches what it claims: a copy of the library is given one wrong
+import, and ``lint-imports`` must report that contract broken, naming the
+import; the copy without it must pass.
 """
 
 from __future__ import annotations
 
-import ast
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -20,124 +18,107 @@ import pytest
 pytestmark = pytest.mark.unit
 
 ROOT = Path(__file__).resolve().parent.parent
-PACKAGE = ROOT / "tutorial"
-ABOVE_THE_STEPS = ("tutorial.notebook", "tutorial.exercises")
+LINT_IMPORTS = Path(sys.executable).with_name("lint-imports")
 
 
-def module_name(path: Path) -> str:
-    """``tutorial/core/app.py`` -> ``tutorial.core.app``; a package's ``__init__`` is the package."""
-    parts = list(path.relative_to(ROOT).with_suffix("").parts)
-    if parts[-1] == "__init__":
-        parts.pop()
-    return ".".join(parts)
+def lint_imports(tree: Path) -> subprocess.CompletedProcess:
+    """``lint-imports`` run in ``tree`` (its cwd is first on the path, so the copy is what it reads)."""
+    return subprocess.run(
+        [str(LINT_IMPORTS), "--no-cache", "--no-logo"],
+        cwd=tree,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
-def imported_modules(source: str, name: str, is_package: bool) -> set[str]:
-    """Every module ``source`` imports, at any depth (functions too), relative imports resolved.
-
-    ``from a.b import c`` counts as ``a.b`` and ``a.b.c`` (``c`` may be a module).
-    """
-    package = name if is_package else name.rpartition(".")[0]
-    found: set[str] = set()
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Import):
-            found.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom):
-            base = node.module or ""
-            if node.level:
-                anchor = package.split(".")
-                anchor = anchor[: len(anchor) - (node.level - 1)]
-                base = ".".join([*anchor, base] if base else anchor)
-            found.add(base)
-            found.update(f"{base}.{alias.name}" for alias in node.names)
-    return found
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory) -> Path:
+    """A copy of the library, the benchmarks' package marker and the contracts."""
+    tree = tmp_path_factory.mktemp("layers")
+    shutil.copytree(ROOT / "tutorial", tree / "tutorial", ignore=shutil.ignore_patterns("__pycache__"))
+    (tree / "benchmarks").mkdir()
+    (tree / "benchmarks" / "__init__.py").write_text("")
+    shutil.copy(ROOT / "pyproject.toml", tree / "pyproject.toml")
+    return tree
 
 
-def violations(modules: dict[str, set[str]]) -> list[str]:
-    """The broken rules, one line each, for ``{module name: the modules it imports}``."""
-    problems = []
-    for name, imports in sorted(modules.items()):
-        steps = {m for m in imports if m.startswith("tutorial.controllers.")}
-        tools = {m for m in imports if m == "tutorial.tools" or m.startswith("tutorial.tools.")}
-        if name.startswith("tutorial.controllers."):
-            others = {m for m in steps if not m.startswith(name)}
-            if others:
-                problems.append(f"step module {name} imports another step: {sorted(others)}")
-        elif steps and not name.startswith(ABOVE_THE_STEPS) and name != "tutorial.controllers":
-            problems.append(f"library module {name} imports a step module: {sorted(steps)}")
-        if tools and not name.startswith("tutorial.tools"):
-            problems.append(f"{name} imports a program's main: {sorted(tools)}")
-    return problems
+@pytest.fixture
+def tree(pristine, tmp_path) -> Path:
+    copy = tmp_path / "tree"
+    shutil.copytree(pristine, copy)
+    return copy
 
 
-def library_imports() -> dict[str, set[str]]:
-    out = {}
-    for path in sorted(PACKAGE.rglob("*.py")):
-        name = module_name(path)
-        out[name] = imported_modules(path.read_text(encoding="utf-8"), name, path.name == "__init__.py")
-    return out
+def test_the_library_keeps_every_contract(pristine):
+    run = lint_imports(pristine)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "Contracts: 4 kept, 0 broken." in run.stdout, run.stdout
 
 
-def test_the_layers_hold():
-    modules = library_imports()
-    assert "tutorial.controllers.joint_state_publisher" in modules  # the scan found the step modules
-    problems = violations(modules)
-    assert not problems, "\n".join(problems)
+# (module given the import, the import, the contract's name as reported, the import as reported: a
+# cycle is reported within its package, ".reader -> .info")
+WRONG = [
+    (
+        "tutorial/core/controller.py",
+        "from tutorial.view.overlays import MeshcatOverlays",
+        "The library's layers",
+        "tutorial.core.controller -> tutorial.view.overlays",
+    ),
+    (
+        "tutorial/interfaces/tf.py",
+        "from tutorial.bag.qos import profile_dict",
+        "The library's layers",
+        "tutorial.interfaces.tf -> tutorial.bag.qos",
+    ),
+    (
+        "tutorial/app/app.py",
+        "from tutorial.notebook.session import TEST_MODE",
+        "The library's layers",
+        "tutorial.app.app -> tutorial.notebook.session",
+    ),
+    (
+        # one layer's packages are independent: the view does not read URDF
+        "tutorial/view/scene.py",
+        "from tutorial.urdf.frames import pose_matrix",
+        "The library's layers",
+        "tutorial.view.scene -> tutorial.urdf.frames",
+    ),
+    (
+        # an import inside a function counts too
+        "tutorial/core/simulator.py",
+        "def _late():\n    from tutorial.controllers.joint_state_publisher import RttJointStatePublisher",
+        "The library's layers",
+        "tutorial.core.simulator -> tutorial.controllers.joint_state_publisher",
+    ),
+    (
+        "tutorial/controllers/imu_state_subscriber.py",
+        "from .imu_state_publisher import find_imu",
+        "A step never imports another step",
+        "tutorial.controllers.imu_state_subscriber -> tutorial.controllers.imu_state_publisher",
+    ),
+    (
+        "tutorial/view/status.py",
+        "import benchmarks",
+        "The library imports neither the tests nor the benchmarks",
+        "tutorial.view.status -> benchmarks",
+    ),
+    (
+        "tutorial/bag/reader.py",
+        "from tutorial.bag.info import bag_info",
+        "No cycles",
+        ".reader -> .info",
+    ),
+]
 
 
-def test_each_step_module_reaches_the_interfaces_not_a_sibling():
-    """The shared contracts moved out of the steps: every step that publishes or subscribes uses them."""
-    modules = library_imports()
-    steps = [n for n in modules if n.startswith("tutorial.controllers.") and n != "tutorial.controllers"]
-    assert len(steps) == 7
-    for name in steps:
-        assert any(m.startswith("tutorial.interfaces.") for m in modules[name]), name
-
-
-@pytest.mark.parametrize(
-    "name, source, expected",
-    [
-        (
-            "tutorial.controllers.imu_state_subscriber",
-            "from .imu_state_publisher import find_imu",
-            "step module tutorial.controllers.imu_state_subscriber imports another step",
-        ),
-        (
-            "tutorial.controllers.camera_image_publisher",
-            "def f():\n    from tutorial.controllers.joint_state_publisher import stamp_parts",
-            "imports another step",
-        ),
-        (
-            "tutorial.core.trajectory",
-            "from tutorial.controllers.joint_state_publisher import PeriodAccumulator",
-            "library module tutorial.core.trajectory imports a step module",
-        ),
-        (
-            "tutorial.view.images",
-            "from ..controllers import camera_image_publisher",
-            "library module tutorial.view.images imports a step module",
-        ),
-        (
-            "tutorial.notebook.live_image",
-            "from tutorial.tools.rtt_image import ImageReceiver",
-            "imports a program's main",
-        ),
-    ],
-)
-def test_the_check_catches_each_kind_of_wrong_import(name, source, expected):
-    imports = imported_modules(source, name, is_package=False)
-    problems = violations({name: imports})
-    assert len(problems) == 1 and expected in problems[0], problems
-
-
-@pytest.mark.parametrize(
-    "name, source",
-    [
-        ("tutorial.controllers.joint_state_subscriber", "from ..interfaces.joint_state import joint_state_qos"),
-        ("tutorial.exercises.step2_joint_state_publisher", "from tutorial.controllers.tank_controller import RttTankController"),
-        ("tutorial.notebook.runs", "from tutorial.core.app import App"),
-        ("tutorial.tools.rtt_joy", "from tutorial.tools import rtt_run"),
-    ],
-)
-def test_what_the_layers_allow_passes(name, source):
-    assert violations({name: imported_modules(source, name, is_package=False)}) == []
+@pytest.mark.parametrize("module, line, contract, reported", WRONG, ids=[w[0] for w in WRONG])
+def test_a_wrong_import_breaks_its_contract(tree, module, line, contract, reported):
+    path = tree / module
+    path.write_text(path.read_text(encoding="utf-8") + "\n\n" + line + "  # noqa\n", encoding="utf-8")
+    run = lint_imports(tree)
+    assert run.returncode != 0, run.stdout
+    broken = " ".join(run.stdout.split("Broken contracts", 1)[-1].split())  # lint-imports wraps long lines
+    assert contract in broken, run.stdout
+    assert reported in broken, run.stdout
+    # a wrong import between packages may make a cycle between them too, so no "1 broken" here

@@ -3,7 +3,7 @@
 import threading
 
 from tests.fixtures import recording_controller as rec
-from tutorial.core.app import App
+from tutorial.app.app import App
 from tutorial.core.project import load_project
 
 from conftest import MODEL

@@ -2,7 +2,7 @@
 
 import pytest
 
-from tutorial.interfaces.timing import PeriodAccumulator
+from tutorial.core.period import PeriodAccumulator
 
 
 def due_steps(time_step, rate, steps):

@@ -78,7 +78,7 @@ def test_a_received_description_is_checked(text, says):
 
 def test_a_viewer_with_no_description_to_read_says_so(ros, tmp_path):
     """No simulation: the viewer waits its timeout, then fails with one clear line."""
-    from tutorial.core.app import App
+    from tutorial.app.app import App
 
     app = App(
         load_project(PROJECT / "step3_description.yaml"),

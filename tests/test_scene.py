@@ -249,7 +249,7 @@ def test_overlays_send_only_changed_arrows_and_hide_without_moving():
 def test_an_arrow_refuses_non_finite_numbers_and_a_second_arrow_of_the_same_name():
     import pytest
 
-    from tutorial.view.overlays import Overlays
+    from tutorial.core.overlays import Overlays
 
     overlays = Overlays()
     arrow = overlays.arrow("a", (1, 0, 0))

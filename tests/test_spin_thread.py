@@ -5,7 +5,7 @@ import threading
 import pytest
 from std_msgs.msg import String
 
-from tutorial.ros.env import SPIN_POLL, SpinThread, make_executor
+from tutorial.ros.spin import SPIN_POLL, SpinThread, make_executor
 
 from conftest import wait_until
 

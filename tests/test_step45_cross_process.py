@@ -6,7 +6,7 @@ import signal
 
 import pytest
 
-from tutorial.ros.env import SpinThread
+from tutorial.ros.spin import SpinThread
 
 from conftest import module_command, wait_until
 

@@ -7,7 +7,7 @@ import pytest
 
 from tutorial.interfaces.compressed_image import compressed_image_qos, compressed_to_array
 from tutorial.interfaces.image import camera_image_qos, image_to_array
-from tutorial.ros import env as ros_env
+from tutorial.ros import spin as ros_spin
 
 from conftest import module_command, wait_until
 from test_camera_publisher import egl  # noqa: F401 - the fixture that skips where EGL is missing
@@ -46,7 +46,7 @@ def test_pictures_arrive_stamped_with_simulation_time_at_the_rate_asked(procs, n
 
     node.create_subscription(Image, "/Tank/camera/image", on_image, camera_image_qos())
     node.create_subscription(CompressedImage, "/Tank/camera/image/compressed", on_compressed, compressed_image_qos())
-    spin = ros_env.SpinThread(node).start()
+    spin = ros_spin.SpinThread(node).start()
     try:
         sim = procs(
             module_command(

@@ -30,7 +30,7 @@ simulator:
 
 
 def test_two_bodies_with_the_same_controller_name_both_report(ros, tmp_path):
-    from tutorial.core.app import App
+    from tutorial.app.app import App
     from tutorial.core.project import load_project
 
     path = tmp_path / "two.yaml"

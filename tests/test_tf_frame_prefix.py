@@ -1,4 +1,4 @@
-"""Two tanks in one TF tree (tutorial/urdf/recording.py): with ``frame_prefix="{body}/"`` their frames are
+"""Two tanks in one TF tree (tutorial/bag/tf.py): with ``frame_prefix="{body}/"`` their frames are
 apart, without it a warning says they collide.
 
 Unit tier: messages are serialized with rclpy (no context, no node) and fed to a :class:`TfRecording` writing
@@ -10,9 +10,9 @@ import io
 
 import pytest
 
+from tutorial.bag.tf import TfRecording, check_frame_prefix
 from tutorial.interfaces.tf import decode_tf_message
 from tutorial.urdf.export import export_model_file
-from tutorial.urdf.recording import TfRecording, check_frame_prefix
 
 from conftest import MODEL
 
@@ -140,22 +140,21 @@ def test_a_prefix_without_body_still_collides_and_is_warned(tank_urdf):
 
 @pytest.mark.parametrize("program", ["rtt-bag", "rtt-foxglove"])
 def test_the_programs_refuse_a_bad_prefix_before_anything_starts(tmp_path, capsys, program):
-    from tutorial.bag import cli
-    from tutorial.tools import rtt_foxglove
+    from tutorial.tools import rtt_bag, rtt_foxglove
 
     out = tmp_path / "x.mcap"
     argv = ["rtt-bag", "record", "--tf", "-o", str(out)] if program == "rtt-bag" else ["rtt-foxglove"]
     with pytest.raises(SystemExit) as exit_:
-        (cli.main if program == "rtt-bag" else rtt_foxglove.main)([*argv, "--tf-frame-prefix", "{name}/"])
+        (rtt_bag.main if program == "rtt-bag" else rtt_foxglove.main)([*argv, "--tf-frame-prefix", "{name}/"])
     assert exit_.value.code == 2
     assert "argument --tf-frame-prefix: bad frame prefix '{name}/'" in capsys.readouterr().err
     assert not out.exists()
 
 
 def test_rtt_bag_record_wants_tf_for_a_prefix(tmp_path, capsys):
-    from tutorial.bag import cli
+    from tutorial.tools import rtt_bag
 
     out = tmp_path / "x.mcap"
-    assert cli.main(["rtt-bag", "record", "/joy", "--tf-frame-prefix", "{body}/", "-o", str(out)]) == 2
+    assert rtt_bag.main(["rtt-bag", "record", "/joy", "--tf-frame-prefix", "{body}/", "-o", str(out)]) == 2
     assert "--tf-frame-prefix needs --tf" in capsys.readouterr().err
     assert not out.exists()

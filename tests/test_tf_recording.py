@@ -43,7 +43,7 @@ class Probe(SimpleController):
 
 
 def transform_matrix(t) -> np.ndarray:
-    from tutorial.urdf.export import pose_matrix
+    from tutorial.urdf.frames import pose_matrix
 
     r, p = t.transform.rotation, t.transform.translation
     return pose_matrix((p.x, p.y, p.z), (r.w, r.x, r.y, r.z))
@@ -53,8 +53,8 @@ def test_tf_in_a_recording_is_the_simulation(ros, tmp_path):
     import mujoco
     from rosbags.highlevel import AnyReader
 
+    from tutorial.app.app import App
     from tutorial.bag.record import BagRecorder
-    from tutorial.core.app import App
     from tutorial.core.project import load_project
     from tutorial.joystick.scripted import ScriptedJoy
 

@@ -292,7 +292,7 @@ def test_a_viewer_mirrors_a_simulation(case, ros, tmp_path):
     messages, then is stopped; the publisher sends the final state in ``stop()``.  The
     viewer must end on exactly that state (the same float64s), no entry rejected for its name.
     """
-    from tutorial.core.app import App
+    from tutorial.app.app import App
     from tutorial.core.project import load_project
 
     path = case.file()

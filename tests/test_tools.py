@@ -17,7 +17,7 @@ PROGRAMS = {  # prog name: module whose main() it runs
     "rtt-graph": "tutorial.tools.rtt_graph",
     "rtt-image": "tutorial.tools.rtt_image",
     "rtt-foxglove": "tutorial.tools.rtt_foxglove",
-    "rtt-bag": "tutorial.bag.cli",
+    "rtt-bag": "tutorial.tools.rtt_bag",
 }
 
 
@@ -67,7 +67,7 @@ def test_plot_and_graph_of_a_running_step2(procs, tmp_path):
 
 
 def test_an_unknown_ros_argument_is_named_and_the_syntax_recalled():
-    from tutorial.ros.env import remove_ros_args_or_fail
+    from tutorial.ros.program import remove_ros_args_or_fail
 
     with pytest.raises(ValueError) as error:
         remove_ros_args_or_fail(["rtt-joy", "--ros-args", "--bogus", "-q"])
@@ -76,12 +76,12 @@ def test_an_unknown_ros_argument_is_named_and_the_syntax_recalled():
 
 
 def test_a_stop_request_turns_ctrl_c_and_sigterm_into_a_flag():
-    """The programs' stop (``tutorial.ros.env.StopRequest``): no KeyboardInterrupt raised mid-call."""
+    """The programs' stop (``tutorial.ros.program.StopRequest``): no KeyboardInterrupt raised mid-call."""
     import os
     import signal
     import time
 
-    from tutorial.ros.env import StopRequest
+    from tutorial.ros.program import StopRequest
 
     calls = []
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)

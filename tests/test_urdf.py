@@ -23,8 +23,10 @@ import numpy as np
 import pytest
 from test_third_party_models import CASES
 
-from tutorial.urdf.export import ROOT_FREE, ROOT_WORLD, export_model_file, pose_matrix
+from tutorial.urdf.export import export_model_file
+from tutorial.urdf.frames import pose_matrix
 from tutorial.urdf.kinematics import UrdfKinematics
+from tutorial.urdf.records import ROOT_FREE, ROOT_WORLD
 
 from conftest import MODEL, ROOT
 

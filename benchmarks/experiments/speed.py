@@ -124,7 +124,7 @@ def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, s
 
 def realtime_mode(project: str, seconds: float) -> dict:
     """Real-time factor and step overrun percentiles with every controller on, in real-time mode."""
-    from tutorial.core.app import App
+    from tutorial.app.app import App
     from tutorial.core.project import load_project
 
     proj = load_project(ROOT / project)

@@ -8,14 +8,17 @@ Foxglove open them.  One job per module:
 :mod:`tutorial.bag.record`       :class:`BagRecorder`: subscribe raw, write each message (ROS)
 :mod:`tutorial.bag.play`         :class:`BagPlayer`: republish with the recorded timing (ROS)
 :mod:`tutorial.bag.info`         :func:`bag_info`: per topic type, count, time span, rate, QoS
-:mod:`tutorial.bag.reader`       read without ROS: raw messages, decoded messages, :func:`joint_series`;
+:mod:`tutorial.bag.reader`       read without ROS: raw messages, decoded messages;
                                  a file that was not closed, record by record
+:mod:`tutorial.bag.series`       :func:`joint_series`: a joint's positions over a recording, as arrays
 :mod:`tutorial.bag.recover`      :func:`recover`: a closed, indexed copy of a damaged or unclosed file
 :mod:`tutorial.bag.writer`       the MCAP file as rosbag2 lays it out; the write-through policy
-:mod:`tutorial.bag.definitions`  the full ``ros2msg`` text of a type, from the installed ``.msg`` files
 :mod:`tutorial.bag.qos`          ``offered_qos_profiles``: rosbag2's YAML and its QoS adaptations
-:mod:`tutorial.bag.cli`          the ``rtt-bag`` command line
+:mod:`tutorial.bag.tf`           :class:`TfRecording`: ``/tf``, ``/tf_static`` from descriptions and states
 ===============================  ===========================================================
+
+The messages' full definitions come from :mod:`tutorial.interfaces.definitions`;
+the ``rtt-bag`` command line is :mod:`tutorial.tools.rtt_bag`.
 
 In a notebook (after ``init_ros()``)::
 
@@ -48,7 +51,7 @@ Both are well kept, both read and write MCAP; compared on what a recorder needs:
   them: ``mcap-ros2-support`` takes the text from its caller, ``rosbags``
   generates a comment-less text from its own bundled copy of each type
   (``Typestore.generate_msgdef``), which may differ from the installed
-  version.  :mod:`tutorial.bag.definitions` builds the text as rosbag2
+  version.  :mod:`tutorial.interfaces.definitions` builds the text as rosbag2
   does (same search, same order, same separators), from the installed files.
 * **Raw CDR bytes.** Both take bytes as they are: ``mcap``'s
   ``Writer.add_message(data=...)``; ``rosbags``' ``Writer.write(conn, t, data)``.
@@ -89,7 +92,7 @@ _EXPORTS = {
     "BagError": "tutorial.bag.reader",
     "iter_raw": "tutorial.bag.reader",
     "read_messages": "tutorial.bag.reader",
-    "joint_series": "tutorial.bag.reader",
+    "joint_series": "tutorial.bag.series",
 }
 
 __all__ = sorted(_EXPORTS)

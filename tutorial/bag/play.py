@@ -25,10 +25,10 @@ import threading
 import time
 from dataclasses import dataclass, field
 
-from tutorial.bag.definitions import UnknownMessageType, message_class
 from tutorial.bag.info import bag_info
 from tutorial.bag.qos import offer_for_recorded, to_qos_profile
 from tutorial.bag.reader import BagError, iter_raw
+from tutorial.interfaces.definitions import UnknownMessageType, message_class
 
 NODE_NAME = "rtt_bag_play"
 ACK_TIMEOUT = 2.0  # s to wait for reliable subscribers to acknowledge the last messages

@@ -41,9 +41,9 @@ from __future__ import annotations
 import threading
 import time
 
-from tutorial.bag.definitions import UnknownMessageType, full_text, message_class
 from tutorial.bag.qos import profile_dict, request_for_offers, serialize_profiles, to_qos_profile
 from tutorial.bag.writer import WRITE_THROUGH_CHECK, BagWriter, WriteStats
+from tutorial.interfaces.definitions import UnknownMessageType, full_text, message_class
 
 NODE_NAME = "rtt_bag"
 POLL_PERIOD = 0.1  # s between looks at the ROS graph for new topics (rosbag2's default)
@@ -69,14 +69,14 @@ class BagRecorder:
         all_topics: record every (non-hidden) topic that has a publisher, now or later.
         node: an ``rclpy`` node to use, spun by its owner; None (default):
             the recorder creates node ``node_name`` and spins it on its own
-            :class:`tutorial.ros.env.SpinThread`.
+            :class:`tutorial.ros.spin.SpinThread`.
         node_name: the name of the node it creates.
         compression: chunk compression, ``zstd`` (default), ``lz4`` or ``none``.
         overwrite: replace an existing file (default: refuse).
         output: called with each status line (default ``print``).
         tf: also record every body's robot description, odometry and joint
             states, and write ``/tf``, ``/tf_static`` and ``/robot_description``
-            computed from them (:mod:`tutorial.urdf.recording`).
+            computed from them (:mod:`tutorial.bag.tf`).
         tf_frame_prefix: with ``tf``, put before every frame of a body;
             ``{body}`` in it is the body's name (``"{body}/"`` for several robots).
         write_through: the writer's policy (:class:`~tutorial.bag.writer.BagWriter`);
@@ -116,7 +116,7 @@ class BagRecorder:
         if not self.topics_wanted and not all_topics and not tf:
             raise ValueError("name the topics to record, or record all topics")
         if tf:
-            from tutorial.urdf.recording import check_frame_prefix
+            from tutorial.bag.tf import check_frame_prefix
 
             check_frame_prefix(tf_frame_prefix)  # before the file is made
         self.all_topics = all_topics
@@ -125,7 +125,7 @@ class BagRecorder:
         self.path = self.writer.path
         self.tf = None
         if tf:  # the TF computation is its own module's; the recorder only feeds it
-            from tutorial.urdf.recording import TfRecording
+            from tutorial.bag.tf import TfRecording
 
             self.tf = TfRecording(self.writer, self._say, tf_frame_prefix)
         self._given_node = node
@@ -149,7 +149,7 @@ class BagRecorder:
         """Create the node if needed, subscribe to what exists now, keep polling for the rest; returns self."""
         import rclpy
 
-        from tutorial.ros import env as ros_env
+        from tutorial.ros import spin as ros_spin
 
         if self.node is None:
             self.node = rclpy.create_node(self.node_name)
@@ -162,7 +162,7 @@ class BagRecorder:
         if self.writer.write_through:
             self._write_through_timer = self.node.create_timer(WRITE_THROUGH_CHECK, self.writer.write_through_due)
         if self._given_node is None:
-            self._spin = ros_env.SpinThread(self.node).start()
+            self._spin = ros_spin.SpinThread(self.node).start()
         return self
 
     @property

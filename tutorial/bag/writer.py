@@ -2,7 +2,7 @@
 
 The file is what ``ros2 bag record -s mcap`` writes: the ``ros2`` profile;
 one schema per message type (encoding ``ros2msg``, the full definition
-text, see :mod:`tutorial.bag.definitions`); one channel per topic (message
+text, see :mod:`tutorial.interfaces.definitions`); one channel per topic (message
 encoding ``cdr``, metadata ``offered_qos_profiles`` and ``topic_type_hash``);
 each message's CDR bytes as received, with ``log_time`` = receive time and
 ``publish_time`` = the publisher's source time (ns since the epoch); and,
@@ -46,6 +46,10 @@ A write that fails (a full disk, ``ENOSPC``; the process's file-size limit,
 ``EFBIG``) stops the writer: :attr:`BagWriter.error` says why in one line,
 later messages are dropped, and the file is left as it is, every chunk
 written through before still readable.
+
+Why one module of over 400 lines: it is one class, :class:`BagWriter`, and
+one job, the file as rosbag2 lays it out.  The write-through policy decides
+when a chunk closes, which is the layout, so the two are not separable.
 """
 
 from __future__ import annotations

@@ -50,6 +50,7 @@ import numpy as np
 
 from ..core.call_later import MainLoop
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.period import PeriodAccumulator
 from ..core.simulator import Snapshot
 from tutorial.interfaces.compressed_image import (
     CODECS,
@@ -59,7 +60,6 @@ from tutorial.interfaces.compressed_image import (
     fill_compressed_image,
 )
 from ..interfaces.image import camera_image_qos, camera_image_topic, fill_image
-from ..interfaces.timing import PeriodAccumulator
 
 DEFAULT_RATE = 30.0  # pictures per second of simulated time
 START_TIMEOUT = 20.0  # s for the render thread to make its OpenGL context

@@ -35,8 +35,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.period import PeriodAccumulator
 from ..interfaces.imu import find_imu, imu_qos, imu_topic
-from ..interfaces.timing import PeriodAccumulator, stamp_parts
+from ..interfaces.timing import stamp_parts
 
 DEFAULT_RATE = 20.0  # Hz of simulated time
 

@@ -17,8 +17,9 @@ from __future__ import annotations
 from array import array
 
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.period import PeriodAccumulator
 from ..interfaces.joint_state import joint_state_qos, joint_state_topic
-from ..interfaces.timing import PeriodAccumulator, stamp_parts
+from ..interfaces.timing import stamp_parts
 
 DEFAULT_RATE = 50.0  # Hz of simulated time
 

@@ -13,6 +13,7 @@ in its own frame, stamped with simulation time, at ``rate`` Hz.
 from __future__ import annotations
 
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
+from ..core.period import PeriodAccumulator
 from tutorial.interfaces.odometry import (
     RootMotion,
     fill_odometry,
@@ -23,7 +24,7 @@ from tutorial.interfaces.robot_description import (
     robot_description_qos,
     robot_description_topic,
 )
-from ..interfaces.timing import PeriodAccumulator, stamp_parts
+from ..interfaces.timing import stamp_parts
 from ..urdf.export import export_body
 
 DEFAULT_RATE = 50.0  # Hz of simulated time: the joint states' rate

@@ -346,8 +346,8 @@ class Body:
 
         Choreonoid's ``notifyKinematicStateChange(true)`` does this and tells
         the views to redraw.  Here it counts the change in
-        :attr:`kinematic_state_changes`, and a viewer's :class:`tutorial.core.app.App`
-        draws a frame soon after (:meth:`tutorial.core.app.App.next_frame_due`).
+        :attr:`kinematic_state_changes`, and a viewer's :class:`tutorial.app.app.App`
+        draws a frame soon after (:meth:`tutorial.app.app.App.next_frame_due`).
         Only the owner thread of the data may call it.
         """
         mujoco.mj_kinematics(self.model, self.data)

@@ -21,7 +21,7 @@ runs its own Python for 0.1 to 0.2 ms (it builds its wait set again) before it
 blocks; the woken main thread waits all that time.  So a posting thread that
 has nothing urgent to do may *step aside*: :meth:`MainLoop.yield_to_owner`
 blocks it (which lets go of the lock) until the owner has taken what was
-posted, at most ``HAND_OVER_WAIT``.  :class:`tutorial.ros.env.SpinThread`
+posted, at most ``HAND_OVER_WAIT``.  :class:`tutorial.ros.spin.SpinThread`
 does this after each callback when it is given the loop.  In the benchmark
 at 1 kHz, callback -> applied on the main thread then takes 0.07 to 0.13 ms
 (p50) instead of 0.16 to 0.19 ms (``book/benchmarks.md``).

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tutorial.core.body import Body
-from tutorial.view.overlays import Overlays
+from tutorial.core.overlays import Overlays
 
 
 @dataclass

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from tutorial.core.controller import SimpleController
-from tutorial.interfaces.timing import PeriodAccumulator
+from tutorial.core.period import PeriodAccumulator
 
 
 class TrajectoryLog(SimpleController):

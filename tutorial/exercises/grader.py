@@ -1,8 +1,8 @@
 """Checks for the notebooks' exercises: run the learner's code on cases, say one clear line.
 
 Each exercise has a check function (in :mod:`tutorial.exercises.step1_tank_controller`,
-``step2_joint_state_publisher``, ...: one module per notebook) that takes what the learner wrote (a function or a class),
-runs it on cases and returns a :class:`Result`.  A notebook's check cell
+``step2_joint_state_publisher``, ...: one module per notebook) that takes
+what the learner wrote (a function or a class), runs it on cases and returns a :class:`Result`.  A notebook's check cell
 ends with that call, so the cell shows one line:
 
     ✓ Exercise 1.1, steer with the D-pad: passed (9 cases).

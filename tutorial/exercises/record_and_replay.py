@@ -28,9 +28,9 @@ def write_bag(path: Path, messages: list[tuple[str, float, object]]) -> Path:
     from rclpy.qos import QoSProfile
     from rclpy.serialization import serialize_message
 
-    from tutorial.bag.definitions import full_text
     from tutorial.bag.qos import profile_dict, serialize_profiles
     from tutorial.bag.writer import BagWriter
+    from tutorial.interfaces.definitions import full_text
 
     writer = BagWriter(path, overwrite=True)
     try:
@@ -151,7 +151,7 @@ def check_peak_speed(func) -> Result:
     a state without the joint (NaN) is skipped, and so is a pair with the
     same stamp; fewer than two usable states give ``(0.0, nan)``.
     """
-    from tutorial.bag.reader import JointSeries
+    from tutorial.bag.series import JointSeries
 
     def series(stamps, q):
         stamps = np.asarray(stamps, dtype=float)

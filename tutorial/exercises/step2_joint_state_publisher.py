@@ -50,7 +50,7 @@ def _drive(name: str, cls, parameters: dict):
     """Run the scripted drive with ``cls`` attached as ``name``; ``(capturing node, probe, app)``.
 
     Raises:
-        tutorial.core.app.ControllerError: the learner's controller refused to configure (or raised there).
+        tutorial.app.app.ControllerError: the learner's controller refused to configure (or raised there).
     """
     import rclpy
 
@@ -91,7 +91,7 @@ def check_selected_joints(cls) -> Result:
     order, with the right values; an empty string means every joint; a name
     the body does not have makes ``configure`` refuse.
     """
-    from tutorial.core.app import ControllerError
+    from tutorial.app.app import ControllerError
     from tutorial.interfaces.joint_state import joint_state_topic
 
     def published(joints: str, rate: float):

@@ -62,7 +62,7 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
     Raises:
         NotImplementedError: the learner's code is not written yet.
         CaseFailed: the simulation failed.
-        tutorial.core.app.ControllerError: the controller refused to configure (or raised there).
+        tutorial.app.app.ControllerError: the controller refused to configure (or raised there).
     """
     import rclpy
 

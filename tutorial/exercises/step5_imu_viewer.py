@@ -48,7 +48,7 @@ def _viewer(cls, name: str):
     """
     import rclpy
 
-    from tutorial.core.app import App, ControllerError
+    from tutorial.app.app import App, ControllerError
     from tutorial.notebook.runs import load
 
     project = load("tank_view.yaml").with_controller("Tank", name, cls)

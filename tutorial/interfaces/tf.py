@@ -11,7 +11,7 @@ There is no ``tf2_msgs`` wheel on PyPI, so rclpy cannot publish these here.
 They are written into recordings (``rtt-bag record --tf``) and served to
 Foxglove (``rtt-foxglove``) as CDR bytes encoded with ``mcap-ros2-support``
 from the message definition (``tutorial/interfaces/share/tf2_msgs/msg/TFMessage.msg``,
-found by :func:`tutorial.bag.definitions.full_text`): byte for byte what a
+found by :func:`tutorial.interfaces.definitions.full_text`): byte for byte what a
 ROS 2 publisher sends.
 
 QoS, as tf2's broadcasters offer it (what ``ros2 bag play`` republishes
@@ -90,7 +90,7 @@ class Transform:
 @cache
 def tf_definition() -> tuple[str, str]:
     """``(encoding, text)`` of ``tf2_msgs/msg/TFMessage``, as rosbag2 stores it (any thread)."""
-    from tutorial.bag.definitions import full_text
+    from tutorial.interfaces.definitions import full_text
 
     return full_text(TF_MESSAGE_TYPE)
 

@@ -39,6 +39,10 @@ run killed before it cleaned up is recognised and cleaned by the next one
 (:func:`remove_stale`).  Everything here needs root; :func:`why_unavailable`
 says what is missing where it cannot work.  One thread at a time per
 :class:`Network` (the test or the notebook that made it).
+
+Why one module of over 400 lines: one job, the test hosts' life (make,
+fault, remove, and remove what a killed run left), in two classes that
+share the namespaces' names and the commands that make and undo them.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """A program running on one host (a network namespace), its output read as it comes.
 
-Notebook 08 (:mod:`tutorial.notebook.hosts`) and the cross-host benchmark
+Notebook 08 (:mod:`tutorial.notebook.two_hosts`) and the cross-host benchmark
 (:mod:`benchmarks.experiments.network`) start the tutorial's programs on
 their hosts with :class:`HostProgram`: stdout and stderr are one stream,
 each line kept with the monotonic time it arrived, so a test or a

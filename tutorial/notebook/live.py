@@ -2,7 +2,7 @@
 
 :class:`LiveOutput` is what :class:`tutorial.notebook.live_plot.LivePlot` (joint
 positions) and :class:`tutorial.notebook.live_image.LiveImage` (a camera picture)
-share: a node of its own spun on a :class:`tutorial.ros.env.SpinThread`, an
+share: a node of its own spun on a :class:`tutorial.ros.spin.SpinThread`, an
 ordinary image output redrawn twice a second by a refresh thread, and a
 ``close()`` (what ``reset()`` calls) that keeps the last picture, its title
 saying it has stopped.  A saved notebook, and the book, keep that picture.
@@ -32,7 +32,7 @@ class LiveOutput:
     def __init__(self, node_name: str):
         import rclpy
 
-        from tutorial.ros.env import SpinThread
+        from tutorial.ros.spin import SpinThread
 
         session.init_ros()
         self.node = rclpy.create_node(node_name)

@@ -33,7 +33,7 @@ class LivePlot(LiveOutput):
         super().__init__(node_name)
 
     def subscribe(self, node) -> None:
-        from tutorial.view.plots import JointStateHistory
+        from tutorial.view.joint_plot import JointStateHistory
 
         self.history = JointStateHistory(node, self.topic)
 
@@ -46,7 +46,7 @@ class LivePlot(LiveOutput):
         """The current plot as PNG bytes (any thread: it uses its own Agg figure)."""
         from matplotlib.figure import Figure
 
-        from tutorial.view.plots import draw
+        from tutorial.view.joint_plot import draw
 
         series = self.history.series()
         latest = max((ts[-1] for ts, _ in series.values() if ts), default=0.0)

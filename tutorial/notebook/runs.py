@@ -38,7 +38,7 @@ def load(project: str | Path | Project) -> Project:
 
 
 def _headless_app(project, duration: float, node_name: str, realtime: bool, output, attach, node=None):
-    """An unopened headless :class:`tutorial.core.app.App` on a node that is never spun, and that node.
+    """An unopened headless :class:`tutorial.app.app.App` on a node that is never spun, and that node.
 
     Nothing spins the node, so no subscription callback ever runs: no message
     from the network (a teleop panel, an ``rtt-joy`` in a terminal) can
@@ -46,7 +46,7 @@ def _headless_app(project, duration: float, node_name: str, realtime: bool, outp
     """
     import rclpy
 
-    from tutorial.core.app import App
+    from tutorial.app.app import App
 
     session.init_ros()
     node = node if node is not None else rclpy.create_node(node_name)
@@ -82,7 +82,7 @@ def run_headless(
         project: a project (see :func:`load`).
         duration: simulated seconds.
         attach: extra ``(body name, controller name, controller instance)`` to
-            attach first (as :class:`tutorial.core.app.App` takes them).
+            attach first (as :class:`tutorial.app.app.App` takes them).
         output: called with each status record (default: dropped).
         node_name: the run's node name.
         realtime: keep simulated time with wall time (False: as fast as possible).
@@ -93,7 +93,7 @@ def run_headless(
         hold the final state).
 
     Raises:
-        tutorial.core.app.ControllerError: a controller refused to configure.
+        tutorial.app.app.ControllerError: a controller refused to configure.
 
     Its node is never spun (no subscription callback runs), so the same
     arguments give the same numbers on every run.
@@ -156,7 +156,7 @@ class BackgroundApp:
         duration: stop after this many seconds (simulated, or wall time without a simulator).
         label: what the view's caption calls this run (default: the node name).
 
-    The owner thread creates, opens, runs and closes the :class:`tutorial.core.app.App`;
+    The owner thread creates, opens, runs and closes the :class:`tutorial.app.app.App`;
     it owns everything the app's main thread owns.  Every method may be called
     from any thread.  :meth:`close` (what ``reset()`` calls) stops the run and
     turns its view into a recording.
@@ -207,7 +207,7 @@ class BackgroundApp:
 
     # ---- the owner thread ---------------------------------------------------------------
     def _run(self) -> None:
-        from tutorial.core.app import App
+        from tutorial.app.app import App
 
         app = vis = None
         try:

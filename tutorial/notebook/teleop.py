@@ -35,7 +35,7 @@ class TeleopPanel(Panel):
         import rclpy
         from sensor_msgs.msg import Joy
 
-        from tutorial.ros.env import SpinThread
+        from tutorial.ros.spin import SpinThread
 
         super().__init__(
             f"Teleop panel /{node_name}",

@@ -2,7 +2,7 @@
 
 :func:`read_graph` asks the middleware what a node sees; :func:`draw_graph`
 draws it left to right, as rqt_graph does.  ``rtt-graph`` and the notebooks
-(:mod:`tutorial.notebook.graph`) use both.
+(:mod:`tutorial.notebook.graph_picture`) use both.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """A small launcher for the ``launch_py/`` files (``ros2 launch`` has no PyPI wheel).
 
 It keeps ROS 2 launch's vocabulary: a :class:`LaunchDescription` lists
-:class:`Node` actions, each started as its own process with its output
+:class:`NodeProcess` actions, each started as its own process with its output
 prefixed by the node name.  Stopping follows ``ros2 launch``'s escalation:
 on Ctrl-C or SIGTERM every node gets SIGINT, then SIGTERM, then SIGKILL,
 and the whole shutdown ends within :data:`SHUTDOWN_TIMEOUT` s.  A node marked
@@ -39,8 +39,8 @@ _SHM_SAMPLE_PERIOD = 1.0  # s between looks at every /dev/shm file the children 
 
 
 @dataclass
-class Node:
-    """One node to launch (``launch_ros.actions.Node``'s analog).
+class NodeProcess:
+    """One node to launch, as its own process (the role of ``launch_ros.actions.Node``, named apart from it).
 
     Attributes:
         name: the node name; passed as ``--ros-args -r __node:=name`` and used as the output prefix.
@@ -63,7 +63,7 @@ class Node:
 class LaunchDescription:
     """The nodes of one launch, started in order."""
 
-    nodes: list[Node]
+    nodes: list[NodeProcess]
 
 
 def _die_with_parent() -> None:  # runs in the child between fork and exec

@@ -8,7 +8,10 @@ module              program
 ``rtt_plot``        ``rtt-plot``: joint positions over time (rqt_plot's stand-in)
 ``rtt_graph``       ``rtt-graph``: nodes and topics (rqt_graph's stand-in)
 ``rtt_image``       ``rtt-image``: a camera topic's pictures (rqt_image_view's stand-in)
+``rtt_bag``         ``rtt-bag``: record, list, replay and recover MCAP bags (``ros2 bag``'s stand-in)
+``rtt_urdf``        ``rtt-urdf``: a MuJoCo model as a URDF
+``rtt_foxglove``    ``rtt-foxglove``: every topic, and TF, to Foxglove over its WebSocket
 ==================  ================================================================
 
-``rtt-bag`` is :mod:`tutorial.bag.cli`.  Nothing in the library imports these modules.
+Nothing in the library imports these modules (``make lint``'s import contracts).
 """

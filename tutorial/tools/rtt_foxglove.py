@@ -21,6 +21,7 @@ import sys
 import time
 
 from tutorial.ros import env as ros_env
+from tutorial.ros import program as ros_program
 
 PROG = "rtt-foxglove"
 _say = functools.partial(print, flush=True)
@@ -31,8 +32,8 @@ def main(argv: list[str] | None = None) -> int:
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
+    from tutorial.bag.tf import add_frame_prefix_argument
     from tutorial.foxglove.bridge import DEFAULT_HOST, DEFAULT_PORT, NODE_NAME, FoxgloveBridge
-    from tutorial.urdf.recording import add_frame_prefix_argument
 
     argv = list(sys.argv if argv is None else argv)
     p = argparse.ArgumentParser(prog=PROG, description="Serve the ROS 2 topics and the robot in 3D to Foxglove.")
@@ -41,10 +42,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--topics", nargs="+", metavar="TOPIC", help="serve only these topics (TF is served in any case)")
     p.add_argument("--duration", type=float, default=None, metavar="SECONDS", help="stop after this long")
     add_frame_prefix_argument(p)
-    args = ros_env.parse_command_line(p, argv)
+    args = ros_program.parse_command_line(p, argv)
     if not 0 <= args.port <= 65535:
         p.error("--port must be 0 to 65535")
-    stop = ros_env.StopRequest().install()
+    stop = ros_program.StopRequest().install()
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     bridge = FoxgloveBridge(
@@ -65,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
                 break
             time.sleep(0.05)  # the stop flag and the deadline are seen within 50 ms
     finally:
-        ros_env.ignore_stop_signals()
+        ros_program.ignore_stop_signals()
         try:
             served = ", ".join(f"{t} {n}" for t, n in sorted(bridge.forwarded.items())) or "nothing"
             bridge.close()

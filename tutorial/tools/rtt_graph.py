@@ -16,6 +16,7 @@ import sys
 import time
 
 from tutorial.ros import env as ros_env
+from tutorial.ros import program as ros_program
 from tutorial.ros.graph import draw_graph, read_graph
 
 NODE_NAME = "rtt_graph"
@@ -39,7 +40,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--output", default=None, help="also draw the graph into this PNG")
     p.add_argument("--all", action="store_true", help="show /rosout and /parameter_events too")
     p.add_argument("--json", action="store_true", help="print the graph as one JSON object")
-    args = ros_env.parse_command_line(p, argv)
+    args = ros_program.parse_command_line(p, argv)
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv)
     node = rclpy.create_node(NODE_NAME)

@@ -43,6 +43,8 @@ import sys
 import time
 
 from tutorial.ros import env as ros_env
+from tutorial.ros import program as ros_program
+from tutorial.ros import spin as ros_spin
 from tutorial.view.images import DEFAULT_TOPIC, TRANSPORTS, ImageReceiver, PngWriter, format_image_status
 
 NODE_NAME = "rtt_image"
@@ -168,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
 
     argv = list(sys.argv if argv is None else argv)
     parser = build_parser()
-    args = ros_env.parse_command_line(parser, argv)
+    args = ros_program.parse_command_line(parser, argv)
     if args.every <= 0 or args.max_files < 1 or (args.duration is not None and args.duration <= 0):
         parser.error("--every and --duration must be > 0, --max-files >= 1")
     live = has_display() and not args.no_window
@@ -192,7 +194,7 @@ def main(argv: list[str] | None = None) -> int:
 
     signal.signal(signal.SIGINT, request_stop)
     signal.signal(signal.SIGTERM, request_stop)
-    spin = ros_env.SpinThread(node).start()
+    spin = ros_spin.SpinThread(node).start()
     viewer.prefix = f"[{node.get_fully_qualified_name()}]"
     viewer.say(
         f"subscribed to {receiver.topic} (best effort, keep last 1); "
@@ -208,7 +210,7 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
+        ros_program.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
         spin.stop()
         if writer is not None:
             viewer.write_newest(force=True)  # the last picture received

@@ -21,6 +21,7 @@ import sys
 from tutorial.interfaces import joy
 from tutorial.joystick.publisher import JoyPublisher
 from tutorial.ros import env as ros_env
+from tutorial.ros import program as ros_program
 
 NODE_NAME = "rtt_joy"
 
@@ -75,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
         default=joy.AUTOREPEAT,
         help="republish an unchanged state at this rate, Hz (default 20, 0: only on change)",
     )
-    args = ros_env.parse_command_line(parser, argv)
+    args = ros_program.parse_command_line(parser, argv)
     if args.rate <= 0 or args.autorepeat < 0:
         parser.error("--rate must be > 0 and --autorepeat >= 0")
     ros_env.use_localhost_by_default()
@@ -83,7 +84,7 @@ def main(argv: list[str] | None = None) -> int:
         source, what = choose_source(args, stack)
         # Ctrl-C and SIGTERM end the loop below: raised as KeyboardInterrupt inside spin_once, they
         # could leave one of rclpy's tasks half made, whose clean-up then printed a traceback.
-        stop = ros_env.StopRequest().install()
+        stop = ros_program.StopRequest().install()
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         node = rclpy.create_node(NODE_NAME)
         pub = JoyPublisher(node, source, rate=args.rate, autorepeat=args.autorepeat, duration=args.duration)
@@ -94,7 +95,7 @@ def main(argv: list[str] | None = None) -> int:
         except ExternalShutdownException:
             pass
         finally:
-            ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
+            ros_program.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
             node.destroy_node()
             rclpy.try_shutdown()
         print(f"[{NODE_NAME}] published {pub.published} messages", flush=True)

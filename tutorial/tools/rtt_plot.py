@@ -16,7 +16,9 @@ import time
 
 from tutorial.interfaces.joint_state import joint_state_topic
 from tutorial.ros import env as ros_env
-from tutorial.view.plots import JointStateHistory, draw
+from tutorial.ros import program as ros_program
+from tutorial.ros import spin as ros_spin
+from tutorial.view.joint_plot import JointStateHistory, draw
 
 NODE_NAME = "rtt_plot"
 
@@ -37,7 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--duration", type=float, default=10.0, help="seconds to record without a display (default 10)")
     p.add_argument("--output", default="joint_state_plot.png", help="PNG written without a display")
     p.add_argument("--no-window", action="store_true", help="write the PNG even when a display exists")
-    args = ros_env.parse_command_line(p, argv)
+    args = ros_program.parse_command_line(p, argv)
     topic = joint_state_topic(args.body)
     live = has_display() and not args.no_window
     import matplotlib
@@ -50,7 +52,7 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv)
     node = rclpy.create_node(NODE_NAME)
     history = JointStateHistory(node, topic)
-    spin = ros_env.SpinThread(node).start()
+    spin = ros_spin.SpinThread(node).start()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     try:
         if live:
@@ -65,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
+        ros_program.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
         spin.stop()
         series = history.series()
         if not live:

@@ -23,10 +23,11 @@ import json
 import signal
 import sys
 
-from tutorial.core.app import DEFAULT_NODE_NAME, App, ControllerError
+from tutorial.app.app import DEFAULT_NODE_NAME, App, ControllerError
 from tutorial.core.project import ProjectError, load_project
 from tutorial.core.world import ModelError
 from tutorial.ros import env as ros_env
+from tutorial.ros import program as ros_program
 from tutorial.view.status import format_status
 
 
@@ -158,7 +159,7 @@ def _model_key(project, exc: ModelError) -> str:
 def main(argv: list[str] | None = None) -> int:
     """``rtt-run``: parse the command line, run the project, print the summary; the exit status (main thread)."""
     argv = list(sys.argv if argv is None else argv)
-    args = ros_env.parse_command_line(build_parser(), argv)
+    args = ros_program.parse_command_line(build_parser(), argv)
     if args.duration is not None and not args.duration > 0:
         build_parser().error("--duration must be > 0")
     output = make_output(args.json)
@@ -192,7 +193,7 @@ def main(argv: list[str] | None = None) -> int:
     except (ControllerError, ValueError, RuntimeError) as exc:
         status = _fail(str(exc), 1)
     finally:
-        ros_env.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
+        ros_program.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
         try:
             app.close()
             if hasattr(app, "bodies"):

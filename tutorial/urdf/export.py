@@ -76,314 +76,41 @@ actuators (transmissions) and equality constraints (the tank's wheels turning
 together); armature; contact parameters; velocity limits (URDF's ``velocity`` is
 written 0: MuJoCo has none) and an effort limit the model does not give
 (``effort`` 0).  A floating joint's motion.  (Joint damping and friction
-loss are written, as ``<dynamics>``.)
-
-Any thread may call these functions: they only read the model.
+loss are written, as ``<dynamics>``.)  Any thread may call these functions:
+they only read the model.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from tutorial.core.body import Body
+from tutorial.urdf.frames import is_identity, pose_matrix, rotation, translation
+from tutorial.urdf.meshes import compiled_mesh, unit_sphere
+from tutorial.urdf.records import (
+    ELLIPSOID_MESH,
+    MOVING,
+    ROOT_FIXED,
+    ROOT_FREE,
+    ROOT_WORLD,
+    Geometry,
+    Inertial,
+    Joint,
+    Link,
+    Shape,
+    UrdfExport,
+)
 
-ROOT_FREE, ROOT_FIXED, ROOT_WORLD = "free", "fixed", "world"
 HIDDEN_GEOM_GROUP = 3  # as tutorial.view.scene: groups 3 and up are not drawn
 PLANE_THICKNESS = 0.002  # m
 INFINITE_PLANE = 10.0  # m, the half size given to a plane MuJoCo makes infinite
 UNLIMITED_SLIDE = 1e6  # m
-ELLIPSOID_MESH = "ellipsoid.stl"
-MOVING = ("revolute", "continuous", "prismatic")
-_IDENTITY_TOL = 1e-12
 
 _T = mujoco.mjtGeom
 _JNT = mujoco.mjtJoint
-
-
-# ---- the URDF, as records -----------------------------------------------------------
-
-
-@dataclass
-class Geometry:
-    """One URDF ``<geometry>``: ``kind`` is ``box`` (``size``: full x, y, z, m), ``cylinder``
-    (``size``: radius, length), ``sphere`` (``size``: radius) or ``mesh`` (``filename``, ``scale``)."""
-
-    kind: str
-    size: tuple[float, ...] = ()
-    filename: str = ""
-    scale: tuple[float, float, float] | None = None
-
-
-@dataclass
-class Shape:
-    """A ``<visual>`` or ``<collision>``: its name, pose in the link (4x4, m), geometry, and
-    colour (rgba, visuals only)."""
-
-    name: str
-    origin: np.ndarray
-    geometry: Geometry
-    rgba: tuple[float, float, float, float] | None = None
-
-
-@dataclass
-class Inertial:
-    """``<inertial>``: the centre of mass and principal axes (4x4), mass (kg), principal inertia (3,) kg m^2."""
-
-    origin: np.ndarray
-    mass: float
-    inertia: tuple[float, float, float]
-
-
-@dataclass
-class Link:
-    """A URDF link: a MuJoCo body (or a joint frame between two joints of one body)."""
-
-    name: str
-    inertial: Inertial | None = None
-    visuals: list[Shape] = field(default_factory=list)
-    collisions: list[Shape] = field(default_factory=list)
-
-
-@dataclass
-class Joint:
-    """A URDF joint: ``type`` fixed, revolute, continuous, prismatic or floating; ``origin``
-    (4x4) places the child in the parent at 0; limits in rad or m, ``effort`` N*m or N,
-    ``damping`` and ``friction`` from MuJoCo's ``damping`` and ``frictionloss``."""
-
-    name: str
-    type: str
-    parent: str
-    child: str
-    origin: np.ndarray
-    axis: tuple[float, float, float] | None = None
-    lower: float | None = None
-    upper: float | None = None
-    effort: float = 0.0
-    velocity: float = 0.0
-    damping: float = 0.0
-    friction: float = 0.0
-
-
-@dataclass
-class UrdfExport:
-    """A body as a URDF, before it is written.
-
-    Attributes:
-        name: the robot's name.
-        links: every link, the root first.
-        joints: every joint, in model order.
-        root_link: the name of the URDF's root link.
-        root_kind: ``free`` (the root body's free joint: its pose is the odometry),
-            ``fixed`` (the root body is welded to the world) or ``world`` (a link
-            for the world frame, see the module text).
-        body_links: MuJoCo body id (in the world model) -> its link's name.
-        moving_joints: the URDF's revolute, continuous and prismatic joints, in
-            model order: the body's numbered joints (``Body.joint_names``).
-        root_body: the MuJoCo id of the root link's body; None when the root
-            link stands for the world frame (``root_kind`` ``world``).
-        meshes: STL file name -> ``(vertices (n, 3) m, faces (k, 3))`` to write beside the URDF.
-        notes: what was approximated or left out, one line each.
-    """
-
-    name: str
-    links: list[Link]
-    joints: list[Joint]
-    root_link: str
-    root_kind: str
-    body_links: dict[int, str]
-    moving_joints: list[str]
-    root_body: int | None = None
-    meshes: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-
-    def xml(self, mesh_prefix: str = "", source: str = "") -> str:
-        """The URDF as text, mesh files named ``mesh_prefix + name`` (e.g. ``tank_meshes/``).
-
-        ``source`` is named in the opening comment (e.g. the model file).
-        Numbers are written as Python's shortest exact text (``repr``), so
-        reading the file back gives the same floats.
-        """
-        from lxml import etree
-
-        robot = etree.Element("robot", name=self.name)
-        robot.append(etree.Comment(self.comment(source)))
-        for link in self.links:
-            element = etree.SubElement(robot, "link", name=link.name)
-            if link.inertial is not None:
-                inertial = etree.SubElement(element, "inertial")
-                _origin(inertial, link.inertial.origin)
-                etree.SubElement(inertial, "mass", value=_num(link.inertial.mass))
-                ixx, iyy, izz = link.inertial.inertia
-                attrib = {"ixx": ixx, "ixy": 0.0, "ixz": 0.0, "iyy": iyy, "iyz": 0.0, "izz": izz}
-                etree.SubElement(inertial, "inertia", {k: _num(v) for k, v in attrib.items()})
-            for tag, shapes in (("visual", link.visuals), ("collision", link.collisions)):
-                for shape in shapes:
-                    child = etree.SubElement(element, tag, name=shape.name)
-                    _origin(child, shape.origin)
-                    _geometry(etree.SubElement(child, "geometry"), shape.geometry, mesh_prefix)
-                    if shape.rgba is not None:
-                        material = etree.SubElement(child, "material", name=shape.name)
-                        etree.SubElement(material, "color", rgba=" ".join(_num(c) for c in shape.rgba))
-        for joint in self.joints:
-            element = etree.SubElement(robot, "joint", name=joint.name, type=joint.type)
-            etree.SubElement(element, "parent", link=joint.parent)
-            etree.SubElement(element, "child", link=joint.child)
-            _origin(element, joint.origin)
-            if joint.type in MOVING:
-                etree.SubElement(element, "axis", xyz=" ".join(_num(a) for a in joint.axis))
-                limit = {"effort": _num(joint.effort), "velocity": _num(joint.velocity)}
-                if joint.lower is not None:
-                    limit.update(lower=_num(joint.lower), upper=_num(joint.upper))
-                etree.SubElement(element, "limit", limit)
-                if joint.damping or joint.friction:
-                    etree.SubElement(element, "dynamics", damping=_num(joint.damping), friction=_num(joint.friction))
-        text = etree.tostring(robot, xml_declaration=True, pretty_print=True, encoding="utf-8")
-        return text.decode("utf-8")
-
-    def comment(self, source: str = "") -> str:
-        """The file's opening comment: where it came from, its root, what was left out."""
-        lines = [
-            f" Written by rtt-urdf (ros-tank-tutorial) from {source or 'a MuJoCo model'}: robot {self.name}. ",
-            f" Root link {self.root_link} ({_ROOT_TEXT[self.root_kind]}). ",
-            f" Joints moved by /{self.name}/joint_state: {', '.join(self.moving_joints) or 'none'}. ",
-        ]
-        if self.notes:
-            lines.append(" Approximated or left out: ")
-            lines += [f"   {n} " for n in self.notes]
-        return "\n" + "\n".join(lines).replace("--", "- -") + "\n"
-
-    def description(self, mesh_folder=None, source: str = "") -> str:
-        """The URDF as a robot description to publish: mesh files named by ``file://`` URIs.
-
-        A description travels as text, without its files: a reader on this
-        machine finds the meshes by absolute URI (RViz2 and Foxglove read
-        ``file://``).  The meshes are written into ``mesh_folder`` (a new
-        temporary folder when None and the body has meshes).
-        """
-        if not self.meshes:
-            return self.xml(source=source)
-        import tempfile
-
-        folder = Path(mesh_folder) if mesh_folder is not None else Path(tempfile.mkdtemp(prefix="rtt-urdf-meshes-"))
-        folder.mkdir(parents=True, exist_ok=True)
-        for name, (vertices, faces) in self.meshes.items():
-            write_stl(folder / name, vertices, faces)
-        return self.xml(folder.resolve().as_uri() + "/", source)
-
-    def write(self, path, mesh_uri: str = "relative", source: str = "") -> list[Path]:
-        """Write the URDF to ``path`` and its meshes to ``<stem>_meshes/`` beside it; the files written.
-
-        Args:
-            path: the ``.urdf`` file.
-            mesh_uri: how the URDF names the mesh files: ``relative`` (to the
-                URDF's folder, which ``yourdfpy`` and MuJoCo read) or ``file``
-                (``file:///absolute/path``, which RViz2 and Foxglove read).
-            source: named in the file's opening comment.
-
-        Raises:
-            ValueError: an unknown ``mesh_uri``.
-            OSError: a file cannot be written.
-        """
-        if mesh_uri not in ("relative", "file"):
-            raise ValueError(f"mesh_uri {mesh_uri!r}: use 'relative' or 'file'")
-        path = Path(path)
-        folder = path.with_name(path.stem + "_meshes")
-        written = []
-        if self.meshes:
-            folder.mkdir(parents=True, exist_ok=True)
-            for name, (vertices, faces) in self.meshes.items():
-                written.append(write_stl(folder / name, vertices, faces))
-        prefix = f"{folder.name}/" if mesh_uri == "relative" else folder.resolve().as_uri() + "/"
-        path.write_text(self.xml(prefix, source), encoding="utf-8")
-        return [path, *written]
-
-
-_ROOT_TEXT = {
-    ROOT_FREE: "the body's free joint: its pose in the world is the odometry",
-    ROOT_FIXED: "welded to the world",
-    ROOT_WORLD: "the world frame the model is placed in",
-}
-
-
-def _num(value: float) -> str:
-    """A number as its shortest exact text (``0.1``, ``-6.283185307179586``); -0.0 as 0.0."""
-    value = float(value)
-    return repr(value + 0.0)
-
-
-def rpy_from_matrix(matrix: np.ndarray) -> tuple[float, float, float]:
-    """URDF's roll, pitch, yaw (rad) of a rotation: ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
-
-    At pitch +-90 degrees (gimbal lock) roll and yaw turn about one axis: yaw is 0 there.
-    """
-    r = matrix[:3, :3]
-    cy = math.hypot(r[0, 0], r[1, 0])
-    if cy > 4 * np.finfo(float).eps:
-        return math.atan2(r[2, 1], r[2, 2]), math.atan2(-r[2, 0], cy), math.atan2(r[1, 0], r[0, 0])
-    return math.atan2(-r[1, 2], r[1, 1]), math.atan2(-r[2, 0], cy), 0.0
-
-
-def _origin(parent, matrix: np.ndarray) -> None:
-    from lxml import etree
-
-    xyz = " ".join(_num(v) for v in matrix[:3, 3])
-    rpy = " ".join(_num(v) for v in rpy_from_matrix(matrix))
-    etree.SubElement(parent, "origin", xyz=xyz, rpy=rpy)
-
-
-def _geometry(parent, geometry: Geometry, mesh_prefix: str) -> None:
-    from lxml import etree
-
-    if geometry.kind == "box":
-        etree.SubElement(parent, "box", size=" ".join(_num(v) for v in geometry.size))
-    elif geometry.kind == "cylinder":
-        etree.SubElement(parent, "cylinder", radius=_num(geometry.size[0]), length=_num(geometry.size[1]))
-    elif geometry.kind == "sphere":
-        etree.SubElement(parent, "sphere", radius=_num(geometry.size[0]))
-    else:
-        attrib = {"filename": mesh_prefix + geometry.filename}
-        if geometry.scale is not None:
-            attrib["scale"] = " ".join(_num(v) for v in geometry.scale)
-        etree.SubElement(parent, "mesh", attrib)
-
-
-# ---- transforms (4x4, m) -------------------------------------------------------------
-
-
-def pose_matrix(pos, quat) -> np.ndarray:
-    """A 4x4 transform from a position (3,) m and a quaternion (4,) w, x, y, z (normalised here)."""
-    q = np.asarray(quat, dtype=float)
-    q = q / np.linalg.norm(q)
-    mat = np.zeros(9)
-    mujoco.mju_quat2Mat(mat, q)
-    out = np.eye(4)
-    out[:3, :3] = mat.reshape(3, 3)
-    out[:3, 3] = pos
-    return out
-
-
-def _translation(v) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, 3] = v
-    return out
-
-
-def _rotation(axis, angle: float) -> np.ndarray:
-    q = np.zeros(4)
-    mujoco.mju_axisAngle2Quat(q, np.asarray(axis, dtype=float), float(angle))
-    return pose_matrix((0.0, 0.0, 0.0), q)
-
-
-def _is_identity(t: np.ndarray) -> bool:
-    return bool(np.abs(t - np.eye(4)).max() <= _IDENTITY_TOL)
-
-
-# ---- the export ----------------------------------------------------------------------
 
 
 def export_body(body: Body, robot_name: str | None = None) -> UrdfExport:
@@ -496,11 +223,11 @@ class _Builder:
             ref = float(m.qpos0[m.jnt_qposadr[j]])
             info = self.numbered.get(j)
             if info is not None and jtype == _JNT.mjJNT_HINGE:
-                origin = offset @ _translation(anchor) @ _rotation(axis, -ref)
+                origin = offset @ translation(anchor) @ rotation(axis, -ref)
                 steps.append(self.moving(j, info, "revolute" if info.limited else "continuous", origin))
-                offset = _translation(-anchor)
+                offset = translation(-anchor)
             elif info is not None:  # a numbered slide
-                origin = offset @ _translation(-axis * ref)
+                origin = offset @ translation(-axis * ref)
                 steps.append(self.moving(j, info, "prismatic", origin))
                 offset = np.eye(4)
             elif jtype == _JNT.mjJNT_FREE:
@@ -511,7 +238,7 @@ class _Builder:
                 if jtype == _JNT.mjJNT_BALL:
                     adr = int(m.jnt_qposadr[j])
                     turn = pose_matrix((0.0, 0.0, 0.0), m.qpos0[adr : adr + 4])
-                    offset = offset @ _translation(anchor) @ turn @ _translation(-anchor)
+                    offset = offset @ translation(anchor) @ turn @ translation(-anchor)
                 # a hinge or slide at its reference position does not move the body
                 folded.append(jname)
                 why = self.body.skipped_joints.get(jname, "not numbered")
@@ -524,7 +251,7 @@ class _Builder:
             current = parent_link
             for i, joint in enumerate(steps):
                 last = i == len(steps) - 1
-                child = link if last and _is_identity(offset) else self.unique_link(f"{joint.name}_frame")
+                child = link if last and is_identity(offset) else self.unique_link(f"{joint.name}_frame")
                 self.add_link(child)
                 joint.name = self.unique_joint(joint.name, own=True)
                 joint.parent, joint.child = current, child
@@ -609,7 +336,7 @@ class _Builder:
         elif kind == _T.mjGEOM_CAPSULE:
             shapes.append((name, Geometry("cylinder", (size[0], 2 * size[1])), pose))
             for i, sign in enumerate((-1.0, 1.0)):
-                cap = pose @ _translation((0.0, 0.0, sign * size[1]))
+                cap = pose @ translation((0.0, 0.0, sign * size[1]))
                 shapes.append((f"{name}_cap{i}", Geometry("sphere", (size[0],)), cap))
         elif kind == _T.mjGEOM_ELLIPSOID:
             if ELLIPSOID_MESH not in self.meshes:
@@ -619,13 +346,13 @@ class _Builder:
         elif kind == _T.mjGEOM_PLANE:
             half = [v if v > 0 else INFINITE_PLANE for v in size[:2]]
             box = Geometry("box", (2 * half[0], 2 * half[1], PLANE_THICKNESS))
-            shapes.append((name, box, pose @ _translation((0.0, 0.0, -PLANE_THICKNESS / 2))))
+            shapes.append((name, box, pose @ translation((0.0, 0.0, -PLANE_THICKNESS / 2))))
             self.notes.append(f"geom {name}: a plane, as a box {PLANE_THICKNESS * 1000:g} mm thick")
         elif kind == _T.mjGEOM_MESH:
             mesh_id = int(m.geom_dataid[g])
             file_name = f"{self.local(mujoco.mjtObj.mjOBJ_MESH, mesh_id) or f'mesh{mesh_id}'}.stl"
             if file_name not in self.meshes:
-                self.meshes[file_name] = _compiled_mesh(m, mesh_id)
+                self.meshes[file_name] = compiled_mesh(m, mesh_id)
             shapes.append((name, Geometry("mesh", filename=file_name), pose))
         else:
             what = {int(_T.mjGEOM_HFIELD): "a height field", int(_T.mjGEOM_SDF): "an SDF"}.get(kind, f"type {kind}")
@@ -641,57 +368,6 @@ class _Builder:
                 link.visuals.append(Shape(shape_name, origin, geometry, color))
             if collides:
                 link.collisions.append(Shape(shape_name, origin, geometry))
-
-
-def _compiled_mesh(m: mujoco.MjModel, mesh_id: int) -> tuple[np.ndarray, np.ndarray]:
-    v0, nv = int(m.mesh_vertadr[mesh_id]), int(m.mesh_vertnum[mesh_id])
-    f0, nf = int(m.mesh_faceadr[mesh_id]), int(m.mesh_facenum[mesh_id])
-    return np.array(m.mesh_vert[v0 : v0 + nv], dtype=float), np.array(m.mesh_face[f0 : f0 + nf], dtype=np.int64)
-
-
-def unit_sphere(rings: int = 16, segments: int = 32) -> tuple[np.ndarray, np.ndarray]:
-    """A sphere of radius 1 as ``(vertices (n, 3), faces (k, 3))``: ``rings`` bands of ``segments`` quads,
-    outward-facing triangles (counter-clockwise seen from outside)."""
-    vertices = [(0.0, 0.0, 1.0)]
-    for i in range(1, rings):
-        theta = math.pi * i / rings
-        for k in range(segments):
-            phi = 2 * math.pi * k / segments
-            vertices.append((math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)))
-    vertices.append((0.0, 0.0, -1.0))
-    south = len(vertices) - 1
-
-    def at(ring: int, k: int) -> int:  # ring 1 .. rings-1
-        return 1 + (ring - 1) * segments + k % segments
-
-    faces = [(0, at(1, k), at(1, k + 1)) for k in range(segments)]
-    for ring in range(1, rings - 1):
-        for k in range(segments):
-            a, b, c, d = at(ring, k), at(ring + 1, k), at(ring + 1, k + 1), at(ring, k + 1)
-            faces += [(a, b, c), (a, c, d)]
-    faces += [(at(rings - 1, k), south, at(rings - 1, k + 1)) for k in range(segments)]
-    return np.array(vertices), np.array(faces, dtype=np.int64)
-
-
-def write_stl(path, vertices: np.ndarray, faces: np.ndarray) -> Path:
-    """Write a triangle mesh (m) as a binary STL file; the path.  Any thread.
-
-    Binary STL: an 80-byte header, the triangle count (uint32), then per
-    triangle its unit normal and three vertices (12 float32) and 2 bytes.
-    """
-    path = Path(path)
-    triangles = np.asarray(vertices, dtype=float)[np.asarray(faces, dtype=np.int64)]  # (k, 3, 3)
-    normals = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    lengths = np.linalg.norm(normals, axis=1, keepdims=True)
-    normals = np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
-    record = np.dtype([("normal", "<f4", 3), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
-    data = np.zeros(len(triangles), dtype=record)
-    data["normal"], data["vertices"] = normals, triangles
-    with open(path, "wb") as f:
-        f.write(b"rtt-urdf: a MuJoCo mesh".ljust(80, b" "))
-        f.write(np.uint32(len(triangles)).tobytes())
-        f.write(data.tobytes())
-    return path
 
 
 def export_model_file(path, body_name: str | None = None) -> tuple[Body, UrdfExport]:

@@ -6,7 +6,7 @@ This is what Choreonoid does when it opens a ``.cnoid`` project, and what
 * **main thread** (the one that creates the :class:`App`): owns the project's
   bodies (over ``App.data``), the meshcat scene and the :class:`MainLoop`;
   runs ``configure``/``unconfigure`` and every ``call_later`` call.
-* **spin thread** (:class:`tutorial.ros.env.SpinThread`): runs the node's
+* **spin thread** (:class:`tutorial.ros.spin.SpinThread`): runs the node's
   subscription callbacks.
 * **simulation thread** (:class:`tutorial.core.simulator.Simulator`, only when the
   project has a simulator): owns the simulation's ``MjData``; the main thread
@@ -16,27 +16,25 @@ This is what Choreonoid does when it opens a ``.cnoid`` project, and what
 from __future__ import annotations
 
 import logging
-import math
 import time
-from collections import Counter
 from collections.abc import Callable
 
 import mujoco
 
+from tutorial.app.descriptions import DESCRIPTION_TIMEOUT, receive_descriptions
+from tutorial.app.frames import FRAME_RATE, FramePacer
+from tutorial.app.summary import app_summary
 from tutorial.core.body import Body
 from tutorial.core.call_later import MainLoop
 from tutorial.core.controller import ControllerConfig
+from tutorial.core.overlays import Overlays
 from tutorial.core.project import Project, check_parameter
 from tutorial.core.simulator import Attachment, Simulator
 from tutorial.core.world import build_world
-from tutorial.view.overlays import MeshcatOverlays, Overlays
+from tutorial.view.overlays import MeshcatOverlays
 
 DEFAULT_NODE_NAME = "rtt"
-FRAME_RATE = 60.0  # Hz, the most often the scene is redrawn
-SETTLE = 0.004  # s: a frame waits this long after a change for more of the same burst (see App.next_frame_due)
-SETTLE_MAX = 0.008  # s: ... and at most this long after the first change it shows
 GRAPH_CHECK_PERIOD = 2.0  # s, how often the node graph is checked for a twin name
-DESCRIPTION_TIMEOUT = 10.0  # s a viewer waits for a robot description it takes its model from
 
 
 class ControllerError(RuntimeError):
@@ -107,12 +105,8 @@ class App:
         self.controllers: list[tuple[str, object, str]] = []  # (name, controller, body name), configured
         self._unconfigured = False
         self.warned_duplicate = False
-        self._started = None
-        self._last_frame = 0.0  # time.monotonic() of the last frame, on the frame clock
-        self._changes_seen = 0  # self.changes() when step() last looked
-        self._first_change = None  # time.monotonic() of the first change not yet drawn, or None
-        self._last_change = None  # ... and of the newest
-        self._drawn_changes: dict[tuple[str, str], int] = {}  # each burst member's count at the last frame
+        self.started_at = None
+        self.frames = FramePacer()  # when the view draws (owner thread)
         self._drawn_step = -1
         self.stop_requested = False
 
@@ -131,13 +125,13 @@ class App:
             from rclpy.node import Node
 
             self.node = Node(self.node_name)
-        self._receive_descriptions()
+        self.project = receive_descriptions(self.project, self.node, self.description_timeout, self.output)
         self.model = build_world(self.project.models, **kwargs)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
         self.bodies = {m.name: Body(self.model, self.data, m.name) for m in self.project.models}
         if self._own_node:
-            from tutorial.ros.env import SpinThread
+            from tutorial.ros.spin import SpinThread
 
             self.spin = SpinThread(self.node, hand_over_to=self.loop)
         for body_name, name, controller in self.attach:
@@ -165,48 +159,8 @@ class App:
                 duration=self.duration,
                 record_timing=self.record_timing,
             ).start()
-        self._started = time.monotonic()
+        self.started_at = time.monotonic()
         return self
-
-    def _receive_descriptions(self) -> None:
-        """Take each model that names a description topic from the URDF published there (owner thread).
-
-        Waits up to ``description_timeout`` s for each (the publisher keeps
-        it, transient local: a simulation already running answers at once),
-        and says where the model came from.  Before the spin thread starts.
-
-        Raises:
-            tutorial.interfaces.robot_description.DescriptionError: none came, or not a URDF.
-        """
-        import dataclasses
-
-        waiting = [m for m in self.project.models if m.description is not None and m.text is None]
-        if not waiting:
-            return
-        from tutorial.interfaces.robot_description import receive_robot_description
-        from tutorial.urdf.mujoco_load import load_description
-
-        models = list(self.project.models)
-        fqn = self.node.get_fully_qualified_name()
-        for entry in waiting:
-            urdf = receive_robot_description(self.node, entry.description, self.description_timeout)
-            text, dropped, tree = load_description(urdf, entry.description)
-            models[models.index(entry)] = dataclasses.replace(entry, text=text)
-            note = f"; {dropped} mesh visuals left out (package:// names need ROS)" if dropped else ""
-            self.output(
-                {
-                    "event": "description",
-                    "node": fqn,
-                    "body": entry.name,
-                    "topic": entry.description,
-                    "links": len(tree.links),
-                    "moving_joints": [j.name for j in tree.moving],
-                    "line": f"[{fqn}] {entry.name}: no model file of its own: drawing the robot description "
-                    f"on {entry.description} (robot {tree.name}, {len(tree.links)} links, "
-                    f"{len(tree.moving)} moving joints{note})",
-                }
-            )
-        self.project = dataclasses.replace(self.project, models=models)
 
     def controller(self, name: str):
         """A configured controller by name (any thread, after :meth:`open` has configured it).
@@ -291,77 +245,27 @@ class App:
         """Run posted calls, and draw a frame when there is something new to show (owner thread).
 
         Waits for posted calls at most ``timeout`` s, and never past the time
-        the next frame is due (:meth:`next_frame_due`): a frame is drawn once a
-        burst of changes is complete or has settled, at most ``FRAME_RATE``
-        times a second.
+        the next frame is due (:meth:`next_frame_due`, :mod:`tutorial.app.frames`).
 
         Returns:
             False when the app is done (duration reached, simulation ended or stop requested).
         """
         self.loop.run_once(max(0.0, min(timeout, self.next_frame_due() - time.monotonic())))
         now = time.monotonic()
-        changes = self.changes()
-        if changes != self._changes_seen:
-            self._changes_seen = changes
-            if self._first_change is None:
-                self._first_change = now
-            self._last_change = now
-        due = self.next_frame_due()
-        if now >= due:
-            cap = self._last_frame + 1.0 / FRAME_RATE
-            # The frame clock advances one period per frame while a frame comes less than
-            # a period after it was allowed (a frame a little late does not push the next
-            # one back: 60 frames/s, not 59), else it restarts from now.  So frames come
-            # at most FRAME_RATE a second on average, and one may follow a late one sooner.
-            self._last_frame = cap if cap <= now < cap + 1.0 / FRAME_RATE else now
-            self._first_change = self._last_change = None
-            self._drawn_changes = dict(self._burst_members())
+        self.frames.note(now, self.changes())
+        if now >= self.next_frame_due():
+            self.frames.drawn(now, self._burst_members())
             self._draw()
         return not self.done()
 
     def next_frame_due(self) -> float:
-        """The ``time.monotonic()`` at which the next frame is due (owner thread); ``inf``: nothing new to show.
-
-        While the project simulates, every frame has something new: frames
-        come ``1/FRAME_RATE`` s apart.  Otherwise a frame is due when the view
-        has changed (:meth:`changes`).  The states of one simulation step
-        arrive as a burst of messages, one per robot, and are drawn together:
-        at once when every body (and arrow) that has ever changed has changed
-        again since the last frame (the burst is complete, :meth:`burst_complete`,
-        which says what it cannot know); else
-        ``SETTLE`` s after the newest change, for the rest of the burst, and at
-        most ``SETTLE_MAX`` s after the first change, so a steady stream of
-        changes is still drawn.  Never before the frame clock allows
-        (``1/FRAME_RATE`` s per frame on average, see :meth:`step`).  A frame
-        drawn at a fixed 60 Hz, whatever came, showed a state that arrived
-        just after a frame 16.7 ms late (``book/benchmarks.md``).
-        """
-        cap = self._last_frame + 1.0 / FRAME_RATE
-        if self.sim is not None and not self.sim.finished.is_set():
-            return cap
-        if self._first_change is None:
-            return math.inf
-        if self.burst_complete():
-            return cap
-        return max(cap, min(self._last_change + SETTLE, self._first_change + SETTLE_MAX))
+        """The ``time.monotonic()`` at which the next frame is due, ``inf`` if none (owner thread)."""
+        simulating = self.sim is not None and not self.sim.finished.is_set()
+        return self.frames.next_frame_due(simulating, self._burst_members())
 
     def burst_complete(self) -> bool:
-        """True when everything that has ever changed the view has changed since the last frame (owner thread).
-
-        The members of a burst are the bodies (their kinematic-state
-        changes) and the overlay arrows (their versions) that have changed at
-        least once.  What it cannot know:
-
-        - a member whose updates stopped (its publisher ended) keeps it False:
-          frames then wait ``SETTLE`` s after the newest change;
-        - members updated at different rates (a 20 Hz IMU's arrows beside
-          50 Hz joint states) complete it only when their updates coincide;
-        - states faster than ``FRAME_RATE``: a burst completed early waits for
-          the frame clock, and the frame may show part of the next burst too;
-        - the first state of a new robot alone completes it, once.
-        """
-        moved_since = [count > self._drawn_changes.get(key, 0) for key, count in self._burst_members() if count]
-        return bool(moved_since) and all(moved_since)
+        """Whether every body and arrow that ever changed has changed since the last frame (owner thread)."""
+        return self.frames.burst_complete(self._burst_members())
 
     def _burst_members(self):
         """((kind, name), change count) of every body and overlay arrow (owner thread)."""
@@ -406,7 +310,7 @@ class App:
             return True  # a subscription callback raised and spinning ended: summary() reports it
         if self.sim is not None:
             return self.sim.finished.is_set()
-        return self.duration is not None and time.monotonic() - self._started >= self.duration
+        return self.duration is not None and time.monotonic() - self.started_at >= self.duration
 
     def run(self) -> None:
         """Step until done (owner thread); Ctrl-C propagates as KeyboardInterrupt."""
@@ -464,48 +368,6 @@ class App:
     def summary(self) -> dict:
         """Exit summary: times, root poses and joint positions (owner thread, after run).
 
-        ``controllers`` holds each controller's own summary under its name, or
-        under ``<body>/<name>`` when bodies share a controller's name (two
-        tanks: ``Tank/RttJointStatePublisher``, ``Tank2/RttJointStatePublisher``).
+        See :func:`tutorial.app.summary.app_summary`.
         """
-        record: dict = {"event": "summary", "project": self.project.name, "node": getattr(self, "node_fqn", None)}
-        if self.sim is not None:
-            record.update(
-                simulated_time=round(self.sim.steps * self.sim.time_step, 6),
-                wall_time=round(self.sim.wall_time, 3),
-                real_time_factor=round(self.sim.real_time_factor, 3),
-                steps=self.sim.steps,
-            )
-            if self.sim.error:
-                record["error"] = self.sim.error
-        else:
-            record["wall_time"] = round(time.monotonic() - self._started, 3) if self._started else 0.0
-        bodies = {}
-        for entry in self.project.models:
-            body = self.bodies[entry.name]
-            if body.num_joints == 0 and not entry.controllers:
-                continue  # the room: nothing to report
-            pos, quat = body.root_pose()
-            w, x, y, z = (float(v) for v in quat)
-            bodies[entry.name] = {
-                "root_position": [round(float(v), 6) for v in pos],
-                "root_yaw": round(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)), 6),
-                "joint_positions": {k: round(v, 9) for k, v in body.joint_positions().items()},
-            }
-        record["bodies"] = bodies
-        if self.spin is not None and self.spin.error is not None:
-            import traceback
-
-            text = "a subscription callback raised; callbacks stopped:\n" + "".join(
-                traceback.format_exception(self.spin.error)
-            )
-            record["error"] = record["error"] + "\n" + text if record.get("error") else text
-        controllers = {}
-        shared = Counter(name for name, _, _ in self.controllers)  # two tanks, two RttJointStatePublisher
-        for name, controller, body_name in self.controllers:
-            s = controller.summary()
-            if s:
-                controllers[f"{body_name}/{name}" if shared[name] > 1 else name] = s
-        if controllers:
-            record["controllers"] = controllers
-        return record
+        return app_summary(self)

@@ -294,8 +294,8 @@ class TfRecording:
     # ---- writing ------------------------------------------------------------------------
     def _write(self, topic: str, qos, data: bytes, log_time: int, type_name: str = TF_MESSAGE_TYPE) -> None:
         if topic not in self._topics_added:
-            from tutorial.bag.definitions import full_text
             from tutorial.bag.qos import profile_dict, serialize_profiles
+            from tutorial.interfaces.definitions import full_text
 
             definition = tf_definition() if type_name == TF_MESSAGE_TYPE else full_text(type_name)
             self.writer.add_topic(topic, type_name, definition, serialize_profiles([profile_dict(qos)]))

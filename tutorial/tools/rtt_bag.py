@@ -35,6 +35,7 @@ import sys
 import time
 
 from tutorial.ros import env as ros_env
+from tutorial.ros import program as ros_program
 
 PROG = "rtt-bag"
 _say = functools.partial(print, flush=True)
@@ -42,7 +43,7 @@ _say = functools.partial(print, flush=True)
 
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``rtt-bag`` (ROS arguments are removed before it parses)."""
-    from tutorial.urdf.recording import add_frame_prefix_argument
+    from tutorial.bag.tf import add_frame_prefix_argument
 
     p = argparse.ArgumentParser(
         prog=PROG,
@@ -152,7 +153,7 @@ def record(args, argv: list[str]) -> int:
         )
     except (BagWriteError, ValueError) as exc:
         return _fail(f"record: {exc}")
-    stop = ros_env.StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
+    stop = ros_program.StopRequest().install()  # SIGTERM (a launcher stopping us) ends the recording like Ctrl-C
     deadline = None if args.duration is None else time.monotonic() + args.duration
     try:
         _init_ros(argv)
@@ -162,7 +163,7 @@ def record(args, argv: list[str]) -> int:
                 break
             time.sleep(0.05)  # the stop flag and the deadline are seen within 50 ms
     finally:
-        ros_env.ignore_stop_signals()  # a second Ctrl-C must not cut the file's closing short
+        ros_program.ignore_stop_signals()  # a second Ctrl-C must not cut the file's closing short
         try:
             recorder.close()
         finally:
@@ -219,14 +220,14 @@ def play(args, argv: list[str]) -> int:
     except (BagError, ValueError) as exc:
         return _fail(f"play: {exc}")
     _say_not_closed("play", player.info)
-    ros_env.StopRequest(player.request_stop).install()
+    ros_program.StopRequest(player.request_stop).install()
     _init_ros(argv)
     try:
         player.play()
     except BagError as exc:  # the file changed or broke while playing
         return _fail(f"play: {exc}")
     finally:
-        ros_env.ignore_stop_signals()
+        ros_program.ignore_stop_signals()
         try:
             player.close()
         finally:
@@ -261,7 +262,7 @@ def recover(args) -> int:
 def main(argv: list[str] | None = None) -> int:
     """``rtt-bag``: parse the command line and run the subcommand; the exit status (main thread)."""
     argv = list(sys.argv if argv is None else argv)
-    args = ros_env.parse_command_line(build_parser(), argv)
+    args = ros_program.parse_command_line(build_parser(), argv)
     if args.command == "record":
         return record(args, argv)
     if args.command == "play":

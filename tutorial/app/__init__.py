@@ -1,0 +1,15 @@
+"""A running project: the App that builds the world, attaches the controllers, simulates and draws.
+
+It sits above the core, the ROS plumbing, the 3D view and the URDF tools,
+and below the steps' notebooks and the programs, which open it.
+
+==================  ==============================================================
+module              what
+==================  ==============================================================
+``app``             :class:`App`: the lifecycle of a running project (Choreonoid's
+                    opening of a ``.cnoid`` project), its threads and its stop
+``frames``          :class:`FramePacer`: when the view draws a frame
+``descriptions``    a model taken from a robot description topic
+``summary``         the exit summary a run prints or returns
+==================  ==============================================================
+"""

@@ -1,0 +1,56 @@
+"""A viewer whose model is a robot description topic: wait for the URDF and load it as a MuJoCo model.
+
+``project/step3_description.yaml`` names ``/Tank/robot_description`` instead
+of a model file; :func:`receive_descriptions` fills such models in before
+the App builds its world.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+from tutorial.core.project import Project
+
+DESCRIPTION_TIMEOUT = 10.0  # s a viewer waits for a robot description it takes its model from
+
+
+def receive_descriptions(project: Project, node, timeout: float, output: Callable[[dict], None]) -> Project:
+    """``project`` with each model that names a description topic taken from the URDF published there.
+
+    Waits up to ``timeout`` s for each on ``node`` (the publisher keeps it,
+    transient local: a simulation already running answers at once), and
+    says where the model came from, one record to ``output`` per model.
+    The App's owner thread calls it, before the node's spin thread starts.
+
+    Raises:
+        tutorial.interfaces.robot_description.DescriptionError: none came, or not a URDF.
+    """
+    waiting = [m for m in project.models if m.description is not None and m.text is None]
+    if not waiting:
+        return project
+    # imported here, so opening an App whose models are files never loads the URDF tools
+    from tutorial.interfaces.robot_description import receive_robot_description
+    from tutorial.urdf.mujoco_load import load_description
+
+    models = list(project.models)
+    fqn = node.get_fully_qualified_name()
+    for entry in waiting:
+        urdf = receive_robot_description(node, entry.description, timeout)
+        text, dropped, tree = load_description(urdf, entry.description)
+        models[models.index(entry)] = dataclasses.replace(entry, text=text)
+        note = f"; {dropped} mesh visuals left out (package:// names need ROS)" if dropped else ""
+        output(
+            {
+                "event": "description",
+                "node": fqn,
+                "body": entry.name,
+                "topic": entry.description,
+                "links": len(tree.links),
+                "moving_joints": [j.name for j in tree.moving],
+                "line": f"[{fqn}] {entry.name}: no model file of its own: drawing the robot description "
+                f"on {entry.description} (robot {tree.name}, {len(tree.links)} links, "
+                f"{len(tree.moving)} moving joints{note})",
+            }
+        )
+    return dataclasses.replace(project, models=models)
