@@ -3,6 +3,7 @@
 import threading
 
 from tutorial.core.call_later import LazyCaller, MainLoop, WrongThreadError
+from tutorial.core.hand_over import HandOverLoop
 
 
 def test_posted_calls_run_on_the_owner_thread_in_order():
@@ -164,7 +165,7 @@ def test_wake_from_another_thread_ends_a_wait():
 def test_yield_to_owner_returns_once_the_waiting_owner_took_the_work():
     from conftest import wait_until
 
-    loop = MainLoop()
+    loop = HandOverLoop()
     ran, results, errors = [], [], []
     stop = threading.Event()
 
@@ -196,7 +197,7 @@ def test_yield_to_owner_returns_once_the_waiting_owner_took_the_work():
 
 
 def test_yield_to_owner_does_not_wait_for_an_owner_that_is_not_waiting():
-    loop = MainLoop()
+    loop = HandOverLoop()
     results = []
 
     def poster():
@@ -214,7 +215,7 @@ def test_yield_to_owner_does_not_wait_for_an_owner_that_is_not_waiting():
 
 
 def test_yield_to_owner_gives_up_after_its_timeout():
-    loop = MainLoop()
+    loop = HandOverLoop()
     loop._owner_waiting = True  # as if the owner were waiting but never scheduled (a busy machine)
     results = []
 

@@ -140,15 +140,15 @@ MISTAKES = [
     ),
     (
         "2.1",
-        "joints = [io.body.joint(name).info for name in self.selected]",
-        "joints = [j for j in io.body.joint_infos if j.name in self.selected]",
+        "self.joints = [io.body.joint(name).info for name in self.selected]",
+        "self.joints = [j for j in io.body.joint_infos if j.name in self.selected]",
         "joints='TURRET_P,TURRET_Y'",
     ),
     ("2.1", "        if unknown:\n", "        if False:\n", "joints='GUN'"),
     (
         "2.1",
-        "self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(joints)]",
-        "self.addresses = self.addresses[:n]",
+        "self.joints = [io.body.joint(name).info for name in self.selected]",
+        "self.joints = self.joints[: len(self.selected)]",
         "joints='TURRET_P,TURRET_Y'",
     ),
     (

@@ -79,9 +79,9 @@ def test_an_exception_in_a_callback_is_kept_for_the_owner(node):
 
 
 def test_after_a_callback_the_spin_thread_steps_aside_for_the_owner(node):
-    from tutorial.core.call_later import MainLoop
+    from tutorial.core.hand_over import HandOverLoop
 
-    loop = MainLoop()  # owned by this thread, which runs it below
+    loop = HandOverLoop()  # owned by this thread, which runs it below
     ran = []
     node.create_subscription(
         String, "/spin_thread_hand_over", lambda msg: loop.call_later(ran.append, msg.data, key=msg.data), 10

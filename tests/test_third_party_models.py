@@ -237,8 +237,8 @@ def test_the_publisher_sends_every_numbered_joint_by_name(case, loaded, node):
     try:
         assert publisher.initialize(ControllerIO(body=body, time_step=world.opt.timestep, node=node, data=data))
         assert publisher.topic == f"/{case.name}/joint_state"
-        assert list(publisher.msg.name) == body.joint_names
-        assert all(publisher.msg.name)
+        assert [j.name for j in publisher.joints] == body.joint_names
+        assert all(j.name for j in publisher.joints)
         publisher.publish()  # a message with these names goes out without an error
     finally:
         publisher.unconfigure()

@@ -25,8 +25,8 @@ from tutorial.app.descriptions import DESCRIPTION_TIMEOUT, receive_descriptions
 from tutorial.app.frames import FRAME_RATE, FramePacer
 from tutorial.app.summary import app_summary
 from tutorial.core.body import Body
-from tutorial.core.call_later import MainLoop
 from tutorial.core.controller import ControllerConfig
+from tutorial.core.hand_over import HandOverLoop
 from tutorial.core.overlays import Overlays
 from tutorial.core.project import Project, check_parameter
 from tutorial.core.simulator import Attachment, Simulator
@@ -92,7 +92,7 @@ class App:
         self.attach = list(attach)
         self.record_timing = record_timing
         self.description_timeout = description_timeout
-        self.loop = MainLoop()
+        self.loop = HandOverLoop()  # call_later's loop, and its spin thread steps aside for it
         self.log = logging.getLogger("rtt")
         self.server = None
         self.scene = None

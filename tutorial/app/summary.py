@@ -29,7 +29,7 @@ def app_summary(app) -> dict:
         if app.sim.error:
             record["error"] = app.sim.error
     else:
-        record["wall_time"] = round(time.monotonic() - app._started, 3) if app._started else 0.0
+        record["wall_time"] = round(time.monotonic() - app.started_at, 3) if app.started_at else 0.0
     bodies = {}
     for entry in app.project.models:
         body = app.bodies[entry.name]

@@ -14,8 +14,6 @@ ends in (from ``stop()``).
 
 from __future__ import annotations
 
-from array import array
-
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
 from ..core.period import PeriodAccumulator
 from ..interfaces.joint_state import joint_state_qos, joint_state_topic
@@ -74,23 +72,9 @@ class RttJointStatePublisher(SimpleController):
         self.data = io.data
         # start() sends the first state: the periodic ones begin a period later.
         self.accumulator = PeriodAccumulator(io.time_step, self.rate, first_due=False)
-        # One message, reused: the names never change, and publish() copies
-        # the message, so refilling its arrays afterwards is safe.
-        joints = io.body.joint_infos
-        n = len(joints)
-        self.msg = self.msg_type()
-        self.msg.name = [j.name for j in joints]
-        self.msg.position = array("d", bytes(8 * n))
-        self.msg.velocity = array("d", bytes(8 * n))
-        self.msg.effort = array("d", bytes(8 * n))
-        # Where each joint's numbers are in MjData, read through memoryviews
-        # (plain floats, cheaper than indexing NumPy arrays every time).
-        self.sources = (
-            memoryview(io.data.qpos),
-            memoryview(io.data.qvel),
-            memoryview(io.data.qfrc_actuator),
-        )
-        self.addresses = [(i, j.qpos_adr, j.dof_adr) for i, j in enumerate(joints)]
+        # Each numbered joint's name, and where its numbers are in MjData:
+        # qpos[qpos_adr] is its position, qvel[dof_adr] its velocity.
+        self.joints = io.body.joint_infos
         return True
 
     def start(self) -> bool:
@@ -106,15 +90,15 @@ class RttJointStatePublisher(SimpleController):
         self.publish()  # the state the simulation ended in
 
     def publish(self) -> None:
-        """Fill the JointState from the simulation state and publish it."""
-        msg = self.msg
-        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(self.data.time)
-        qpos, qvel, qfrc = self.sources
-        position, velocity, effort = msg.position, msg.velocity, msg.effort
-        for i, qpos_adr, dof_adr in self.addresses:
-            position[i] = qpos[qpos_adr]  # rad (hinge) or m (slide)
-            velocity[i] = qvel[dof_adr]  # rad/s or m/s
-            effort[i] = qfrc[dof_adr]  # N*m or N, from the actuators
+        """Make a JointState of the simulation state now and publish it."""
+        data, joints = self.data, self.joints
+        msg = self.msg_type()
+        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(data.time)
+        msg.name = [j.name for j in joints]
+        # rad (hinge) or m (slide); rad/s or m/s; N*m or N, from the actuators
+        msg.position = [float(data.qpos[j.qpos_adr]) for j in joints]
+        msg.velocity = [float(data.qvel[j.dof_adr]) for j in joints]
+        msg.effort = [float(data.qfrc_actuator[j.dof_adr]) for j in joints]
         self.publisher.publish(msg)
         self.published += 1
 

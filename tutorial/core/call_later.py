@@ -13,18 +13,9 @@ instead of queueing a second call.  The newest state wins and a burst of
 messages can never build a backlog; :attr:`MainLoop.coalesced` counts the
 calls that were superseded.
 
-Python runs one thread at a time (the interpreter lock, the GIL), and that
-decides how soon posted work runs.  Posting wakes the main thread, but it can
-only run once the posting thread lets go of the lock, which a busy thread
-does when it next blocks.  After a subscription callback, rclpy's executor
-runs its own Python for 0.1 to 0.2 ms (it builds its wait set again) before it
-blocks; the woken main thread waits all that time.  So a posting thread that
-has nothing urgent to do may *step aside*: :meth:`MainLoop.yield_to_owner`
-blocks it (which lets go of the lock) until the owner has taken what was
-posted, at most ``HAND_OVER_WAIT``.  :class:`tutorial.ros.spin.SpinThread`
-does this after each callback when it is given the loop.  In the benchmark
-at 1 kHz, callback -> applied on the main thread then takes 0.07 to 0.13 ms
-(p50) instead of 0.16 to 0.19 ms (``book/benchmarks.md``).
+How soon the owner runs posted work is a matter of speed, not of
+correctness: :class:`tutorial.core.hand_over.HandOverLoop` adds a way for the
+posting thread to step aside for it, and the App uses that.
 """
 
 from __future__ import annotations
@@ -35,8 +26,6 @@ import traceback
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from typing import Any
-
-HAND_OVER_WAIT = 0.001  # s: the longest yield_to_owner() waits for the owner to take posted work
 
 
 class WrongThreadError(RuntimeError):
@@ -56,11 +45,9 @@ class MainLoop:
 
     def __init__(self, owner: threading.Thread | None = None):
         self._owner = (owner or threading.current_thread()).ident
+        # The lock guards the pending calls and the counters: posting threads
+        # and the owner both touch them, and posting never waits for a call to run.
         self._lock = threading.Lock()
-        # Signalled (under _lock) each time the owner takes the pending calls: see yield_to_owner().
-        self._taken = threading.Condition(self._lock)
-        self._taken_upto = 0  # the value of `posted` when the owner last took the pending calls
-        self._owner_waiting = False  # the owner is blocked in run_once(), waiting for work
         self._pending: OrderedDict[Hashable, tuple[Callable, tuple, dict]] = OrderedDict()
         self._wakeup = threading.Event()
         self._wake_requested = False  # set by wake() on the owner thread (a signal handler), see wake()
@@ -69,8 +56,6 @@ class MainLoop:
         self.coalesced = 0
         self.executed = 0
         self.max_pending = 0  # the longest the queue has been: stays at the number of keys, never grows
-        self.yields = 0  # yield_to_owner() calls that waited until the owner took the work
-        self.yield_timeouts = 0  # ... and that gave up after HAND_OVER_WAIT
         self.errors: list[str] = []
 
     # ---- any thread ------------------------------------------------------
@@ -94,41 +79,6 @@ class MainLoop:
             self._pending[k] = (func, args, kwargs)
             self.max_pending = max(self.max_pending, len(self._pending))
         self._wakeup.set()
-
-    def yield_to_owner(self, timeout: float = HAND_OVER_WAIT) -> bool:
-        """Step aside until the owner has taken every call posted so far (any thread but the owner).
-
-        Blocking here lets go of the interpreter lock, so a main thread that
-        was woken by the post runs it at once instead of waiting for this
-        thread's next blocking call (see the module's docstring).  It waits
-        only when the owner is blocked in :meth:`run_once` and posted calls
-        are still pending: an owner busy drawing, or not running the loop at
-        all, costs nothing.
-
-        Args:
-            timeout: the longest wait, s.
-
-        Returns:
-            True when the owner took the work in time; False when there was
-            nothing to wait for, or after ``timeout`` (counted in :attr:`yield_timeouts`).
-        """
-        if threading.get_ident() == self._owner:
-            return False  # the owner cannot wait for itself
-        with self._lock:
-            target = self.posted
-            if not self._owner_waiting or self._taken_upto >= target:
-                return False
-            taken = self._taken.wait_for(lambda: self._taken_upto >= target, timeout)
-            if taken:
-                self.yields += 1
-            else:
-                self.yield_timeouts += 1
-            return taken
-
-    @property
-    def owner_waiting(self) -> bool:
-        """Whether the owner is blocked in :meth:`run_once` now (any thread; a hint, stale at once)."""
-        return self._owner_waiting
 
     def pending(self) -> int:
         """How many calls wait to run (any thread)."""
@@ -174,8 +124,7 @@ class MainLoop:
         self._check_owner()
         with self._lock:
             batch, self._pending = self._pending, OrderedDict()
-            self._taken_upto = self.posted
-            self._taken.notify_all()  # a thread in yield_to_owner() may go on
+            self._taken()
         for func, args, kwargs in batch.values():
             self._run(func, args, kwargs)
         self.executed += len(batch)
@@ -193,11 +142,7 @@ class MainLoop:
             due = min((t[0] for t in self._timers), default=None)
             if due is not None:
                 timeout = max(0.0, min(timeout, due - time.monotonic()))
-            self._owner_waiting = True  # a hint for yield_to_owner(); a stale read only costs a wait
-            try:
-                self._wakeup.wait(timeout)
-            finally:  # a Ctrl-C raised in the wait must not leave posting threads waiting for nobody
-                self._owner_waiting = False
+            self._wait(timeout)
         self._wake_requested = False
         self._wakeup.clear()
         return self.process_pending()
@@ -215,6 +160,13 @@ class MainLoop:
                 break
             self.run_once(min(poll, left))
         return done()
+
+    def _wait(self, timeout: float) -> None:
+        """Block the owner until a post wakes it or ``timeout`` s pass (a subclass may note that it waits)."""
+        self._wakeup.wait(timeout)
+
+    def _taken(self) -> None:
+        """The owner took every pending call (called with the lock held; a subclass may tell the posters)."""
 
     def _run(self, func: Callable, args: tuple, kwargs: dict) -> None:
         try:

@@ -69,11 +69,11 @@ class SpinThread:
 
     Args:
         node: the ``rclpy.node.Node`` whose callbacks to run.
-        hand_over_to: the :class:`tutorial.core.call_later.MainLoop` its callbacks
-            post to, if any: after each callback the thread steps aside
-            (:meth:`~tutorial.core.call_later.MainLoop.yield_to_owner`, at most
-            1 ms) so the main thread runs the posted work before the
-            executor's own bookkeeping holds the interpreter lock.
+        hand_over_to: the :class:`tutorial.core.hand_over.HandOverLoop` its
+            callbacks post to, if any: after each callback the thread steps
+            aside (:meth:`~tutorial.core.hand_over.HandOverLoop.yield_to_owner`,
+            at most 1 ms) so the main thread runs the posted work before the
+            executor's own bookkeeping holds the interpreter lock (speed only).
 
     Raises:
         RuntimeError: the node was already given to a SpinThread (one per node
