@@ -8,17 +8,26 @@
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
 #       make export (write the controllers from the notebooks that build them),
-#       make run-notebooks (run every notebook and save its outputs, the ones nbval checks).
+#       make run-notebooks (run every notebook and save its outputs, the ones nbval checks),
+#       make lock (uv.lock anew: the newest versions pyproject.toml allows), make test-latest (make test against
+#       those newest versions, in .venv-latest, without touching uv.lock: an upgrade is one command and one run).
 
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast test-lab fuzz lint notebooks book bench export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab test-latest fuzz lint lock notebooks book bench export run-notebooks venv clean
 
-$(VENV)/.installed: pyproject.toml
+UV_VERSION := 0.13.9
+
+# Exactly the versions in uv.lock (with their hashes), the ones the tests passed with: uv, from PyPI, installs
+# the lock into .venv; --locked fails when uv.lock no longer matches pyproject.toml.  --inexact: uv must not
+# remove what it did not install itself, since the ROS 2 wheels carry the metadata of the ROS packages inside
+# them (ros-jazzy-rclpy brings "rclpy"), and removing those deletes rclpy's files.
+$(VENV)/.installed: pyproject.toml uv.lock
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[notebook,test,book,bench]"
+	$(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
+	$(VENV)/bin/uv sync --locked --inexact --all-extras --python $(PY) --quiet
 	touch $@
 
 venv: $(VENV)/.installed
@@ -75,5 +84,20 @@ bench: $(VENV)/.installed
 	bash scripts/ensure-nftables.sh
 	$(PY) -m benchmarks.run
 
+# The lock anew, every package at the newest version pyproject.toml allows (then make test, and commit uv.lock).
+lock: $(VENV)/.installed
+	$(VENV)/bin/uv lock --upgrade
+
+# make test in a second environment with the newest versions pyproject.toml allows, the lock untouched;
+# it first prints every package whose version differs from uv.lock.
+test-latest: $(VENV)/.installed
+	rm -rf .venv-latest
+	$(PYTHON) -m venv .venv-latest
+	.venv-latest/bin/pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
+	.venv-latest/bin/uv pip install --python .venv-latest/bin/python --quiet --upgrade -e ".[notebook,test,book,bench]"
+	$(PY) scripts/lock_diff.py .venv-latest/bin/python
+	touch .venv-latest/.installed
+	$(MAKE) test VENV=.venv-latest
+
 clean:
-	rm -rf $(VENV) .pytest_cache book/_build
+	rm -rf $(VENV) .venv-latest .pytest_cache book/_build
