@@ -4,7 +4,8 @@
 # Both create the virtual environment .venv on first use and reuse it after.
 # More: make test-fast (the unit tier, under a minute: the inner loop), make lint (ruff check and format),
 #       make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
-#       make bench (the benchmark suite; not part of make test),
+#       make bench (the benchmark suite; not part of make test; its plots go beside its results),
+#       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
 #       make export (write the controllers from the notebooks that build them),
@@ -16,7 +17,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast test-lab test-latest fuzz lint lock notebooks book bench export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab test-latest fuzz lint lock notebooks book bench bench-figures export run-notebooks venv clean
 
 UV_VERSION := 0.13.9
 
@@ -83,6 +84,10 @@ bench: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
 	bash scripts/ensure-nftables.sh
 	$(PY) -m benchmarks.run
+
+# The book's benchmark plots from the last make bench (benchmarks/results/): the only way they change.
+bench-figures: $(VENV)/.installed
+	$(PY) -m benchmarks.publish
 
 # The lock anew, every package at the newest version pyproject.toml allows (then make test, and commit uv.lock).
 lock: $(VENV)/.installed

@@ -6,4 +6,4 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results"  # latest.json, targets.md (git-ignored)
-BOOK_STATIC = ROOT / "book" / "_static"  # the plots a full run draws for the book
+BOOK_STATIC = ROOT / "book" / "_static"  # the book's plots: only make bench-figures writes them

@@ -73,7 +73,7 @@ def plot_scale(r: dict, path: Path) -> Path:
             ax.grid(alpha=0.3)
     fig.suptitle(
         f"Scale: {SCALE_RATE:g} Hz publishers, one viewer mirroring every body "
-        f"(make bench, {r['when']}; dotted lines: targets)",
+        f"(make bench, {r['when']}, {r.get('commit', '?')}; dotted lines: targets)",
         fontsize=11,
     )
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -111,7 +111,10 @@ def plot_latency(r: dict, path: Path) -> Path:
     ax.axhline(0.01, color="grey", ls=":", lw=1)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    ax.set_title(f"1 kHz hand-off, {r['rounds']} interleaved rounds pooled (make bench, {r['when']})", fontsize=10)
+    ax.set_title(
+        f"1 kHz hand-off, {r['rounds']} interleaved rounds pooled (make bench, {r['when']}, {r.get('commit', '?')})",
+        fontsize=10,
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=80)
     plt.close(fig)
@@ -167,7 +170,9 @@ def plot_browser(r: dict, path: Path) -> Path:
     ax.set_xlabel("ms from publish (tutorial) or send (bare page) to drawn: bars p50 per stage, marks p99")
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22), ncol=3)
     ax.grid(alpha=0.3, axis="x")
-    ax.set_title(f"A state's way to the pixel, headless Chromium (make bench, {r['when']})", fontsize=10)
+    ax.set_title(
+        f"A state's way to the pixel, headless Chromium (make bench, {r['when']}, {r.get('commit', '?')})", fontsize=10
+    )
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=80)
     plt.close(fig)

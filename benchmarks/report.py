@@ -39,6 +39,13 @@ def runs_table(paths: list[str]) -> str:
 def print_report(r: dict) -> None:
     """Print a run's figures, section by section (times in ms unless marked), then its targets."""
     sim = r["simulation_speed"]
+    for when in ("start", "end"):
+        m = r.get(f"machine_at_{when}")
+        if m:
+            print(
+                f"machine at the {when} ({m['when']}): bare mj_step {m['mj_step_per_s']:,} steps/s, "
+                f"load average {m['load_average']}, other processes {m['others_cpu_cores']} cores"
+            )
     print("\n== simulation speed (steps/s, as fast as possible; ratio to bare mj_step on the same model, same run)")
     for name, s in sim.items():
         parts = [f"bare {s['bare_steps_per_s']}"]
@@ -122,6 +129,20 @@ def print_report(r: dict) -> None:
         f"\n== start-up: launch to first state shown: {r['startup']['first_state_s']} s, "
         f"median {r['startup']['median_s']} s"
     )
+    lj = r.get("late_join")
+    if lj:
+        print(f"\n== late join ({lj['starts']} starts each, next to a running 0.1 Hz publisher): s to the kept state")
+        for kind in ("viewer", "recorder"):
+            for name, f in lj[kind].items():
+                print(
+                    f"  {kind:8s} {name:16s} p50 {f['p50']} p95 {f['p95']} max {f['max']} "
+                    f"(missed {lj['missed'][kind][name]})"
+                )
+        for name, c in lj["idle_per_participant"].items():
+            print(
+                f"  an idle participant, {name}: {c['cpu_cores']} CPU cores, "
+                f"{c['udp_datagrams_per_s']} UDP datagrams/s sent (this machine's, per participant)"
+            )
     scale = r.get("scale")
     if scale:
         print(

@@ -14,6 +14,9 @@ because absolute times on a shared machine vary:
 * the viewer under a 1 kHz flood: age of the displayed state, backlog,
   meshcat cost per frame, frames per second, CPU per process;
 * start-up: from the launch command to the first state shown;
+* late join: a viewer's and a recorder's wait for the state a running
+  publisher keeps, under the project's Fast DDS profile and Fast DDS's
+  defaults, and what each profile costs an idle participant;
 * scale curves: N tanks in one world (each with its Step 1 controller and
   Step 2 publisher, driven by one ``rtt-joy --demo``) and one viewer
   mirroring all N, for N = 1, 2, 4, 8; the same for one arm of 6, 12, 24
@@ -23,10 +26,11 @@ because absolute times on a shared machine vary:
 
 It prints a table of the targets (target, measured, baseline, ratio,
 pass/fail), writes ``benchmarks/results/latest.json`` and
-``benchmarks/results/targets.md``, and draws the plots
-``book/_static/bench_scale.png`` and ``book/_static/bench_latency.png``
-(``--quick`` draws them in ``benchmarks/results/`` instead, so a smoke run
-never replaces the book's).  ROS traffic stays on this machine (localhost
+``benchmarks/results/targets.md``, and draws its plots beside them
+(``bench_scale.png``, ``bench_latency.png``, ``bench_browser.png``), each
+titled with the run's time and commit.  The book's figures change only
+through ``make bench-figures`` (:mod:`benchmarks.publish`), which copies a
+run's plots into ``book/_static/``.  ROS traffic stays on this machine (localhost
 discovery, a ROS_DOMAIN_ID of its own).
 
 Here: the options, the order of the experiments, and where the results go.
@@ -50,15 +54,29 @@ from pathlib import Path
 from benchmarks.experiments.browser import CASES as BROWSER_CASES
 from benchmarks.experiments.browser import pixel_latency
 from benchmarks.experiments.cross_process import latency_rounds
+from benchmarks.experiments.late_join import late_join
 from benchmarks.experiments.network import measure as across_hosts
 from benchmarks.experiments.scale import scale_curves
 from benchmarks.experiments.scene_update import scene_update_cost
 from benchmarks.experiments.speed import SPEED_PAIRS, SPEED_PAIRS_OTHER, realtime_mode, simulation_speed
 from benchmarks.experiments.startup import startup
+from benchmarks.machine import probe as machine_probe
 from benchmarks.paths import BOOK_STATIC, RESULTS, ROOT
 from benchmarks.plots import plot_browser, plot_latency, plot_scale
 from benchmarks.report import print_report, runs_table, targets_markdown
 from benchmarks.targets import targets
+
+
+def _commit() -> str:
+    """The checked-out commit, short, with ``+`` when the work tree has changes ("unknown" outside git)."""
+    import subprocess
+
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True)
+    except OSError:
+        return "unknown"
+    return head.stdout.strip() + ("+" if dirty.stdout.strip() else "") if head.returncode == 0 else "unknown"
 
 
 def main(argv=None) -> int:
@@ -83,8 +101,8 @@ def main(argv=None) -> int:
     p.add_argument(
         "--plots",
         default=None,
-        help=f"directory for the plots (default {BOOK_STATIC.relative_to(ROOT)}; "
-        f"with --quick {RESULTS.relative_to(ROOT)})",
+        help=f"directory for the plots (default {RESULTS.relative_to(ROOT)}, beside the results; "
+        f"make bench-figures copies them into {BOOK_STATIC.relative_to(ROOT)})",
     )
     args = p.parse_args(argv)
     if args.table:
@@ -94,7 +112,7 @@ def main(argv=None) -> int:
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
     seconds, warmup = (5.0, 1.0) if args.quick else (args.seconds, 2.0)
     rounds = 1 if args.quick else args.rounds
-    plots = Path(args.plots) if args.plots else (RESULTS if args.quick else BOOK_STATIC)
+    plots = Path(args.plots) if args.plots else RESULTS
 
     import rclpy
     from rclpy.signals import SignalHandlerOptions
@@ -104,9 +122,11 @@ def main(argv=None) -> int:
     r: dict = {
         "machine": machine,
         "when": time.strftime("%Y-%m-%d %H:%M"),
+        "commit": _commit(),
         "seconds_per_run": seconds,
         "rounds": rounds,
         "load_average_at_start": [round(x, 2) for x in os.getloadavg()],
+        "machine_at_start": machine_probe(),
     }
     pairs, other_pairs = (8, 8) if args.quick else (SPEED_PAIRS, SPEED_PAIRS_OTHER)
     rates = {"publisher_50Hz": 50.0, "publisher_every_step": 0.0}
@@ -122,6 +142,7 @@ def main(argv=None) -> int:
         "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200),
     }
     r["startup"] = startup(1 if args.quick else 3)
+    r["late_join"] = late_join(4 if args.quick else 20, 4 if args.quick else 8, 5.0 if args.quick else 20.0)
     with tempfile.TemporaryDirectory() as d:
         r["scale"] = scale_curves(
             seconds, warmup, 1 if args.quick else args.scale_rounds, 8 if args.quick else 20, Path(d)
@@ -136,6 +157,7 @@ def main(argv=None) -> int:
     else:
         r["network"] = across_hosts(6.0 if args.quick else 14.0)
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
+    r["machine_at_end"] = machine_probe()
     r["targets"] = targets(r)
     print_report(r)
     r["plots"] = [

@@ -273,6 +273,21 @@ NETWORK_TARGETS = (
     )
 )
 
+LATE_JOIN_TARGETS = tuple(
+    Target(
+        f"late join: {words} started next to a running 0.1 Hz publisher has its kept state within {{limit}} s "
+        "(p95 of the starts)",
+        1.0,
+        AT_MOST,
+        read("late_join", kind, "project", "p95"),
+        "{:.2f} s",
+        baseline=read("late_join", kind, "fast_dds_default", "p95"),
+        baseline_fmt="Fast DDS's defaults {:.2f} s",
+        needs="late_join",
+    )
+    for kind, words in (("viewer", "a viewer"), ("recorder", "rtt-bag record"))
+)
+
 TARGETS = (
     Target(
         "simulation with the 50 Hz publisher >= {limit}x bare mj_step (steps/s)",
@@ -327,6 +342,7 @@ TARGETS = (
     SCALE_FRAMES,
     SCALE_AGE,
     SCALE_CPU,
+    *LATE_JOIN_TARGETS,
     *NETWORK_TARGETS,
     *BROWSER_TARGETS,
 )

@@ -60,6 +60,16 @@ def test_a_lost_joint_state_gets_several_chances_to_be_repaired_before_the_next_
     assert root.findall(".//p:qos", NS) == []
 
 
+def test_a_newcomer_finds_a_running_node_within_a_quarter_second():
+    """Fast DDS's 3 s announcement period made a late viewer wait up to 3 s (benchmarks.experiments.late_join)."""
+    root = ET.parse(PROJECT_PROFILES).getroot()
+    [participant] = root.findall("p:participant", NS)
+    assert participant.get("is_default_profile") == "true"
+    config = participant.find("p:rtps/p:builtin/p:discovery_config", NS)
+    assert seconds(config.find("p:leaseAnnouncement", NS)) <= 0.25
+    assert config.find("p:leaseDuration", NS) is None  # the lease stays Fast DDS's 20 s: a pause is no departure
+
+
 NODE_WITH_A_RELIABLE_PUBLISHER = """
 import rclpy
 from std_msgs.msg import String
