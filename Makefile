@@ -3,7 +3,7 @@
 #   make test   - the whole test suite: library, cross-process, launch, browser, and the notebooks (nbval)
 # Both create the virtual environment .venv on first use and reuse it after.
 # More: make test-fast (the unit tier, under a minute: the inner loop), make lint (ruff check and format),
-#       make notebooks (JupyterLab on notebooks/), make book (the Jupyter Book, warnings are errors),
+#       make notebooks (JupyterLab on notebooks/), make hub (a class's JupyterHub on 127.0.0.1:8000, course/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
@@ -17,7 +17,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast test-lab test-latest fuzz lint lock notebooks book bench bench-figures export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
 
 UV_VERSION := 0.13.9
 
@@ -88,6 +88,15 @@ bench: $(VENV)/.installed
 # The book's benchmark plots from the last make bench (benchmarks/results/): the only way they change.
 bench-figures: $(VENV)/.installed
 	$(PY) -m benchmarks.publish
+
+# A class's JupyterHub on this machine, for a trial: http://127.0.0.1:8000, learners learner1..learner3,
+# password tanktutorial (course/jupyterhub_config.py says how a course changes each).  The proxy comes from npm.
+hub: $(VENV)/.installed course/node_modules/.installed
+	$(VENV)/bin/jupyterhub -f course/jupyterhub_config.py
+
+course/node_modules/.installed: course/package.json course/package-lock.json
+	cd course && npm ci --no-audit --no-fund --silent
+	touch $@
 
 # The lock anew, every package at the newest version pyproject.toml allows (then make test, and commit uv.lock).
 lock: $(VENV)/.installed

@@ -137,6 +137,37 @@ def use_localhost_by_default(environ: MutableMapping[str, str] | None = None) ->
     return env.setdefault(DISCOVERY_RANGE_VARIABLE, DEFAULT_DISCOVERY_RANGE)
 
 
+ASSIGNED_DOMAIN_VARIABLE = "RTT_ASSIGNED_ROS_DOMAIN_ID"  # set by a class's hub (course/jupyterhub_config.py)
+
+
+def assigned_domain_warning(environ: Mapping[str, str] | None = None) -> str | None:
+    """A warning when ``ROS_DOMAIN_ID`` is not the domain a class's hub gave this learner, else None.
+
+    On a shared server each learner's nodes live in a domain of their own
+    (``RTT_ASSIGNED_ROS_DOMAIN_ID``, set by the hub).  A learner who changes
+    ``ROS_DOMAIN_ID`` by hand loses their own nodes started elsewhere and may
+    join another learner's robots.  Any thread may call it.
+    """
+    env = os.environ if environ is None else environ
+    assigned = env.get(ASSIGNED_DOMAIN_VARIABLE)
+    current = env.get("ROS_DOMAIN_ID", "0") or "0"
+    if not assigned or current == assigned:
+        return None
+    return (
+        f"ROS_DOMAIN_ID is {current}, but this server gave you ROS domain {assigned}: your notebooks, terminals "
+        f"and rtt-* programs meet only in {assigned}, and {current} may be another learner's robots. "
+        f"Run `export ROS_DOMAIN_ID={assigned}` (or unset it in this notebook: "
+        f"os.environ['ROS_DOMAIN_ID'] = '{assigned}') before starting nodes."
+    )
+
+
+def warn_if_not_assigned_domain() -> None:
+    """At import: print :func:`assigned_domain_warning`'s warning, if any, once (main thread)."""
+    message = assigned_domain_warning()
+    if message:
+        print(f"rtt: WARNING: {message}", file=sys.stderr, flush=True)
+
+
 PROFILES_VARIABLE = "FASTRTPS_DEFAULT_PROFILES_FILE"  # the name Fast DDS 2.x (Jazzy's 2.14) reads
 PROJECT_PROFILES = Path(__file__).with_name("fastdds_profiles.xml")
 

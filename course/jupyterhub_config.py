@@ -1,0 +1,131 @@
+# A JupyterHub for a class: each learner's server runs the project's environment, opens its notebooks, and
+# gets a ROS 2 domain of its own (course/domains.py), so each learner's robots are their own.
+#
+#   make hub        # http://127.0.0.1:8000, learners learner1..learner3, trial password "tanktutorial"
+#
+# What a course changes, each in one place below: who logs in (the authenticator), where a learner's
+# server runs (the spawner), and where the hub listens.  Settings from the environment, for a trial or a test:
+#   RTT_HUB_URL         where the hub listens (default http://127.0.0.1:8000; keep 127.0.0.1 for a trial)
+#   RTT_HUB_STATE       the hub's own files: database, cookie secret, the book of ROS domains, learners'
+#                       homes in a trial (default course/.hub)
+#   RTT_HUB_LEARNERS    the trial's learner accounts, comma-separated (default learner1,learner2,learner3)
+#   RTT_HUB_PASSWORD    the trial's shared password (at least 8 characters; default tanktutorial)
+#   RTT_HUB_SPAWNER     "simple" (default: every learner's server runs as this user, homes under the state
+#                       folder; a trial only) or "users" (each learner a Unix user of this machine; the hub
+#                       runs as root; RTT_HUB_PYTHON then names an environment every user can run)
+#   RTT_HUB_PYTHON      the Python of the learners' environment (default this project's .venv)
+#   RTT_HUB_DOMAINS     the ROS domains to give out, comma-separated (default: every one a server has, 1-101
+#                       and 215-232; tests pick their own)
+#   RTT_HUB_PER_LEARNER_NETWORK  "1" when the spawner gives each learner a network namespace (containers,
+#                       pods): domains may then repeat
+
+import os
+import pwd
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+COURSE = Path(__file__).resolve().parent
+ROOT = COURSE.parent
+sys.path.insert(0, str(COURSE))
+
+from domains import DomainBook, DomainError  # noqa: E402 - course/ is on the path only from here
+
+c = get_config()  # noqa: F821 - JupyterHub provides it
+
+STATE = Path(os.environ.get("RTT_HUB_STATE", COURSE / ".hub")).resolve()
+STATE.mkdir(parents=True, exist_ok=True)
+PYTHON = Path(os.environ.get("RTT_HUB_PYTHON", ROOT / ".venv" / "bin" / "python"))
+ENV_BIN = PYTHON.parent  # jupyterhub-singleuser and the rtt-* programs of the learners' environment
+LEARNERS = [n for n in os.environ.get("RTT_HUB_LEARNERS", "learner1,learner2,learner3").split(",") if n]
+
+# ---- where the hub listens: this machine only, unless a course puts it behind its own HTTPS front
+c.JupyterHub.bind_url = os.environ.get("RTT_HUB_URL", "http://127.0.0.1:8000")
+PORT = int(c.JupyterHub.bind_url.rstrip("/").rsplit(":", 1)[1])
+c.JupyterHub.hub_ip = "127.0.0.1"
+c.JupyterHub.hub_port = PORT + 2  # the hub's own API; the proxy's is the next port
+c.ConfigurableHTTPProxy.api_url = f"http://127.0.0.1:{PORT + 1}"
+c.ConfigurableHTTPProxy.command = [str(COURSE / "node_modules" / ".bin" / "configurable-http-proxy")]
+c.JupyterHub.db_url = f"sqlite:///{STATE / 'jupyterhub.sqlite'}"
+c.JupyterHub.cookie_secret_file = str(STATE / "jupyterhub_cookie_secret")
+c.JupyterHub.pid_file = str(STATE / "jupyterhub.pid")
+c.ConfigurableHTTPProxy.pid_file = str(STATE / "proxy.pid")
+
+# ---- who logs in.  A trial: one shared password for the listed learners.  A course plugs in its own:
+#   OAuth (GitHub, Google, a university's):  pip install oauthenticator
+#       c.JupyterHub.authenticator_class = "github"; c.GitHubOAuthenticator.client_id = ...
+#   LTI, from a learning management system (Moodle, Canvas):  pip install jupyterhub-ltiauthenticator
+#       c.JupyterHub.authenticator_class = "ltiauthenticator.lti13.authenticator.LTI13Authenticator"
+c.JupyterHub.authenticator_class = "shared-password"
+c.SharedPasswordAuthenticator.user_password = os.environ.get("RTT_HUB_PASSWORD", "tanktutorial")
+c.Authenticator.allowed_users = set(LEARNERS)
+
+# ---- where a learner's server runs.  A trial: a process of this user per learner.  A course uses one of:
+#   every learner a Unix user of this machine (The Littlest JupyterHub):  RTT_HUB_SPAWNER=users below
+#   a container each:  pip install dockerspawner;  c.JupyterHub.spawner_class = "docker"
+#   Kubernetes (Zero to JupyterHub):  pip install jupyterhub-kubespawner;  c.JupyterHub.spawner_class = "kubespawner"
+#   systemd units with resource limits:  pip install jupyterhub-systemdspawner;  c.JupyterHub.spawner_class = "systemd"
+# In a container or pod each learner has a network namespace of their own: set RTT_HUB_PER_LEARNER_NETWORK=1.
+if os.environ.get("RTT_HUB_SPAWNER", "simple") == "users":
+    c.JupyterHub.spawner_class = "localprocess"  # each learner's server runs as their Unix user
+    c.LocalProcessSpawner.notebook_dir = "~"
+else:
+    c.JupyterHub.spawner_class = "simple"  # a trial only: no isolation between learners' files
+    c.SimpleLocalProcessSpawner.home_dir_template = str(STATE / "homes" / "{username}")
+    if os.geteuid() == 0:  # a trial started as root (a container): Jupyter refuses root without this
+        c.Spawner.args = ["--allow-root"]
+c.Spawner.cmd = [str(ENV_BIN / "jupyterhub-singleuser")]
+c.Spawner.ip = "127.0.0.1"
+c.Spawner.default_url = "/lab/tree/notebooks/00_setup_check.ipynb"
+c.Spawner.http_timeout = 60  # s: a 2-core server starting several learners at once is slow
+c.Spawner.start_timeout = 120
+c.Spawner.environment = {
+    "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",  # a learner's nodes never look beyond this machine
+    "PATH": f"{ENV_BIN}:/usr/local/bin:/usr/bin:/bin",  # rtt-* in the learner's terminals
+}
+
+DOMAINS = DomainBook(
+    STATE / "ros_domains.json",
+    domains=[int(d) for d in os.environ["RTT_HUB_DOMAINS"].split(",")] if os.environ.get("RTT_HUB_DOMAINS") else None,
+    per_learner_network=os.environ.get("RTT_HUB_PER_LEARNER_NETWORK") == "1",
+)
+
+
+def give_learner_their_domain_and_notebooks(spawner):
+    """Before a learner's server starts: their ROS domain, in its environment, and their copy of the notebooks.
+
+    A learner the book cannot give a domain (a name it cannot hold, none left) gets the reason on the hub's
+    page and no server; no other learner's server is touched.
+    """
+    name = spawner.user.name
+    try:
+        domain = DOMAINS.domain_for(name)
+    except DomainError as exc:
+        spawner.log.error("%s", exc)
+        raise RuntimeError(str(exc)) from None
+    spawner.environment["ROS_DOMAIN_ID"] = str(domain)
+    spawner.environment["RTT_ASSIGNED_ROS_DOMAIN_ID"] = str(domain)  # the notebooks warn if it is changed
+    spawner.log.info("learner %s: ROS domain %d", name, domain)
+    unix_user = c.JupyterHub.spawner_class == "localprocess"
+    home = Path(pwd.getpwnam(name).pw_dir) if unix_user else Path(spawner.home_dir)
+    target = home / "notebooks"
+    if target.exists():
+        return  # a learner's own copy, made once: their work is never overwritten
+    shutil.copytree(ROOT / "notebooks", target, ignore=shutil.ignore_patterns(".ipynb_checkpoints", "*.cfg"))
+    # Trusted in the learner's own Jupyter, so the notebooks' recorded 3D views run (JupyterLab runs no
+    # script of an untrusted output).
+    subprocess.run(
+        [str(ENV_BIN / "jupyter"), "trust", *map(str, sorted(target.glob("*.ipynb")))],
+        env={"HOME": str(home), "PATH": spawner.environment["PATH"]},
+        capture_output=True,
+        timeout=120,
+        check=False,
+    )
+    if unix_user and os.geteuid() == 0:  # made by the hub (root): the learner's own from now on
+        entry = pwd.getpwnam(name)
+        for path in [target, *target.rglob("*"), *(home / ".local").rglob("*"), home / ".local"]:
+            os.chown(path, entry.pw_uid, entry.pw_gid)
+
+
+c.Spawner.pre_spawn_hook = give_learner_their_domain_and_notebooks

@@ -1,0 +1,218 @@
+"""A class's JupyterHub for tests (``course/jupyterhub_config.py``), and learners who log in and run code.
+
+:class:`Hub` starts ``jupyterhub`` on a port of 127.0.0.1 with a state
+folder of its own; :class:`Learner` logs in through the hub's login form
+(its session cookie, as a browser has), starts their server, and runs code
+in a kernel of it over the kernel's WebSocket, as a notebook's cell does.
+Every wait has a deadline.  One thread per object.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import time
+import uuid
+from pathlib import Path
+
+import requests
+
+ROOT = Path(__file__).resolve().parent.parent
+PASSWORD = "tanktutorial-test"
+
+
+def free_port_block(size: int = 3) -> int:
+    """A port p with p .. p+size-1 free on 127.0.0.1 (the hub, its proxy's API, its own API)."""
+    for _ in range(50):
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        if port + size < 65535 and all(_free(port + i) for i in range(size)):
+            return port
+    raise RuntimeError("no block of free ports")
+
+
+def _free(port: int) -> bool:
+    with socket.socket() as s:
+        try:
+            s.bind(("127.0.0.1", port))
+        except OSError:
+            return False
+    return True
+
+
+class Hub:
+    """``jupyterhub -f course/jupyterhub_config.py`` on 127.0.0.1, its state in ``state``.
+
+    Args:
+        state: the hub's state folder (database, learners' homes, the book of ROS domains).
+        learners: the accounts allowed in.
+        domains: the ROS domains to give out.
+        extra_env: more of the hub's environment (``RTT_HUB_SPAWNER``, ``RTT_HUB_PYTHON``, ...).
+    """
+
+    def __init__(self, state: Path, learners, domains, extra_env: dict | None = None, timeout: float = 60.0):
+        self.port = free_port_block()
+        self.url = f"http://127.0.0.1:{self.port}"
+        env = dict(
+            os.environ,
+            RTT_HUB_URL=self.url,
+            RTT_HUB_STATE=str(state),
+            RTT_HUB_LEARNERS=",".join(learners),
+            RTT_HUB_PASSWORD=PASSWORD,
+            RTT_HUB_DOMAINS=",".join(str(d) for d in domains),
+            **(extra_env or {}),
+        )
+        env.pop("ROS_DOMAIN_ID", None)  # the learners' servers get theirs from the hub, nothing else
+        self.log_path = Path(state) / "hub.log"
+        Path(state).mkdir(parents=True, exist_ok=True)
+        self._log = open(self.log_path, "w")  # noqa: SIM115 - closed in close()
+        self.proc = subprocess.Popen(
+            [str(Path(sys.executable).with_name("jupyterhub")), "-f", str(ROOT / "course" / "jupyterhub_config.py")],
+            cwd=state,
+            env=env,
+            stdout=self._log,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,  # its proxy and the learners' servers stop with it (close)
+        )
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise RuntimeError(f"the hub exited: {self.log()[-2000:]}")
+            try:
+                if requests.get(self.url + "/hub/login", timeout=2).status_code == 200:
+                    return
+            except requests.ConnectionError:
+                pass
+            time.sleep(0.2)  # polling the hub's page, within the deadline
+        self.close()
+        raise RuntimeError(f"the hub did not answer within {timeout} s: {self.log()[-2000:]}")
+
+    def log(self) -> str:
+        self._log.flush()
+        return self.log_path.read_text(errors="replace")
+
+    def close(self) -> None:
+        """Stop the hub, its proxy and every learner's server (the whole session)."""
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+            try:
+                self.proc.wait(20)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait(10)
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)  # a learner's server or kernel left in the session
+        except ProcessLookupError:
+            pass
+        self._log.close()
+
+
+class Learner:
+    """One learner: a browser's cookies, their server, and a kernel in it."""
+
+    def __init__(self, hub: Hub, name: str):
+        self.hub, self.name = hub, name
+        self.http = requests.Session()
+        self.kernel_id: str | None = None
+        self.token: str | None = None
+
+    def _xsrf(self) -> str:
+        return self.http.cookies.get("_xsrf", path="/hub/") or self.http.cookies.get("_xsrf") or ""
+
+    def log_in(self, password: str = PASSWORD) -> requests.Response:
+        """Log in through the form; the response after the redirects (the spawn page, or the form again)."""
+        page = self.http.get(self.hub.url + "/hub/login", timeout=10)
+        xsrf = re.search(r'name="_xsrf" value="([^"]+)"', page.text)
+        data = {"username": self.name, "password": password, "_xsrf": xsrf.group(1) if xsrf else self._xsrf()}
+        return self.http.post(self.hub.url + "/hub/login?next=", data=data, timeout=30, allow_redirects=False)
+
+    def start_server(self, timeout: float = 120.0) -> str:
+        """Ask the hub for this learner's server and wait until it answers; its URL.
+
+        Raises:
+            RuntimeError: the hub refused (the message it gave) or the server did not start in time.
+        """
+        headers = {"X-XSRFToken": self._xsrf(), "Referer": self.hub.url + "/hub/home"}
+        r = self.http.post(f"{self.hub.url}/hub/api/users/{self.name}/server", headers=headers, timeout=60)
+        if r.status_code not in (201, 202, 400):  # 400: already running
+            raise RuntimeError(f"the hub refused {self.name}'s server: {r.status_code} {r.text[:500]}")
+        base = f"{self.hub.url}/user/{self.name}/"
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            progress = self.http.get(f"{self.hub.url}/hub/api/users/{self.name}", headers=headers, timeout=10)
+            if progress.ok:
+                server = progress.json().get("servers", {}).get("", {})
+                if server.get("ready"):
+                    # A token of this learner's, as a notebook's own requests would carry, for their server's API.
+                    t = self.http.post(
+                        f"{self.hub.url}/hub/api/users/{self.name}/tokens",
+                        headers=headers,
+                        json={"note": "test", "expires_in": 3600},
+                        timeout=30,
+                    )
+                    t.raise_for_status()
+                    self.token = t.json()["token"]
+                    return base
+                if not server and r.status_code in (201, 202) and time.monotonic() > deadline - timeout + 5:
+                    raise RuntimeError(f"{self.name}'s server stopped: {self.server_error()}")
+            time.sleep(0.5)  # polling the hub's record of the server, within the deadline
+        raise RuntimeError(f"{self.name}'s server did not start within {timeout} s")
+
+    def server_error(self) -> str:
+        """What the hub's spawn page says went wrong, as a learner reads it."""
+        page = self.http.get(f"{self.hub.url}/hub/spawn-pending/{self.name}", timeout=10)
+        return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page.text))[:2000]
+
+    def api(self, method: str, path: str, **kw) -> requests.Response:
+        """A request to this learner's server's REST API, with their token."""
+        headers = {"Authorization": f"token {self.token}"}
+        return requests.request(method, f"{self.hub.url}/user/{self.name}/{path}", headers=headers, timeout=30, **kw)
+
+    def run(self, code: str, timeout: float = 120.0) -> str:
+        """Run ``code`` in this learner's kernel (started on first use); its stdout and stderr as text.
+
+        Raises:
+            RuntimeError: the code raised (its traceback), or it did not finish in ``timeout`` s.
+        """
+        from websockets.sync.client import connect
+
+        if self.kernel_id is None:
+            r = self.api("POST", "api/kernels", json={"name": "python3"})
+            r.raise_for_status()
+            self.kernel_id = r.json()["id"]
+        url = f"ws://127.0.0.1:{self.hub.port}/user/{self.name}/api/kernels/{self.kernel_id}/channels"
+        msg_id = uuid.uuid4().hex
+        request = {
+            "header": {"msg_id": msg_id, "msg_type": "execute_request", "username": self.name,
+                       "session": uuid.uuid4().hex, "version": "5.3"},
+            "parent_header": {}, "metadata": {}, "channel": "shell",
+            "content": {"code": code, "silent": False, "store_history": False, "user_expressions": {},
+                        "allow_stdin": False, "stop_on_error": True},
+        }  # fmt: skip
+        out, error = [], None
+        deadline = time.monotonic() + timeout
+        with connect(url, additional_headers={"Authorization": f"token {self.token}"}, open_timeout=30) as ws:
+            ws.send(json.dumps(request))
+            while True:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise RuntimeError(f"code in {self.name}'s kernel did not finish in {timeout} s: {''.join(out)}")
+                msg = json.loads(ws.recv(timeout=left))
+                if msg.get("parent_header", {}).get("msg_id") != msg_id:
+                    continue
+                kind = msg["header"]["msg_type"]
+                if kind == "stream":
+                    out.append(msg["content"]["text"])
+                elif kind == "error":
+                    error = "\n".join(msg["content"]["traceback"])
+                elif kind == "status" and msg["content"]["execution_state"] == "idle":
+                    break
+        if error is not None:
+            raise RuntimeError(f"code in {self.name}'s kernel raised:\n{error}\n{''.join(out)}")
+        return "".join(out)

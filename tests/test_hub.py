@@ -1,0 +1,183 @@
+"""A class on one server: ``make hub``'s configuration gives each learner's robots to that learner alone.
+
+Two learners log in through the hub and start their servers; each server's
+environment carries the learner's own ROS domain, and what each learner's
+kernel starts (the Step 2 simulation, a joystick) lives in that domain: A's
+joystick drives A's tank and not B's, and neither sees the other's nodes.
+Both run as this machine's one Unix user (the trial's spawner), where Fast
+DDS's shared memory would carry data between them if their domains met.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+
+import pytest
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.cross_process
+
+sys.path.insert(0, str(ROOT / "course"))
+
+from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
+from hub import Hub, Learner  # noqa: E402
+
+# Two domains of the upper block (215-232), picked per test session: the test sessions' own are 1-100.
+_FIRST = 215 + (os.getpid() % 9) * 2
+DOMAINS = (_FIRST, _FIRST + 1)
+
+# What a learner's kernel runs: the Step 2 simulation (and with a joystick, its demo) for a few seconds,
+# then the summary of where the tank ended and which nodes this learner's graph held meanwhile.
+DRIVE = """
+import json, os, subprocess, sys, time
+import rclpy
+venv = os.path.dirname(sys.executable)
+sim = subprocess.Popen([os.path.join(venv, "rtt-run"), "{root}/project/step2.yaml", "--headless", "--json",
+                        "--duration", "12"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "8"],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if {with_joy} else None
+rclpy.init()
+node = rclpy.create_node("graph_look")
+seen = set()
+deadline = time.monotonic() + 10
+while time.monotonic() < deadline:
+    rclpy.spin_once(node, timeout_sec=0.2)
+    seen.update(n for n, _ in node.get_node_names_and_namespaces())
+node.destroy_node(); rclpy.shutdown()
+out, _ = sim.communicate(timeout=120)
+if joy: joy.wait(60)
+lines = [json.loads(l) for l in out.splitlines() if l.startswith("{{")]
+summary = [l for l in lines if l.get("event") == "summary"][-1]
+warnings = [l for l in lines if l.get("event") == "warning"]
+print(json.dumps({{"domain": os.environ.get("ROS_DOMAIN_ID"), "nodes": sorted(seen),
+                  "root": summary["bodies"]["Tank"]["root_position"], "warnings": warnings}}))
+"""
+
+
+@pytest.fixture
+def hub(tmp_path):
+    h = Hub(tmp_path / "hub", ["learner-a", "learner-b"], DOMAINS)
+    yield h
+    h.close()
+
+
+def run_drive(learner: Learner, with_joy: bool) -> dict:
+    out = learner.run(DRIVE.format(root=ROOT, with_joy=with_joy), timeout=180)
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def test_each_learners_robots_are_their_own(hub):
+    a, b = Learner(hub, "learner-a"), Learner(hub, "learner-b")
+    for learner in (a, b):
+        assert learner.log_in().status_code == 302, hub.log()[-2000:]
+        learner.start_server()
+    env_a = json.loads(a.run("import os, json; print(json.dumps(dict(os.environ)))"))
+    env_b = json.loads(b.run("import os, json; print(json.dumps(dict(os.environ)))"))
+    assert {env_a["ROS_DOMAIN_ID"], env_b["ROS_DOMAIN_ID"]} == {str(d) for d in DOMAINS}
+    assert env_a["RTT_ASSIGNED_ROS_DOMAIN_ID"] == env_a["ROS_DOMAIN_ID"]
+    assert env_a["ROS_AUTOMATIC_DISCOVERY_RANGE"] == env_b["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
+    book = json.loads((hub_state(hub) / "ros_domains.json").read_text())
+    assert book == {"learner-a": int(env_a["ROS_DOMAIN_ID"]), "learner-b": int(env_b["ROS_DOMAIN_ID"])}
+    assert (hub_state(hub) / "homes" / "learner-a" / "notebooks" / "01_step1_tank_controller.ipynb").is_file()
+
+    # Both drive at once: B's kernel runs its drive while A's runs in a thread of this test.
+    import threading
+
+    results, errors = {}, []
+
+    def drive(name, learner, with_joy):
+        try:
+            results[name] = run_drive(learner, with_joy)
+        except BaseException as exc:  # noqa: BLE001 - collected and asserted below
+            errors.append(exc)
+
+    threads = [
+        threading.Thread(target=drive, args=("a", a, True)),
+        threading.Thread(target=drive, args=("b", b, False)),
+    ]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(240)
+    assert not errors, errors
+    ra, rb = results["a"], results["b"]
+    rest = undriven_root()
+    moved_a = sum((x - y) ** 2 for x, y in zip(ra["root"], rest)) ** 0.5
+    moved_b = sum((x - y) ** 2 for x, y in zip(rb["root"], rest)) ** 0.5
+    assert moved_a > 0.2, ra  # A's joystick drove A's tank
+    assert moved_b < 0.001, rb  # ... and not B's
+    assert "rtt_joy" in ra["nodes"] and "rtt_joy" not in rb["nodes"], (ra["nodes"], rb["nodes"])
+    assert rb["nodes"].count("rtt") == 1 and ra["nodes"].count("rtt") == 1
+    assert ra["warnings"] == [] and rb["warnings"] == []  # no "2 nodes are named /rtt"
+
+
+def hub_state(hub: Hub):
+    return hub.log_path.parent
+
+
+def undriven_root() -> list[float]:
+    """Where the Step 2 tank's root ends after 12 s with no joystick (run here, in the test's own domain)."""
+    import subprocess
+
+    rtt_run = os.path.join(os.path.dirname(sys.executable), "rtt-run")
+    out = subprocess.run(
+        [rtt_run, str(ROOT / "project" / "step2.yaml"), "--headless", "--json", "--fast", "--duration", "12"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    ).stdout
+    [summary] = [json.loads(line) for line in out.splitlines() if '"event": "summary"' in line]
+    return summary["bodies"]["Tank"]["root_position"]
+
+
+def test_a_learner_the_book_cannot_hold_is_told_why_and_no_one_else_is_disturbed(tmp_path):
+    book = DomainBook(tmp_path / "d.json", domains=(7, 8))
+    assert book.domain_for("ada") == 7 and book.domain_for("grace") == 8
+    assert book.domain_for("ada") == 7  # kept across restarts
+    with pytest.raises(DomainError, match=r"no ROS domain left for linus: .* its 2 domains .* several servers"):
+        book.domain_for("linus")
+    with pytest.raises(DomainError, match="cannot be given a ROS domain"):
+        book.domain_for("Robert'); DROP")
+    assert book.read() == {"ada": 7, "grace": 8}  # the refusals changed nothing
+    assert DomainBook(tmp_path / "d.json", domains=(7, 8), per_learner_network=True).domain_for("linus") == 7
+    (tmp_path / "bad.json").write_text("[1, 2]")
+    with pytest.raises(DomainError, match="not a book of ROS domains"):
+        DomainBook(tmp_path / "bad.json").domain_for("ada")
+
+
+def test_the_domains_a_server_has():
+    assert len(LEARNER_DOMAINS) == 119 and 0 not in LEARNER_DOMAINS
+    assert max(LEARNER_DOMAINS) == 232 and 102 not in LEARNER_DOMAINS
+    # Fast DDS's ports of domain d start at 7400 + 250 d: below Linux's ephemeral range (32768-60999), or
+    # above it and below 65536 (ROS 2's documentation, "The ROS_DOMAIN_ID").
+    for d in LEARNER_DOMAINS:
+        base = 7400 + 250 * d
+        assert base + 11 < 32768 or (base > 60999 and base + 11 <= 65535), d  # participant 0 fits
+
+
+def test_a_learner_who_changed_their_domain_is_warned():
+    from tutorial.ros.env import assigned_domain_warning
+
+    assert assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12", "ROS_DOMAIN_ID": "12"}) is None
+    assert assigned_domain_warning({"ROS_DOMAIN_ID": "5"}) is None  # no hub, no assignment
+    text = assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12", "ROS_DOMAIN_ID": "5"})
+    assert "gave you ROS domain 12" in text and "ROS_DOMAIN_ID is 5" in text
+    assert "gave you ROS domain 12" in assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12"})
+
+
+def test_a_refused_learner_sees_the_reason_and_the_other_learner_runs(tmp_path):
+    hub = Hub(tmp_path / "hub", ["learner-a", "learner-b"], DOMAINS[:1])  # one domain for two learners
+    try:
+        a, b = Learner(hub, "learner-a"), Learner(hub, "learner-b")
+        a.log_in(), b.log_in()
+        a.start_server()
+        with pytest.raises(RuntimeError):
+            b.start_server(timeout=30)
+        assert "no ROS domain left for learner-b" in hub.log()
+        assert a.run("import os; print(os.environ['ROS_DOMAIN_ID'])").strip() == str(DOMAINS[0])
+    finally:
+        hub.close()
