@@ -159,15 +159,22 @@ class Learner:
                     t.raise_for_status()
                     self.token = t.json()["token"]
                     return base
-                if not server and r.status_code in (201, 202) and time.monotonic() > deadline - timeout + 5:
+                if not server and time.monotonic() > deadline - timeout + 5:
                     raise RuntimeError(f"{self.name}'s server stopped: {self.server_error()}")
             time.sleep(0.5)  # polling the hub's record of the server, within the deadline
         raise RuntimeError(f"{self.name}'s server did not start within {timeout} s")
 
     def server_error(self) -> str:
-        """What the hub's spawn page says went wrong, as a learner reads it."""
-        page = self.http.get(f"{self.hub.url}/hub/spawn-pending/{self.name}", timeout=10)
-        return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page.text))[:2000]
+        """What the spawn page's event log tells the learner went wrong (the hub's progress events), or ""."""
+        headers = {"X-XSRFToken": self._xsrf(), "Referer": self.hub.url + "/hub/home"}
+        url = f"{self.hub.url}/hub/api/users/{self.name}/server/progress"
+        with self.http.get(url, headers=headers, stream=True, timeout=(10, 10)) as r:
+            for line in r.iter_lines(decode_unicode=True):
+                if line and line.startswith("data:"):
+                    event = json.loads(line[5:])
+                    if event.get("failed") or event.get("ready"):
+                        return event.get("message", "")
+        return ""
 
     def api(self, method: str, path: str, **kw) -> requests.Response:
         """A request to this learner's server's REST API, with their token."""
