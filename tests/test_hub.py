@@ -18,12 +18,12 @@ import pytest
 
 from conftest import ROOT
 
-pytestmark = pytest.mark.cross_process
-
 sys.path.insert(0, str(ROOT / "course"))
 
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
 from hub import Hub, Learner  # noqa: E402
+
+from netns import net, on  # noqa: E402,F401 - net: the network tier's fixture
 
 # Two domains of the upper block (215-232), picked per test session: the test sessions' own are 1-100.
 _FIRST = 215 + (os.getpid() % 9) * 2
@@ -69,6 +69,7 @@ def run_drive(learner: Learner, with_joy: bool) -> dict:
     return json.loads(out.strip().splitlines()[-1])
 
 
+@pytest.mark.cross_process
 def test_each_learners_robots_are_their_own(hub):
     a, b = Learner(hub, "learner-a"), Learner(hub, "learner-b")
     for learner in (a, b):
@@ -142,6 +143,7 @@ def undriven_root() -> list[float]:
     return summary["bodies"]["Tank"]["root_position"]
 
 
+@pytest.mark.unit
 def test_a_learner_the_book_cannot_hold_is_told_why_and_no_one_else_is_disturbed(tmp_path):
     book = DomainBook(tmp_path / "d.json", domains=(7, 8))
     assert book.domain_for("ada") == 7 and book.domain_for("grace") == 8
@@ -157,6 +159,7 @@ def test_a_learner_the_book_cannot_hold_is_told_why_and_no_one_else_is_disturbed
         DomainBook(tmp_path / "bad.json").domain_for("ada")
 
 
+@pytest.mark.unit
 def test_the_domains_a_server_has():
     assert len(LEARNER_DOMAINS) == 119 and 0 not in LEARNER_DOMAINS
     assert max(LEARNER_DOMAINS) == 232 and 102 not in LEARNER_DOMAINS
@@ -167,6 +170,7 @@ def test_the_domains_a_server_has():
         assert base + 11 < 32768 or (base > 60999 and base + 11 <= 65535), d  # participant 0 fits
 
 
+@pytest.mark.unit
 def test_a_learner_who_changed_their_domain_is_warned():
     from tutorial.ros.env import assigned_domain_warning
 
@@ -175,3 +179,24 @@ def test_a_learner_who_changed_their_domain_is_warned():
     text = assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12", "ROS_DOMAIN_ID": "5"})
     assert "gave you ROS domain 12" in text and "ROS_DOMAIN_ID is 5" in text
     assert "gave you ROS domain 12" in assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12"})
+
+
+@pytest.mark.network
+def test_with_a_network_namespace_each_learners_may_share_a_domain(procs, net):  # noqa: F811 - the fixture
+    """Containers or pods: each learner's server in a network namespace of its own, the same ROS domain.
+
+    Both simulations are named /rtt in one domain; each learner's nodes find each other over their own
+    loopback (localhost discovery, as the hub sets it), never the other's, though the hosts are linked.
+    """
+    a, b = net["robot"], net["operator"]
+    learner = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}  # what the hub gives every learner's server
+    sim_args = ("tutorial.tools.rtt_run", str(ROOT / "project" / "step2.yaml"), "--headless", "--json")
+    sim_a = on(procs, a, *sim_args, "--duration", "10", **learner)
+    sim_b = on(procs, b, *sim_args, "--duration", "10", **learner)
+    joy_a = on(procs, a, "tutorial.tools.rtt_joy", "--demo", "--duration", "6", **learner)
+    assert sim_a.wait(90) == 0 and sim_b.wait(90) == 0, (sim_a.err, sim_b.err)
+    joy_a.wait(60)
+    summary_a, summary_b = sim_a.summary(), sim_b.summary()
+    assert summary_a["controllers"]["RttTankController"]["joy_received"] > 10  # A's joystick drove A's tank
+    assert summary_b["controllers"]["RttTankController"]["joy_received"] == 0  # ... and nothing reached B's
+    assert sim_a.records("warning") == [] and sim_b.records("warning") == []  # neither saw the other /rtt
