@@ -8,6 +8,7 @@
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
+#       make test-hub (the hub with learners as Unix users: slow),
 #       make export (write the controllers from the notebooks that build them),
 #       make run-notebooks (run every notebook and save its outputs, the ones nbval checks),
 #       make lock (uv.lock anew: the newest versions pyproject.toml allows), make test-latest (make test against
@@ -17,7 +18,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast test-lab test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab test-hub test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
 
 UV_VERSION := 0.13.9
 
@@ -37,10 +38,15 @@ demo: $(VENV)/.installed
 	$(PY) launch_py/step3_launch.py --demo
 
 # Every tier (tests/conftest.py lists them), the notebooks under nbval, after the lint gate.
-test: $(VENV)/.installed lint
+test: $(VENV)/.installed lint course/node_modules/.installed
 	bash scripts/ensure-chromium.sh
 	bash scripts/ensure-nftables.sh
-	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
+	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks -m "not slow" --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
+
+# The hub's slow test: two learners as two Unix users of this machine (root; Debian's python3), each with their
+# own robots (make test runs the hub with two learners under one user, and with a network namespace each).
+test-hub: $(VENV)/.installed course/node_modules/.installed
+	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_hub.py -m slow -q
 
 # The unit tier only: no ROS, no process, no browser.
 test-fast: $(VENV)/.installed

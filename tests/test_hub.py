@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -200,3 +201,83 @@ def test_with_a_network_namespace_each_learners_may_share_a_domain(procs, net): 
     assert summary_a["controllers"]["RttTankController"]["joy_received"] > 10  # A's joystick drove A's tank
     assert summary_b["controllers"]["RttTankController"]["joy_received"] == 0  # ... and nothing reached B's
     assert sim_a.records("warning") == [] and sim_b.records("warning") == []  # neither saw the other /rtt
+
+
+# ---- learners as Unix users (The Littlest JupyterHub's way): slow (an environment to build), `make test-hub` ----
+
+
+@pytest.fixture(scope="module")
+def shared_environment(tmp_path_factory):
+    """The project's environment on Debian's Python, in a folder every user can read (root's own Python cannot)."""
+    import shutil
+    import stat
+    import subprocess
+
+    system_python = shutil.which("python3", path="/usr/bin")
+    if os.geteuid() != 0 or not system_python:
+        pytest.skip("learners as Unix users need root (to make them) and Debian's /usr/bin/python3")
+    for parent in [ROOT, *ROOT.parents]:
+        if not parent.stat().st_mode & stat.S_IXOTH:
+            pytest.skip(f"other users cannot enter {parent}, where the project is")
+    folder = tmp_path_factory.mktemp("learners_env")
+    for parent in [folder, *folder.parents]:
+        os.chmod(parent, parent.stat().st_mode | stat.S_IXOTH | stat.S_IROTH)
+    env = dict(os.environ, UV_PROJECT_ENVIRONMENT=str(folder / "venv"))
+    uv = os.path.join(os.path.dirname(sys.executable), "uv")
+    subprocess.run(
+        [uv, "sync", "--locked", "--inexact", "--all-extras", "--python", system_python, "--quiet"],
+        cwd=ROOT,
+        env=env,
+        check=True,
+        timeout=600,
+    )
+    return folder / "venv" / "bin" / "python"
+
+
+@pytest.fixture
+def unix_learners():
+    """Two Unix users of this machine, removed afterwards with everything they ran and owned."""
+    import subprocess
+
+    names = [f"rttl{os.getpid() % 100000}{x}" for x in "ab"]
+    for name in names:
+        subprocess.run(["useradd", "--create-home", "--shell", "/bin/bash", name], check=True, timeout=30)
+    try:
+        yield names
+    finally:
+        for name in names:
+            subprocess.run(["pkill", "-KILL", "-u", name], timeout=30, check=False)
+            subprocess.run(["userdel", "--remove", name], capture_output=True, timeout=30, check=False)
+
+
+@pytest.mark.slow
+@pytest.mark.cross_process
+def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environment, unix_learners):
+    hub = Hub(
+        tmp_path / "hub",
+        unix_learners,
+        DOMAINS,
+        extra_env={"RTT_HUB_SPAWNER": "users", "RTT_HUB_PYTHON": str(shared_environment)},
+    )
+    try:
+        a, b = (Learner(hub, name) for name in unix_learners)
+        for learner in (a, b):
+            assert learner.log_in().status_code == 302, hub.log()[-2000:]
+            learner.start_server()
+        import pwd
+
+        for learner in (a, b):
+            uid, home = learner.run("import os; print(os.getuid(), os.path.expanduser('~'))").split()
+            entry = pwd.getpwnam(learner.name)
+            assert (int(uid), home) == (entry.pw_uid, entry.pw_dir)
+            assert (Path(home) / "notebooks" / "02_step2_joint_state_publisher.ipynb").stat().st_uid == entry.pw_uid
+        results = {}
+        for name, learner, with_joy in (("a", a, True), ("b", b, False)):  # one after the other: a slow machine
+            results[name] = run_drive(learner, with_joy)
+        rest = undriven_root()
+        moved = {k: sum((x - y) ** 2 for x, y in zip(r["root"], rest)) ** 0.5 for k, r in results.items()}
+        assert moved["a"] > 0.2 and moved["b"] < 0.001, (moved, results)
+        assert results["a"]["domain"] != results["b"]["domain"]
+        assert "rtt_joy" not in results["b"]["nodes"]
+    finally:
+        hub.close()
