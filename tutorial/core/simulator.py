@@ -26,8 +26,8 @@ from tutorial.core.controller import ControllerIO, SimpleController
 # publisher sends one message a millisecond.  Shorter sleeps are lost in the
 # operating system's wake-up time.  Sleeping only when 2 ms ahead (two steps at
 # a time) saved CPU, but a subscriber then got pairs of messages: keeping the
-# newest, it dropped half of them and showed the other half later (1.5x the bare
-# rclpy pair's latency at p50 instead of 1.3x, book/benchmarks.md).
+# newest, it dropped half of them and showed the other half later (the 1 kHz
+# latency targets of the book's Benchmarks page).
 REALTIME_MIN_SLEEP = 0.0002  # s
 
 

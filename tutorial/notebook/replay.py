@@ -25,10 +25,9 @@ CPU, as the live page is (``rttLighten``, :mod:`tutorial.view.meshcat_page`:
 no multisampling, fewer triangles for round shapes, opaque closed shapes
 from the front only, the background painted once), and draws only while
 the page is in sight.  A recording loops its animation for as long as it is
-open, and a browser draws an offscreen frame's animation as well: on this
-GPU-less machine one 900 x 380 recording took Chromium 1.8 cores with
-meshcat's settings and 1.3 to 1.5 made lighter; scrolled out of sight it
-still took 1.2, and 0.17 once out-of-sight drawing stopped.
+open, and a browser draws an offscreen frame's animation as well: without
+a GPU, each recording in a notebook took Chromium more than a core, scrolled
+out of sight too (measured in ``benchmarks/RESULTS.md``).
 
 Any thread may build a page: nothing here touches a live server.
 """

@@ -25,8 +25,8 @@ def make_executor(context):
 
     It is the executor ``rclpy.spin()`` uses, so a learner's own nodes run
     their callbacks the way this tutorial's do.  rclpy's ``EventsExecutor``
-    dispatches from C++ and measured faster here (``book/benchmarks.md``: at
-    1 kHz the viewer shows each state sooner and uses less CPU), but in Jazzy
+    dispatches from C++ and measured faster here (the book's Benchmarks page,
+    "What each figure compares": the 1 kHz rounds run it too), but in Jazzy
     it is experimental: it refuses guard conditions, and its ``shutdown()``
     and ``create_task()`` hang when called from another thread while it
     spins (``SpinThread`` never does that).  It is not kept out for losing

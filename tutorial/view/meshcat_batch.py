@@ -4,10 +4,9 @@ meshcat's protocol has one message per command, so a frame that moves
 three bodies costs the server three forwards and the page three WebSocket
 messages, each a task on the page's main thread.  On a machine without a
 GPU the page rasterizes on the same cores as the simulation, and those
-tasks added to the time from the viewer's send to the pixel: with eight
-tanks, one message a frame (and no multisampling, see
-:mod:`tutorial.view.meshcat_page`) took the p50 from 67 to 31-38 ms
-(``make bench``'s publish-to-pixel experiment; the book's Benchmarks page).
+tasks add to the time from the viewer's send to the pixel; one message a
+frame takes them away (``make bench``'s publish-to-pixel experiment: the
+book's Benchmarks page, "From publish to pixel").
 
 ``set_transforms`` holds a frame's ``set_transform`` commands, each exactly
 as meshcat-python lowers it::

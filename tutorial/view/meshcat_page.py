@@ -14,9 +14,8 @@ things:
 - **it drops multisampling on a software renderer**.  meshcat asks for a
   4x multisampled (antialiased) canvas.  Without a GPU, Chromium rasterizes
   WebGL on the CPU (SwiftShader; Mesa's llvmpipe, Windows' WARP
-  elsewhere), where multisampling costs a third to a half of the frame
-  rate (measured, drawing every frame on an idle 2-core machine: 8 tanks
-  30.7 -> 48.1 frames/s, the 48-joint arm 7.7 -> 17.8); on a GPU it is
+  elsewhere), where multisampling costs a large share of the frame rate
+  (the book's Benchmarks page, "From publish to pixel"); on a GPU it is
   nearly free and is kept.  The script asks WebGL which renderer it got
   and, on a software one, gives meshcat's viewer a renderer without it
   (meshcat reads ``viewer.renderer`` each time it draws, resizes or
@@ -24,13 +23,11 @@ things:
   ``?antialias=1`` or ``?antialias=0`` (also ``true``/``false``,
   ``yes``/``no``, ``on``/``off``) in the page's address decides instead;
 - **it draws a lighter scene on a software renderer** (low detail): first,
-  round shapes with fewer triangles.  meshcat asks three.js for 20 x 20 segments a sphere and
-  50 a cylinder: a capsule is about 1,700 triangles, and the 48-joint
-  arm's 48 capsules are 83,000, which SwiftShader drew at 40 frames/s on
-  the idle machine and at 16 to 30 while the simulation and the viewer
-  ran.  Low detail caps the counts at :data:`COARSE_SEGMENTS` (a capsule
-  about 400 triangles; the arm then drew 60 frames/s, the idle machine's
-  per-frame CPU for 8 tanks fell by a quarter).  The page changes its
+  round shapes with fewer triangles.  meshcat asks three.js for 20 x 20
+  segments a sphere and 50 a cylinder: a capsule is about 1,700
+  triangles, and the 48-joint arm's 48 capsules are 83,000.  Low detail
+  caps the counts at :data:`COARSE_SEGMENTS` (a capsule about 400
+  triangles).  The page changes its
   own copy of each ``set_object`` before meshcat's loader reads it; the
   server keeps meshcat's counts, so each page chooses for itself.  Boxes
   and meshes keep their triangles.  Low detail also draws opaque closed
@@ -42,10 +39,10 @@ things:
   transparent canvas, where meshcat draws it as a textured quad over the
   whole canvas every frame; a frame read back as a picture (meshcat's
   ``capture_image``, its animation recording) is drawn with meshcat's own.
-  Screenshots of the tank and the arm are the same to a unit of rounding;
-  on the idle machine, drawing every frame, Chromium's GPU process took
-  1.1 cores for the arm's page instead of 1.5, 0.9 for eight tanks'
-  instead of 1.35.  ``?detail=full`` or ``?detail=low`` decides instead.
+  Screenshots of the tank and the arm are the same to a unit of rounding
+  (tests/test_browser.py); what each change saves is measured on the
+  book's Benchmarks page ("From publish to pixel"; the history in
+  ``benchmarks/RESULTS.md``).  ``?detail=full`` or ``?detail=low`` decides instead.
 
 ``window.rttPage`` says what was chosen:
 ``{renderer: "...", software: true, antialias: false, detail: "low"}``.
