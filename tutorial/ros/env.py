@@ -102,7 +102,7 @@ def sourced_ros_installation(
         "Two builds of rclpy on one path fail in confusing ways. Run the rtt-* programs and notebooks in a "
         "shell that has not sourced /opt/ros/<distro>/setup.bash (open a new terminal, or `env -u PYTHONPATH "
         "-u AMENT_PREFIX_PATH -u LD_LIBRARY_PATH ...`), and ros2, RViz2 and robot_state_publisher in another "
-        f"(see the README, 'With ROS 2 installed'). {ALLOW_SOURCED_ROS_VARIABLE}=1 skips this check."
+        f"(see the book's 'With ROS 2 installed'). {ALLOW_SOURCED_ROS_VARIABLE}=1 skips this check."
     )
 
 
