@@ -41,7 +41,7 @@ demo: $(VENV)/.installed
 test: $(VENV)/.installed lint course/node_modules/.installed
 	bash scripts/ensure-chromium.sh
 	bash scripts/ensure-nftables.sh
-	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks -m "not slow" --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
+	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks -m "not slow" --durations=15 --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
 
 # The hub's slow test: two learners as two Unix users of this machine (root; Debian's python3), each with their
 # own robots (make test runs the hub with two learners under one user, and with a network namespace each).

@@ -132,6 +132,11 @@ class Learner:
         data = {"username": self.name, "password": password, "_xsrf": xsrf.group(1) if xsrf else self._xsrf()}
         return self.http.post(self.hub.url + "/hub/login?next=", data=data, timeout=30, allow_redirects=False)
 
+    def request_server(self) -> requests.Response:
+        """Ask the hub to start this learner's server; the hub's answer (201, 202, or 400 if already running)."""
+        headers = {"X-XSRFToken": self._xsrf(), "Referer": self.hub.url + "/hub/home"}
+        return self.http.post(f"{self.hub.url}/hub/api/users/{self.name}/server", headers=headers, timeout=60)
+
     def start_server(self, timeout: float = 120.0) -> str:
         """Ask the hub for this learner's server and wait until it answers; its URL.
 
@@ -139,7 +144,7 @@ class Learner:
             RuntimeError: the hub refused (the message it gave) or the server did not start in time.
         """
         headers = {"X-XSRFToken": self._xsrf(), "Referer": self.hub.url + "/hub/home"}
-        r = self.http.post(f"{self.hub.url}/hub/api/users/{self.name}/server", headers=headers, timeout=60)
+        r = self.request_server()
         if r.status_code not in (201, 202, 400):  # 400: already running
             raise RuntimeError(f"the hub refused {self.name}'s server: {r.status_code} {r.text[:500]}")
         base = f"{self.hub.url}/user/{self.name}/"

@@ -37,13 +37,13 @@ import json, os, subprocess, sys, time
 import rclpy
 venv = os.path.dirname(sys.executable)
 sim = subprocess.Popen([os.path.join(venv, "rtt-run"), "{root}/project/step2.yaml", "--headless", "--json",
-                        "--duration", "12"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "8"],
+                        "--duration", "7"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "5"],
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if {with_joy} else None
 rclpy.init()
 node = rclpy.create_node("graph_look")
 seen = set()
-deadline = time.monotonic() + 10
+deadline = time.monotonic() + 5
 while time.monotonic() < deadline:
     rclpy.spin_once(node, timeout_sec=0.2)
     seen.update(n for n, _ in node.get_node_names_and_namespaces())
@@ -75,6 +75,8 @@ def test_each_learners_robots_are_their_own(hub):
     a, b = Learner(hub, "learner-a"), Learner(hub, "learner-b")
     for learner in (a, b):
         assert learner.log_in().status_code == 302, hub.log()[-2000:]
+        learner.request_server()  # both start at once, as a class does
+    for learner in (a, b):
         learner.start_server()
     env_a = json.loads(a.run("import os, json; print(json.dumps(dict(os.environ)))"))
     env_b = json.loads(b.run("import os, json; print(json.dumps(dict(os.environ)))"))
@@ -129,12 +131,12 @@ def hub_state(hub: Hub):
 
 
 def undriven_root() -> list[float]:
-    """Where the Step 2 tank's root ends after 12 s with no joystick (run here, in the test's own domain)."""
+    """Where the Step 2 tank's root ends after 7 s with no joystick (run here, in the test's own domain)."""
     import subprocess
 
     rtt_run = os.path.join(os.path.dirname(sys.executable), "rtt-run")
     out = subprocess.run(
-        [rtt_run, str(ROOT / "project" / "step2.yaml"), "--headless", "--json", "--fast", "--duration", "12"],
+        [rtt_run, str(ROOT / "project" / "step2.yaml"), "--headless", "--json", "--fast", "--duration", "7"],
         capture_output=True,
         text=True,
         timeout=120,
