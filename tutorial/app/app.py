@@ -129,7 +129,10 @@ class App:
         self.model = build_world(self.project.models, **kwargs)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
-        self.bodies = {m.name: Body(self.model, self.data, m.name) for m in self.project.models}
+        # a robot drawn from its description: its mimic joints follow their leaders (Body's mimic)
+        self.bodies = {
+            m.name: Body(self.model, self.data, m.name, mimic=m.description is not None) for m in self.project.models
+        }
         if self._own_node:
             from tutorial.ros.spin import SpinThread
 

@@ -37,9 +37,11 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
     fqn = node.get_fully_qualified_name()
     for entry in waiting:
         urdf = receive_robot_description(node, entry.description, timeout)
-        text, dropped, tree = load_description(urdf, entry.description)
+        text, left_out, tree = load_description(urdf, entry.description)
         models[models.index(entry)] = dataclasses.replace(entry, text=text)
-        note = f"; {dropped} mesh visuals left out (package:// names need ROS)" if dropped else ""
+        note = f"; {len(left_out)} mesh visuals left out" if left_out else ""
+        for line in left_out:  # which mesh, and why: the rest of the robot is drawn
+            output({"event": "warning", "node": fqn, "body": entry.name, "message": f"{entry.description}: {line}"})
         output(
             {
                 "event": "description",

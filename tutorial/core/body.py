@@ -168,6 +168,11 @@ class Body:
         model: the world's compiled model, from :func:`tutorial.core.world.build_world`.
         data: the ``MjData`` to read and write; its owner thread owns this Body.
         name: the model's name in the world (``Tank``), the prefix of its elements.
+        mimic: a joint coupled to another by a joint equality constraint (what
+            MuJoCo makes of a URDF ``<mimic>``: a gripper's second finger)
+            follows its leader in :meth:`notify_kinematic_state_change`, and
+            is not numbered (a JointState does not carry it).  For a model
+            that is drawn, not simulated: a simulation enforces the constraint.
 
     Attributes:
         root_ids: the model's top-level bodies (children of the world body), ids in order.
@@ -178,13 +183,16 @@ class Body:
         joint_infos: the numbered joints' static facts, in model order.
         skipped_joints: joint name -> why it is not numbered, for every other
             joint the body owns.
+        followers: with ``mimic``, ``(follower qpos address, leader qpos address,
+            polynomial coefficients (5,), follower's and leader's reference
+            positions)`` per following joint.
 
     Raises:
         KeyError: the world has no model named ``name``: no top-level body and
             no world geom or site is named ``name/...``.
     """
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, name: str):
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, name: str, mimic: bool = False):
         self.model = model
         self.data = data
         self.name = name
@@ -208,6 +216,12 @@ class Body:
         # A model of static geoms only (a room) has no link: its root is the world body.
         self.root_id = self.root_ids[0] if self.root_ids else 0
         self.joint_infos, self.skipped_joints = self._sort_joints()
+        self.followers = self._followers() if mimic else []
+        if self.followers:
+            following = {int(m.jnt_qposadr[j]) for j in self.joint_ids} & {f[0] for f in self.followers}
+            for info in [i for i in self.joint_infos if i.qpos_adr in following]:
+                self.skipped_joints[info.name] = "follows another joint (a URDF mimic joint)"
+            self.joint_infos = [i for i in self.joint_infos if i.qpos_adr not in following]
         self.joints = [Joint(info, data) for info in self.joint_infos]
         self._by_name = {j.name: j for j in self.joints}
 
@@ -350,8 +364,24 @@ class Body:
         draws a frame soon after (:meth:`tutorial.app.app.App.next_frame_due`).
         Only the owner thread of the data may call it.
         """
+        for follower, leader, coef, q1_ref, q2_ref in self.followers:  # mimic joints first (see mimic)
+            x = self.data.qpos[leader] - q2_ref
+            self.data.qpos[follower] = q1_ref + coef[0] + x * (coef[1] + x * (coef[2] + x * (coef[3] + x * coef[4])))
         mujoco.mj_kinematics(self.model, self.data)
         self.kinematic_state_changes += 1
+
+    def _followers(self) -> list:
+        """The body's joint equality constraints between two hinge or slide joints (see ``mimic``)."""
+        m, out = self.model, []
+        for e in range(m.neq):
+            if m.eq_type[e] != mujoco.mjtEq.mjEQ_JOINT or m.eq_obj2id[e] < 0:
+                continue
+            j1, j2 = int(m.eq_obj1id[e]), int(m.eq_obj2id[e])
+            if j1 not in self.joint_ids or j2 not in self.joint_ids:
+                continue
+            a1, a2 = int(m.jnt_qposadr[j1]), int(m.jnt_qposadr[j2])
+            out.append((a1, a2, m.eq_data[e][:5].copy(), float(m.qpos0[a1]), float(m.qpos0[a2])))
+        return out
 
 
 def _name(model: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:

@@ -1,0 +1,222 @@
+"""The Step 3 monitor draws robots no one here wrote, from their descriptions as ROS publishes them.
+
+Three robots of ``example-robot-data`` (BSD-licensed URDFs and meshes): the
+Franka Panda (Collada visuals, a mimic finger), the UR5 (Collada) and the
+SO-100 arm (STL), each published on ``/<name>/robot_description`` with its
+``package://`` URIs as shipped, ``AMENT_PREFIX_PATH`` naming the package's
+prefix, and a sine JointState on ``/<name>/joint_state``.  The monitor must
+draw every visual, end on the publisher's final positions, and put every
+link where ``yourdfpy``'s forward kinematics puts it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sysconfig
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+PREFIX = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix"
+ROBOTS = PREFIX / "share" / "example-robot-data" / "robots"
+CASES = {
+    "Panda": "panda_description/urdf/panda.urdf",
+    "UR5": "ur_description/urdf/ur5_robot.urdf",
+    "SO100": "so_arm_description/urdf/so100.urdf",
+}
+
+pytestmark = pytest.mark.skipif(not ROBOTS.is_dir(), reason="example-robot-data is not installed (make installs it)")
+
+
+def project(name: str, folder: Path):
+    from tutorial.core.project import load_project
+
+    path = folder / f"monitor_{name}.yaml"
+    path.write_text(
+        f"""name: monitor_{name}
+models:
+  - name: {name}
+    description: /{name}/robot_description
+    controllers:
+      - name: RttJointStateMonitor
+        class: tutorial.controllers.joint_state_subscriber:RttJointStateMonitor
+"""
+    )
+    return load_project(path)
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_the_monitor_draws_a_real_robot_from_its_published_description(ros, node, tmp_path, monkeypatch, name):
+    import yourdfpy
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import String
+
+    from tutorial.app.app import App
+    from tutorial.interfaces.joint_state import joint_state_qos
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(PREFIX))  # where package://example-robot-data/ is
+    monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))
+    urdf = (ROBOTS / CASES[name]).read_text()
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
+    description = node.create_publisher(String, f"/{name}/robot_description", latched)
+    description.publish(String(data=urdf))
+    states = node.create_publisher(JointState, f"/{name}/joint_state", joint_state_qos())
+
+    robot = yourdfpy.URDF.load(str(ROBOTS / CASES[name]), load_meshes=False, build_collision_scene_graph=False)
+    moving = list(robot.actuated_joint_names)  # a mimic joint is not among them: JointState does not carry it
+    records = []
+    app = App(project(name, tmp_path), node_name=f"monitor_{name.lower()}", headless=True, output=records.append)
+    try:
+        app.open()
+        said = [r for r in records if r.get("event") == "description"]
+        assert said and "visuals left out" not in said[0]["line"], said
+        assert [r for r in records if r.get("event") == "warning"] == []
+        body = app.bodies[name]
+        visuals = sum(len(link.visuals) for link in robot.robot.links)
+        drawn = sum(1 for g in body.geom_ids if app.model.geom_group[g] < 3)
+        assert drawn >= visuals, (drawn, visuals)  # a Collada file of several colours draws as several geoms
+
+        final = None
+        for k in range(40):  # a sine, joint by joint, inside each joint's limits
+            q = []
+            for j, joint_name in enumerate(moving):
+                joint = robot.joint_map[joint_name]
+                lo, hi = (joint.limit.lower, joint.limit.upper) if joint.limit else (-math.pi, math.pi)
+                lo, hi = (lo, hi) if lo is not None and hi is not None and hi > lo else (-1.0, 1.0)
+                q.append(lo + (hi - lo) * (0.5 + 0.4 * math.sin(0.3 * k + j)))
+            msg = JointState(name=moving, position=q)
+            msg.header.stamp.sec = k
+            states.publish(msg)
+            final = dict(zip(moving, q))
+        monitor = app.controller("RttJointStateMonitor")
+        app.loop.run_until(
+            lambda: body.joint_positions() and all(abs(body.joint(n).q - final[n]) <= 1e-6 for n in moving),
+            timeout=30,
+        )
+        shown = body.joint_positions()
+        assert all(abs(shown[n] - final[n]) <= 1e-6 for n in moving), (shown, final)
+        assert monitor.summary()["rejected"] == {}
+
+        robot.update_cfg({n: final[n] for n in moving})  # yourdfpy applies the mimic joints itself
+        import mujoco
+
+        checked = 0
+        for link in robot.robot.links:
+            b = mujoco.mj_name2id(app.model, mujoco.mjtObj.mjOBJ_BODY, f"{name}/{link.name}")
+            if b < 0 and link.name == robot.base_link:
+                continue  # the root link, fixed to the world: MuJoCo makes it part of the world body
+            assert b >= 0, f"no body for link {link.name}"
+            checked += 1
+            expected = robot.get_transform(link.name, robot.base_link)
+            assert np.abs(app.data.xpos[b] - expected[:3, 3]).max() <= 1e-6, link.name
+            assert np.abs(app.data.xmat[b].reshape(3, 3) - expected[:3, :3]).max() <= 1e-6, link.name
+        assert checked >= len(robot.robot.links) - 1
+    finally:
+        app.close()
+
+
+def test_a_mesh_that_cannot_be_found_or_read_leaves_out_only_its_visual(tmp_path, monkeypatch):
+    from tutorial.urdf.mujoco_load import mujoco_text
+
+    monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))
+    broken = tmp_path / "broken.dae"
+    broken.write_text("<COLLADA><library_geometries>")  # cut short
+    truncated = tmp_path / "cut.stl"
+    truncated.write_bytes((ROBOTS / "so_arm_description" / "meshes" / "so100" / "Base.stl").read_bytes()[:300])
+    good = ROBOTS / "so_arm_description" / "meshes" / "so100" / "Base.stl"
+    urdf = f"""<robot name="r">
+  <link name="a"><visual><geometry><mesh filename="package://nowhere/meshes/a.stl"/></geometry></visual></link>
+  <link name="b"><visual><geometry><mesh filename="file://{broken}"/></geometry></visual></link>
+  <link name="c"><visual><geometry><mesh filename="file://{truncated}"/></geometry></visual></link>
+  <link name="d"><visual><geometry><mesh filename="file://{good}"/></geometry></visual></link>
+  <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
+  <joint name="bc" type="fixed"><parent link="b"/><child link="c"/></joint>
+  <joint name="cd" type="fixed"><parent link="c"/><child link="d"/></joint>
+</robot>"""
+    text, left_out = mujoco_text(urdf, environ={"AMENT_PREFIX_PATH": str(tmp_path / "ros")})
+    assert len(left_out) == 3 and all("\n" not in line for line in left_out)
+    assert left_out[0].startswith("link a: visual left out: package://nowhere/meshes/a.stl: not found (looked in ")
+    assert str(tmp_path / "ros" / "share" / "nowhere") in left_out[0]
+    assert left_out[1].startswith("link b: visual left out:") and "broken.dae" in left_out[1]
+    assert left_out[2].startswith("link c: visual left out:") and "cut.stl" in left_out[2]
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_string(text)
+    assert model.nmesh == 1 and model.ngeom == 1  # link d still drawn
+
+
+def test_package_uris_are_found_as_ros_finds_them(tmp_path):
+    from tutorial.urdf.mesh_files import MeshError, resolve_mesh
+
+    ament, ros1 = tmp_path / "install", tmp_path / "src"
+    (ament / "share" / "arm" / "meshes").mkdir(parents=True)
+    (ament / "share" / "arm" / "meshes" / "a.stl").write_text("solid")
+    (ros1 / "gripper" / "meshes").mkdir(parents=True)
+    (ros1 / "gripper" / "meshes" / "g.stl").write_text("solid")
+    env = {"AMENT_PREFIX_PATH": f"{tmp_path / 'other'}{os.pathsep}{ament}", "ROS_PACKAGE_PATH": str(ros1)}
+    assert resolve_mesh("package://arm/meshes/a.stl", env) == ament / "share" / "arm" / "meshes" / "a.stl"
+    assert resolve_mesh("package://gripper/meshes/g.stl", env) == ros1 / "gripper" / "meshes" / "g.stl"
+    assert resolve_mesh(f"file://{ament}/share/arm/meshes/a.stl", env).name == "a.stl"
+    with pytest.raises(MeshError, match=r"package://arm/meshes/b.stl: not found \(looked in .*other/share/arm"):
+        resolve_mesh("package://arm/meshes/b.stl", env)
+    with pytest.raises(MeshError, match="http:// names cannot be read here"):
+        resolve_mesh("http://example.com/a.stl", env)
+
+
+def test_a_converted_mesh_is_cached(tmp_path):
+    from tutorial.urdf.mesh_files import drawable_meshes
+
+    dae = ROBOTS / "panda_description" / "meshes" / "visual" / "link0.dae"
+    cold = drawable_meshes(dae, tmp_path)
+    warm = drawable_meshes(dae, tmp_path)
+    assert cold == warm and all(p.suffix == ".stl" and p.is_file() for p, _ in cold)
+    assert len({rgba for _, rgba in cold}) == len(cold) > 1  # the file's colours, one STL each
+    stamps = [p.stat().st_mtime_ns for p, _ in warm]
+    drawable_meshes(dae, tmp_path)
+    assert [p.stat().st_mtime_ns for p, _ in warm] == stamps  # not written again
+
+
+def light_grey_pixels(image: np.ndarray) -> int:
+    """Pixels of a white or light grey robot (the Panda's paint) against meshcat's blue background."""
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    return int(np.count_nonzero((abs(r - b) < 0.08) & (abs(r - g) < 0.08) & (r > 0.6)))
+
+
+@pytest.mark.browser
+def test_the_panda_is_drawn_with_its_collada_meshes(ros, node, tmp_path, monkeypatch):
+    """In Chromium: the Panda's converted meshes are on the page; with its meshes unfound, only the floor is."""
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from std_msgs.msg import String
+
+    from tutorial.app.app import App
+
+    from browser import chromium, screenshot
+
+    if not chromium():
+        pytest.skip("no chromium (make test installs Debian's)")
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(PREFIX))
+    monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
+    urdf = (ROBOTS / CASES["Panda"]).read_text()
+    counts = {}
+    for case, text in (("meshes", urdf), ("no meshes", urdf.replace("package://", "package://missing_"))):
+        topic = f"/Panda_{len(counts)}/robot_description"
+        node.create_publisher(String, topic, latched).publish(String(data=text))
+        records = []
+        (tmp_path / "p.yaml").write_text(f"name: p\nmodels:\n  - name: Panda\n    description: {topic}\n")
+        from tutorial.core.project import load_project
+
+        app = App(load_project(tmp_path / "p.yaml"), node_name=f"panda_page_{len(counts)}", output=records.append)
+        try:
+            app.open()
+            app.step(0.1)
+            url = next(r["url"] for r in records if r.get("event") == "meshcat")
+            counts[case] = light_grey_pixels(screenshot(url, tmp_path / f"{len(counts)}.png"))
+            warnings = [r for r in records if r.get("event") == "warning"]
+            assert (len(warnings) == 0) == (case == "meshes"), warnings
+        finally:
+            app.close()
+    assert counts["meshes"] > 1000 and counts["no meshes"] < 500, counts
