@@ -82,3 +82,60 @@ def test_every_entry_gets_exactly_one_outcome(tank):
         assert r.matched + len(r.rejected) == max(len(names), len(positions))
         assert set(r.counts()) <= set(REASONS)
         assert all(math.isfinite(v) for v in r.applied.values())
+
+
+@pytest.fixture(scope="module")
+def mixed(tmp_path_factory):
+    """A limited hinge, an unlimited hinge and a limited slide: what the tank alone does not have."""
+    path = tmp_path_factory.mktemp("mixed") / "mixed.xml"
+    path.write_text(
+        """<mujoco model="mixed"><compiler angle="radian"/><worldbody><body name="base">
+  <joint name="pan" type="hinge" range="-1 1" limited="true"/>
+  <geom type="box" size="0.1 0.1 0.1"/>
+  <body name="spinner" pos="0 0 0.3"><joint name="spin" type="hinge" limited="false"/>
+    <geom type="box" size="0.05 0.05 0.05"/>
+    <body name="carriage" pos="0 0 0.2"><joint name="lift" type="slide" range="0 0.5" limited="true"/>
+      <geom type="box" size="0.02 0.02 0.02"/></body></body></body></worldbody></mujoco>"""
+    )
+    model = build_world([ModelEntry("Mixed", path)])
+    return Body(model, mujoco.MjData(model), "Mixed")
+
+
+# A table written by hand (not by match_joint_state): (names, positions, applied, rejected reasons by entry).
+HAND_TABLE = [
+    # limits, with their tolerance: 0.05 rad for a hinge, 0.01 m for a slide, at both ends
+    (["pan"], [-1.0 - 0.049], {"pan": -1.049}, {}),
+    (["pan"], [-1.0 - 0.051], {}, {0: "out_of_range"}),
+    (["pan"], [1.0 + 0.049], {"pan": 1.049}, {}),
+    (["pan"], [1.0 + 0.051], {}, {0: "out_of_range"}),
+    (["lift"], [-0.009], {"lift": -0.009}, {}),
+    (["lift"], [-0.011], {}, {0: "out_of_range"}),
+    (["lift"], [0.509], {"lift": 0.509}, {}),
+    (["lift"], [0.511], {}, {0: "out_of_range"}),
+    # an unlimited joint takes any finite value, and never an infinite one
+    (["spin"], [1e6], {"spin": 1e6}, {}),
+    (["spin"], [-1e6], {"spin": -1e6}, {}),
+    (["spin"], [math.inf], {}, {0: "not_finite"}),
+    (["spin"], [-math.inf], {}, {0: "not_finite"}),
+    (["spin"], [math.nan], {}, {0: "not_finite"}),
+    # a name given three times: all three rejected, the others applied
+    (
+        ["pan", "spin", "pan", "pan"],
+        [0.1, 0.2, 0.3, 0.4],
+        {"spin": 0.2},
+        {0: "duplicate_name", 2: "duplicate_name", 3: "duplicate_name"},
+    ),
+    (["spin", "spin"], [0.1, 0.2], {}, {0: "duplicate_name", 1: "duplicate_name"}),
+    # unknown names, missing positions and missing names
+    (["gun", "pan"], [0.1, 0.2], {"pan": 0.2}, {0: "unknown_name"}),
+    (["pan", "lift"], [0.3], {"pan": 0.3}, {1: "no_position"}),
+    (["pan"], [0.3, 0.4], {"pan": 0.3}, {1: "no_name"}),
+]
+
+
+@pytest.mark.parametrize("names, positions, applied, rejected", HAND_TABLE)
+def test_a_table_written_by_hand(mixed, names, positions, applied, rejected):
+    r = match_joint_state(mixed.joint_infos, names, positions)
+    assert r.applied == pytest.approx(applied)
+    assert {i: reason for i, _, reason in r.rejected} == rejected
+    assert set(r.missing) == {"pan", "spin", "lift"} - set(applied)

@@ -87,7 +87,13 @@ def test_after_a_callback_the_spin_thread_steps_aside_for_the_owner(node):
         String, "/spin_thread_hand_over", lambda msg: loop.call_later(ran.append, msg.data, key=msg.data), 10
     )
     pub = node.create_publisher(String, "/spin_thread_hand_over", 10)
-    spin = SpinThread(node, hand_over_to=loop).start()
+    stepped_aside, spun = [], []
+    real_yield = loop.yield_to_owner
+    loop.yield_to_owner = lambda: stepped_aside.append(real_yield())  # a spy: called after every spin_once
+    spin = SpinThread(node, hand_over_to=loop)
+    real_spin_once = spin.executor.spin_once
+    spin.executor.spin_once = lambda timeout_sec: spun.append(real_spin_once(timeout_sec=timeout_sec))
+    spin.start()
     try:
         assert wait_until(lambda: pub.get_subscription_count() > 0, timeout=10)
         for i in range(5):
@@ -97,5 +103,7 @@ def test_after_a_callback_the_spin_thread_steps_aside_for_the_owner(node):
         assert spin.stop(timeout=10 * SPIN_POLL + 2.0)
     assert spin.error is None
     assert ran == ["0", "1", "2", "3", "4"]
-    # This thread waited in run_once for each message: the spin thread waited for it to take them.
-    assert loop.yields >= 1, (loop.yields, loop.yield_timeouts)
+    # After every turn of the executor the spin thread stepped aside (the spy), and at least once it waited
+    # until this thread, waiting in run_once, took the work (the others found nothing to wait for).
+    assert len(stepped_aside) == len(spun) >= 5, (len(stepped_aside), len(spun))
+    assert loop.yields >= 1 and loop.yields == sum(stepped_aside), (loop.yields, loop.yield_timeouts, stepped_aside)
