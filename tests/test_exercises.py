@@ -175,6 +175,36 @@ MISTAKES = [
         "        if joint.limited:\n            q = min(max(q, joint.lower), joint.upper)\n",
         "(huge)",
     ),
+    # the outside read's nine, each a plausible mistake the checks let pass before
+    (
+        "1.1",
+        "return forward - turn_left, forward + turn_left",
+        "return (forward - turn_left, forward + turn_left) if forward >= 0 else "
+        "(forward + turn_left, forward - turn_left)",
+        "(down and right)",
+    ),
+    ("2.2", 'self.rate = config.parameters["rate"]', "self.rate = 10.0", "25 Hz from t = 0"),
+    (
+        "2.2",
+        "o.x, o.y, o.z, o.w = float(qx), float(qy), float(qz), float(w)",
+        "o.x, o.y, o.z, o.w = -float(qx), -float(qy), -float(qz), float(w)",
+        "the root's orientation as it turns",
+    ),
+    ("2.2", "o.x, o.y, o.z, o.w = float(qx), float(qy), float(qz), float(w)", "o.w = 1.0", "as it turns"),
+    ("3.1", 'self.rejected["wrong_model"] += 1', 'self.rejected["wrong_model"] = 1', "(the crane's message, twice)"),
+    ("3.2", "not math.isfinite(q)", "math.isnan(q)", "(an unlimited hinge at infinity)"),
+    (
+        "3.2",
+        "low, high = joint.lower - tolerance, joint.upper + tolerance",
+        "low, high = joint.lower, joint.upper + tolerance",
+        "(just below a lower limit)",
+    ),
+    (
+        "3.2",
+        "copies = Counter(names)",
+        "copies = Counter(names)\n    copies = {n: 2 - c % 2 for n, c in copies.items()}  # paired off",
+        "(three copies of a name)",
+    ),
     ("4.1", "math.hypot(a[0], a[1])", "math.hypot(a[0], a[1], a[2])", "(at rest, t <= 0.5 s)"),
     (
         "4.1",

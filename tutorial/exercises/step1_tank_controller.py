@@ -48,6 +48,18 @@ def check_dpad_steering(func) -> Result:
             "a diagonal is the sum of its two directions.",
         ),
         (
+            "down and right",
+            _axes(dh=-1.0, dv=-1.0),
+            (-DPAD_SPEED + DPAD_TURN, -DPAD_SPEED - DPAD_TURN),
+            "a diagonal is the sum of its two directions, reversing too: do not swap the tracks when going back.",
+        ),
+        (
+            "down and left",
+            _axes(dh=1.0, dv=-1.0),
+            (-DPAD_SPEED - DPAD_TURN, -DPAD_SPEED + DPAD_TURN),
+            "reversing while turning left is still the sum: backward, and the left track runs backward harder.",
+        ),
+        (
             "a Joy with only 4 axes",
             [0.0, 0.0, 0.0, 0.0],
             (0.0, 0.0),

@@ -36,17 +36,26 @@ class _Probe:
             def control(probe):
                 step = round(probe.io.current_time / probe.io.time_step)
                 pos, quat = probe.io.body.root_pose()
-                probe.states[step] = (probe.io.data.qpos.copy(), pos, quat)
+                data = probe.io.data
+                probe.states[step] = (data.qpos.copy(), pos, quat, data.qvel.copy(), data.qfrc_actuator.copy())
                 return True
 
         self.controller = Probe()
 
     def at(self, seconds: float):
-        """``(qpos, root position, root quaternion w x y z)`` at the step of ``seconds``, or None."""
+        """``(qpos, root position, root quaternion w x y z, qvel, qfrc_actuator)`` at the step of ``seconds``.
+
+        None when no step of the run is at ``seconds``.
+        """
         return self.controller.states.get(round(seconds / self.controller.io.time_step))
 
 
-def _drive(name: str, cls, parameters: dict):
+# A drive that turns the tank on the spot, left, from 0.2 s: the pose's orientation then changes (the
+# demo drive only goes straight in the check's 2 s, where any quaternion near identity passes).
+TURN_SCRIPT = ((0.2, (0.0, 0.0, 0.0, 0.0)), (10.0, (0.8, 0.0, 0.0, 0.0)))
+
+
+def _drive(name: str, cls, parameters: dict, script=None):
     """Run the scripted drive with ``cls`` attached as ``name``; ``(capturing node, probe, app)``.
 
     Raises:
@@ -67,7 +76,7 @@ def _drive(name: str, cls, parameters: dict):
         DURATION,
         node=node,
         attach=[
-            ("Tank", "ScriptedJoy", ScriptedJoy(tank)),
+            ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=script)),
             ("Tank", "RttTankController", tank),
             ("Tank", "Probe", probe.controller),
         ],
@@ -140,6 +149,19 @@ def check_selected_joints(cls) -> Result:
                         f"{len(names)}, {len(msg.position)}, {len(msg.velocity)}, {len(msg.effort)}.",
                         "a JointState's arrays must all be as long as its name list.",
                     )
+                for field, values, source, unit in (
+                    ("velocity", msg.velocity, state[3], "rad/s"),
+                    ("effort", msg.effort, state[4], "N m"),
+                ):
+                    for name, v in zip(names, values):
+                        true = float(source[body.joint(name).info.dof_adr])
+                        if abs(v - true) > 1e-9:
+                            raise CaseFailed(
+                                f"{call}: at t = {_stamp(msg):.3f} s {name}'s {field} was published as "
+                                f"{v:.6f} {unit}, but the simulation had {true:.6f} {unit}.",
+                                f"a joint's {field} comes from its own dof address (qvel, qfrc_actuator), "
+                                "in the order of the names you publish: not from its qpos address.",
+                            )
 
         return Case(call, run, hint)
 
@@ -187,13 +209,15 @@ def check_pose_publisher(cls) -> Result:
     position in m and orientation (x, y, z, w, ROS's order) of the root link.
     """
     call = f"{cls.__name__} on the Tank, scripted drive of {DURATION} s"
-    runs: list = []  # one drive serves every case
+    turning = f"{cls.__name__} with rate=25, the tank turning on the spot"
+    runs: dict = {}  # one drive per kind serves every case of that kind
 
-    def poses():
-        if not runs:
+    def poses(kind: str = "drive"):
+        if kind not in runs:
             from geometry_msgs.msg import PoseStamped
 
-            node, probe, _ = _drive("PosePublisher", cls, {})
+            parameters, script = ({}, None) if kind == "drive" else ({"rate": 25.0}, TURN_SCRIPT)
+            node, probe, _ = _drive("PosePublisher", cls, parameters, script)
             pubs = node.published("/Tank/pose")
             if len(pubs) != 1:
                 topics = [p.topic for p in node.published()]
@@ -203,25 +227,28 @@ def check_pose_publisher(cls) -> Result:
                 )
             if pubs[0].msg_type is not PoseStamped:
                 raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__}, expected geometry_msgs/PoseStamped.")
-            runs.append((pubs[0].messages(), probe))
-        return runs[0]
+            runs[kind] = (pubs[0].messages(), probe)
+        return runs[kind]
 
-    want = round(10.0 * DURATION)
-
-    def timing():
-        messages, _ = poses()
+    def timing(kind: str = "drive", rate: float = 10.0, who: str = call):
+        messages, _ = poses(kind)
+        want = round(rate * DURATION)
         if len(messages) < want:
             raise CaseFailed(
-                f"{call} published {len(messages)} poses, expected {want} (10 Hz for {DURATION} s).",
-                "use a PeriodAccumulator(io.time_step, rate) in initialize and tick() it in control().",
+                f"{who} published {len(messages)} poses, expected {want} ({rate:g} Hz for {DURATION} s).",
+                "use a PeriodAccumulator(io.time_step, rate) in initialize, with the rate parameter, "
+                "and tick() it in control().",
             )
         for k, msg in enumerate(messages[:want]):
             t = _stamp(msg)
-            if abs(t - 0.1 * k) > 1e-9:
+            if abs(t - k / rate) > 1e-9:
                 raise CaseFailed(
-                    f"{call}: pose {k} is stamped {t:.4f} s, expected {0.1 * k:.4f} s.",
-                    "stamp with simulation time (io.data.time), the first at t = 0, every 0.1 s.",
+                    f"{who}: pose {k} is stamped {t:.4f} s, expected {k / rate:.4f} s.",
+                    f"stamp with simulation time (io.data.time), the first at t = 0, every {1 / rate:g} s: "
+                    "read config.parameters['rate'].",
                 )
+
+    want = round(10.0 * DURATION)
 
     def position():
         messages, probe = poses()
@@ -232,7 +259,7 @@ def check_pose_publisher(cls) -> Result:
                     f"{call}: frame_id is {msg.header.frame_id!r}, expected 'world'.",
                     "the pose is the root link's, in the world frame.",
                 )
-            _, pos, _ = probe.at(t)
+            pos = probe.at(t)[1]
             p = msg.pose.position
             got = (p.x, p.y, p.z)
             if max(abs(a - b) for a, b in zip(got, pos)) > 5e-3:
@@ -242,20 +269,25 @@ def check_pose_publisher(cls) -> Result:
                     "io.body.root_pose() gives the root's (position, quaternion).",
                 )
 
-    def orientation():
-        messages, probe = poses()
-        for msg in messages[:want]:
+    def orientation(kind: str = "drive", who: str = call):
+        messages, probe = poses(kind)
+        turned = 0.0
+        for msg in messages:
             t = _stamp(msg)
-            _, _, quat = probe.at(t)
+            quat = probe.at(t)[2]
+            turned = max(turned, abs(2 * math.atan2(float(quat[3]), float(quat[0]))))
             o = msg.pose.orientation
             got, expected = (o.x, o.y, o.z, o.w), (quat[1], quat[2], quat[3], quat[0])
             if not _same_rotation(got, expected):
                 raise CaseFailed(
-                    f"{call}: at t = {t:.2f} s the orientation (x, y, z, w) was "
+                    f"{who}: at t = {t:.2f} s the orientation (x, y, z, w) was "
                     f"{show([round(v, 4) for v in got])}, expected "
                     f"{show([round(float(v), 4) for v in expected])}.",
-                    "ROS orders a quaternion x, y, z, w; MuJoCo (root_pose) orders it w, x, y, z.",
+                    "ROS orders a quaternion x, y, z, w; MuJoCo (root_pose) orders it w, x, y, z, "
+                    "and the pose is the root's own (io.body.root_pose()), as it turns.",
                 )
+        if kind == "turn":
+            assert turned > 0.3, f"the check's own drive did not turn the tank ({turned:.3f} rad)"
 
     return grade(
         "Exercise 2.2, publish the pose",
@@ -263,6 +295,8 @@ def check_pose_publisher(cls) -> Result:
             Case(f"{call}: 10 Hz from t = 0, stamped with simulation time", timing),
             Case(f"{call}: the root's position, frame world", position),
             Case(f"{call}: the root's orientation", orientation),
+            Case(f"{turning}: 25 Hz from t = 0", lambda: timing("turn", 25.0, turning)),
+            Case(f"{turning}: the root's orientation as it turns", lambda: orientation("turn", turning)),
         ],
     )
 

@@ -74,6 +74,10 @@ def check_own_matcher(func) -> Result:
         ("a slide a little past its limit", crane, ["TROLLEY"], [crane[2].upper + 0.005]),
         ("a slide 0.05 m past its limit", crane, ["TROLLEY"], [crane[2].upper + 0.05]),
         ("an unlimited hinge far round", crane, ["SLEW", "LUFF"], [100.0, 0.1]),
+        ("an unlimited hinge at infinity", crane, ["SLEW", "LUFF"], [math.inf, 0.1]),
+        ("just below a lower limit", tank, ["TURRET_P"], [tank[1].lower - 0.03]),
+        ("far below a lower limit", tank, ["TURRET_P"], [tank[1].lower - 0.2]),
+        ("three copies of a name", tank, ["TURRET_Y", "TURRET_Y", "TURRET_P", "TURRET_Y"], [0.1, 0.2, 0.3, 0.4]),
     ]
     hints = {
         "reordered": "match by name, not by index: the message may list joints in any order.",
@@ -89,6 +93,12 @@ def check_own_matcher(func) -> Result:
         "a slide a little past its limit": "a slide's tolerance is 0.01 m (info.kind == 'slide').",
         "a slide 0.05 m past its limit": "a slide's tolerance is 0.01 m (info.kind == 'slide').",
         "an unlimited hinge far round": "an unlimited joint (info.limited False) has no range to check.",
+        "an unlimited hinge at infinity": "no range to check, but infinity is still not a position: "
+        "math.isfinite(q), not only math.isnan(q).",
+        "just below a lower limit": "the 0.05 rad tolerance holds at both ends: lower - 0.05 <= q <= upper + 0.05.",
+        "far below a lower limit": "more than 0.05 rad below the lower limit: skip it.",
+        "three copies of a name": "every copy of a name given more than once is skipped: count them "
+        "(collections.Counter), do not pair them off.",
     }
 
     def case(label, joints, names, positions):
@@ -229,6 +239,14 @@ def check_wrong_model(cls) -> Result:
                 {"not_finite": 1},
                 {"TURRET_Y": 0.0, "TURRET_P": 0.2},
                 "a message of this body stays with the matcher, which rejects the NaN entry alone.",
+            ),
+            expect(
+                "the crane's message, twice",
+                [message(["SLEW", "LUFF"], [0.5, 0.2]), message(["TROLLEY"], [1.0])],
+                0,
+                {"wrong_model": 2},
+                zero,
+                "count every refused message: self.rejected['wrong_model'] += 1, not = 1.",
             ),
             expect(
                 "the crane's, then the tank's",
