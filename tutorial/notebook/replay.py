@@ -36,16 +36,14 @@ from __future__ import annotations
 
 import base64
 import functools
-import gzip
 import html
 import json
 import re
 from collections.abc import Sequence
-from pathlib import Path
 
 import numpy as np
 
-from tutorial.view.meshcat_page import LIGHTEN_SCRIPT
+from tutorial.view.meshcat_page import LIGHTEN_SCRIPT, viewer_script_gzip
 
 DECIMALS = 4  # animation values: 0.1 mm, 1e-4 of a unit quaternion
 _UUID = re.compile(r"^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")
@@ -237,11 +235,8 @@ def _key_frames(track: np.ndarray) -> np.ndarray:
 
 @functools.lru_cache(maxsize=1)
 def _viewer_script_gzip_base64() -> str:
-    """meshcat's own viewer script, gzip-compressed (fixed mtime: same bytes every time), as base64."""
-    import meshcat
-
-    path = Path(meshcat.__file__).parent / "viewer" / "dist" / "main.min.js"
-    return base64.b64encode(gzip.compress(path.read_bytes(), compresslevel=9, mtime=0)).decode("ascii")
+    """meshcat's own viewer script, gzip-compressed (same bytes every time), as base64."""
+    return base64.b64encode(viewer_script_gzip()).decode("ascii")
 
 
 _PAGE = """<!DOCTYPE html>

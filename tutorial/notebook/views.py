@@ -1,20 +1,19 @@
 """3D views in a notebook: live while their run lives, a recording once it has ended.
 
 A :class:`LiveView` belongs to one run (:class:`tutorial.notebook.runs.BackgroundApp`)
-and outlives its Start/Stop cycles: its meshcat server stays up, so the
-page in the notebook stays connected and shows every restarted run.  A
-caption under the page says what the view shows right now: starting,
-live, stopped, finished, failed.  When the view closes (``reset()``), the
-live page is replaced, in the same output, by a recording of the run's
-last seconds, marked as a recording: a view never points at a server that
-is gone, and a saved notebook (and the book) shows what happened.
+and outlives its Start/Stop cycles.  Its page is a Jupyter widget
+(:class:`tutorial.view.widget.widget.MeshcatWidget`): meshcat's own viewer,
+fed over the notebook's own connection, so it draws wherever the notebook
+opens (on this machine, a course's JupyterHub, behind an SSH tunnel, in
+Colab), keeps its scene across a page reload, and shows every restarted
+run.  A caption under the page says what the view shows right now:
+starting, live, stopped, finished, failed.  When the view closes
+(``reset()``), the live page is replaced, in the same output, by a
+recording of the run's last seconds, marked as a recording: a saved
+notebook (and the book) shows what happened.
 
-A kernel that is restarted or shut down cannot replace its outputs any
-more, and its meshcat servers stop with it.  So a live output watches its
-servers from the browser (:func:`live_html`): once one stops answering, a
-notice over the page says it is not live any more (the page keeps its last
-frame; one that never loaded is hidden, never the browser's error page),
-and the caption says so too.
+A kernel that is restarted or shut down takes its widgets with it: the
+page then says the view is not live any more (``widget.js``).
 
 :func:`show` puts one or more views side by side in one output.
 
@@ -29,36 +28,30 @@ a lock guards them.
 from __future__ import annotations
 
 import html
-import json
 import threading
 import time
-import uuid
 from collections import deque
 
 from tutorial.notebook import replay, session
 
 
 class LiveView:
-    """The inline 3D view of one run, with a meshcat server of its own.
+    """The inline 3D view of one run: a Jupyter widget drawing its scene, then a recording of it.
 
     Args:
         label: what the view shows, e.g. ``"simulation (node /rtt)"``.
         height: height of the page in the notebook, px.
-
-    Raises:
-        RuntimeError: the meshcat server did not start.
     """
 
     FPS = 15.0  # recorded frames per second of wall time
     SECONDS = 60.0  # the recording keeps the last this many seconds of the run
 
     def __init__(self, label: str, height: int = 380):
-        from tutorial.view.meshcat_server import start_server
+        from tutorial.view.widget.widget import MeshcatWidget
 
         self.label = label
         self.height = height
-        self.server = start_server()
-        self.url = self.server.web_url
+        self.widget = MeshcatWidget(label, height)
         self.status = "not started yet"
         self.closed = False
         self._displays: list[_Display] = []
@@ -71,8 +64,8 @@ class LiveView:
 
     # ---- the run's owner thread ---------------------------------------------------
     def visualizer(self):
-        """A ``meshcat.Visualizer`` on this view's server, owned by the calling thread (one per run)."""
-        return self.server.visualizer()
+        """A ``meshcat.Visualizer`` drawing into this view's widget, owned by the calling thread (one per run)."""
+        return self.widget.visualizer()
 
     def begin(self, model, camera=None, overlays=None) -> None:
         """A run starts drawing ``model``: its recording starts afresh (owner thread).
@@ -124,106 +117,40 @@ class LiveView:
             return len(self._frames) / self.FPS
 
     def close(self) -> None:
-        """Replace the live page by the recording and stop the server (kernel thread, once)."""
+        """Replace the live page by the recording and close the widget (kernel thread, once)."""
         if self.closed:
             return
         self.closed = True
         for d in list(self._displays):
             d.view_closed()
-        self.server.close()
+        self.release()
 
-
-# Runs in the browser, in a live output: every 2 s it asks each page's server for its page (HEAD).
-# When none answers, the kernel has gone (restarted or shut down: nothing in the kernel can say so
-# any more), and the output says it.  One closed view alone (its run reset while the other's is
-# still stopping) is not that.  The box is looked up by its id at every check, so a cell that
-# JupyterLab takes out of the page while scrolled away is watched again when it comes back; the
-# watch ends when its output is replaced (by a recording), or after a minute with no box.
-_WATCH = """<script>
-(() => {
-  const urls = %(urls)s, notice = %(notice)s, caption = %(caption)s;
-  let missing = 0, answered = false;
-  const gone = (box) => {
-    const note = document.createElement("div");
-    note.textContent = notice + (answered ? " What you see is its last frame." : "");
-    note.style.cssText = "position: absolute; left: 0; right: 0; top: 0; padding: 4px 8px; "
-      + "background: rgba(255, 236, 179, 0.95); color: #5d4037; font: 13px sans-serif";
-    if (!answered) box.querySelectorAll("iframe").forEach((f) => { f.style.visibility = "hidden"; });
-    box.appendChild(note);
-    const under = document.getElementById(%(caption_id)s);
-    if (under) under.innerHTML = caption;
-  };
-  const check = () => {
-    const box = document.getElementById(%(box_id)s);
-    if (!box) { if (++missing < 300) setTimeout(check, 200); return; }  // not (or no longer) in the page
-    missing = 0;
-    const ask = (u) => fetch(u, {method: "HEAD", mode: "no-cors", cache: "no-store"});
-    Promise.allSettled(urls.map(ask)).then((results) => {
-      if (results.some((r) => r.status === "fulfilled")) {
-        answered = true;
-        setTimeout(check, 2000);
-      } else if (box.isConnected) {
-        gone(box);
-      }
-    });
-  };
-  check();
-})();
-</script>"""
-
-
-def live_html(urls: list[str], frames: str, caption_id: str, what: str) -> str:
-    """``frames`` (the live pages of ``urls``) in a box that says so when their servers have gone.
-
-    Args:
-        urls: the meshcat pages the frames show.
-        frames: their ``<iframe>`` elements.
-        caption_id: the ``id`` of the caption under them, rewritten then.
-        what: what the frames show, for the notice (e.g. ``"simulation /rtt"``).
-    """
-    box_id = f"rtt-live-{uuid.uuid4().hex}"
-    notice = (
-        f"Not live any more: the kernel that ran {what} was restarted or shut down, so nothing runs "
-        "here now. Run the section again for a live view."
-    )
-    caption = (
-        f'<div style="font-size: 90%"><b>{html.escape(what)}</b> (not live): its kernel has gone, '
-        "so nothing runs; run the section again for a live view.</div>"
-    )
-
-    def js(value) -> str:  # a JavaScript literal that cannot end the script early
-        return json.dumps(value).replace("</", "<\\/")
-
-    script = _WATCH % {
-        "urls": js(urls),
-        "notice": js(notice),
-        "caption": js(caption),
-        "box_id": js(box_id),
-        "caption_id": js(caption_id),
-    }
-    return f'<div id="{box_id}" style="position: relative">{frames}</div>{script}'
+    def release(self) -> None:
+        """Close the widget once no output shows it live any more (kernel thread)."""
+        if self.closed and all(d.done for d in self._displays):
+            self.widget.close()
 
 
 class _Display:
     """One output showing one or more views side by side, with a caption under them."""
 
     def __init__(self, views: list[LiveView], height: int):
+        import ipywidgets
         from IPython.display import HTML, display
 
         self.views = views
         self.height = height
-        self.caption_id = f"rtt-caption-{uuid.uuid4().hex}"
-        frames = "".join(
-            f'<iframe src="{v.url}" style="flex: 1; min-width: 0; height: {height}px; border: none"></iframe>'
-            for v in views
+        self.done = False  # every view of it has closed, and it shows their recordings
+        for v in views:
+            v.widget.height = height
+            v.widget.layout = ipywidgets.Layout(flex="1 1 0%", min_width="0")
+        page = (
+            views[0].widget
+            if len(views) == 1
+            else ipywidgets.HBox([v.widget for v in views], layout=ipywidgets.Layout(width="100%", grid_gap="4px"))
         )
-        page = live_html(
-            [v.url for v in views],
-            f'<div style="display: flex; gap: 4px">{frames}</div>',
-            self.caption_id,
-            " and ".join(v.label for v in views),
-        )
-        self.page = display(HTML(page), display_id=True)
+        self._box = None if len(views) == 1 else page
+        self.page = display(page, display_id=True)
         self.caption = display(HTML(self._caption()), display_id=True)
         for v in views:
             v._displays.append(self)
@@ -233,7 +160,7 @@ class _Display:
         for v in self.views:
             state = "recording" if v.closed else "live"
             parts.append(f"<b>{html.escape(v.label)}</b> ({state}): {html.escape(v.status)}")
-        return f'<div id="{self.caption_id}" style="font-size: 90%">' + " &nbsp;|&nbsp; ".join(parts) + "</div>"
+        return '<div style="font-size: 90%">' + " &nbsp;|&nbsp; ".join(parts) + "</div>"
 
     def refresh_caption(self) -> None:
         from IPython.display import HTML
@@ -270,6 +197,11 @@ class _Display:
                 "Run the section again for a live view.</div>"
             )
         )
+        self.done = True
+        if self._box is not None:
+            self._box.close()
+        for v in self.views:
+            v.release()
 
 
 def show(*views: LiveView, height: int | None = None) -> None:
@@ -286,22 +218,21 @@ def show(*views: LiveView, height: int | None = None) -> None:
 class MeshcatPage:
     """A meshcat page to draw in by hand, shown inline; a still picture of it stays after it closes.
 
-    ``vis`` is a ``meshcat.Visualizer`` that draws both into the live page
-    and into a recording, so :meth:`close` can leave the scene as it was.
-    Owned by the kernel thread (meshcat's socket is not thread-safe).
+    ``vis`` is a ``meshcat.Visualizer`` that draws both into the live page (a
+    :class:`tutorial.view.widget.widget.MeshcatWidget`) and into a recording,
+    so :meth:`close` can leave the scene as it was.  Owned by the kernel thread.
     """
 
     def __init__(self, label: str = "meshcat page", height: int = 350):
         import meshcat
 
-        from tutorial.view.meshcat_server import start_server
+        from tutorial.view.widget.widget import MeshcatWidget
 
         self.label = label
         self.height = height
-        self.server = start_server()
-        self.url = self.server.web_url
+        self.widget = MeshcatWidget(label, height)
         self.recording = replay.ViewRecording()
-        self.vis = meshcat.Visualizer(window=_Tee(self.server.visualizer().window, self.recording))
+        self.vis = meshcat.Visualizer(window=_Tee(self.widget.window(), self.recording))
         self.closed = False
         self._handle = None
         session.register(self)
@@ -310,16 +241,14 @@ class MeshcatPage:
         """Display the live page, with a caption, in this cell's output."""
         from IPython.display import HTML, display
 
-        caption_id = f"rtt-caption-{uuid.uuid4().hex}"
-        frame = f'<iframe src="{self.url}" style="width: 100%; height: {self.height}px; border: none"></iframe>'
-        self._handle = display(HTML(live_html([self.url], frame, caption_id, self.label)), display_id=True)
+        self._handle = display(self.widget, display_id=True)
         self._caption = display(
-            HTML(f'<div id="{caption_id}" style="font-size: 90%"><b>{html.escape(self.label)}</b> (live)</div>'),
+            HTML(f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> (live)</div>'),
             display_id=True,
         )
 
     def close(self) -> None:
-        """Leave a still copy of the scene in the output, then stop the server (kernel thread)."""
+        """Leave a still copy of the scene in the output, then close the widget (kernel thread)."""
         from IPython.display import HTML
 
         if self.closed:
@@ -334,7 +263,7 @@ class MeshcatPage:
                     "(a saved copy: the live page has closed; drag to turn, scroll to zoom)</div>"
                 )
             )
-        self.server.close()
+        self.widget.close()
 
 
 class _Tee:

@@ -9,7 +9,9 @@ A body without joints rides in the frame of the body it is welded to (the
 tank's tracks in the chassis'), so a frame sends one transform for each part
 that moves on its own: three for a tank, not five.
 
-A frame's transforms go out as *one message*: meshcat-python sends one
+A frame's transforms go out as *one message*.  Into a notebook's widget
+(:mod:`tutorial.view.widget`), through its window's ``send_transforms``.
+To a meshcat server: meshcat-python sends one
 command per transform and waits for the server's reply after each (a zmq
 REQ socket), which costs a round trip between processes per body (20 ms a
 frame for a 24-joint arm) and the page one WebSocket message per body.
@@ -96,8 +98,11 @@ class Scene:
         self._paths: list = []  # the meshcat handle of each moving body, made once in build()
         self.frames = 0
         self.transforms_sent = 0
-        zmq_url = getattr(getattr(vis, "window", None), "zmq_url", None)
+        window = getattr(vis, "window", None)
+        zmq_url = getattr(window, "zmq_url", None)
         self._pipe = _Pipeline(zmq_url) if zmq_url else None
+        # A window that takes a frame's transforms at once (a notebook's widget, tutorial.view.widget).
+        self._send_transforms = getattr(window, "send_transforms", None)
 
     def body_path(self, body_id: int) -> str:
         """The meshcat path of a body's frame, e.g. ``rtt/Tank/TURRET_Y``."""
@@ -211,6 +216,9 @@ class Scene:
         self._sent[changed] = now[changed]
         if self._pipe is not None:
             self._pipe.send_frame([(self._paths[i].path, _pose(now[i, :3], now[i, 3:])) for i in changed])
+        elif self._send_transforms is not None:
+            if len(changed):
+                self._send_transforms([(self._paths[i].path, _pose(now[i, :3], now[i, 3:])) for i in changed])
         else:
             for i in changed:
                 self._paths[i].set_transform(_pose(now[i, :3], now[i, 3:]))

@@ -1,0 +1,200 @@
+"""A meshcat scene as a Jupyter widget: the live 3D view that travels over the notebook's own connection.
+
+A view that is a page of a server the kernel starts (an ``<iframe
+src="http://127.0.0.1:PORT/...">``) works only when the browser runs on
+the kernel's machine.  A course's JupyterHub, Binder, Colab, VS Code's
+remote notebooks and a machine behind ``ssh -L`` all give the browser one
+way in: Jupyter's own port.  :class:`MeshcatWidget` goes that way.  It is an
+`anywidget <https://anywidget.dev>`_ (no lab extension to install; it runs
+in JupyterLab, Notebook 7, VS Code and Colab) whose view is meshcat's own
+page, drawn by meshcat's own three.js viewer taken from the meshcat wheel
+(``widget.js`` beside this file).  It takes meshcat's own commands:
+
+>>> w = MeshcatWidget("a box")
+>>> vis = w.visualizer()           # a meshcat.Visualizer, as with meshcat's server
+>>> vis["box"].set_object(meshcat.geometry.Box([0.1, 0.2, 0.3]))
+>>> w                               # the last expression of a cell shows it
+
+What travels: each frame is one widget message whose binary buffers are
+meshcat's commands, packed as meshcat packs them (a frame's transforms as
+one ``set_transforms``: :mod:`tutorial.view.meshcat_batch`).  Coalescing,
+the one-frame window and the scene kept for a page that opens later are
+:class:`tutorial.view.widget.flow.FrameFlow`'s.  meshcat's viewer script
+(850 kB) goes once per browser page, when its first view asks.
+
+Threads: the visualizer (:meth:`visualizer`, :class:`WidgetWindow`) belongs to
+one thread, usually a run's owner thread; the browser's messages arrive on
+the kernel's thread.  Both end in a send, under one lock (see
+``MeshcatWidget._lock``).  The widget is shown, closed and displayed from
+the kernel's thread.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from pathlib import Path
+
+import anywidget
+import numpy as np
+import traitlets
+
+from tutorial.view import meshcat_batch
+from tutorial.view.meshcat_page import PAGE_SCRIPT, viewer_script_gzip
+from tutorial.view.widget.flow import FrameFlow
+
+# What a view takes in one command (widget.js refuses more and says so): a mesh of a few hundred
+# thousand triangles fits; a frame's transforms are held to the limits of the server's set_transforms.
+LIMITS = {
+    "max_command_bytes": 64 * 1024 * 1024,
+    "max_commands": meshcat_batch.MAX_COMMANDS,
+    "max_path_parts": meshcat_batch.MAX_PATH_PARTS,
+    "max_path_chars": meshcat_batch.MAX_PATH_CHARS,
+    "ping_ms": 5000,  # a view cut off its kernel asks it this long for an answer before it says "not live"
+}
+
+
+def _esm() -> str:
+    """widget.js with the page script and the limits written in (JavaScript literals)."""
+    source = (Path(__file__).with_name("widget.js")).read_text(encoding="utf-8")
+    return source.replace("__PAGE_SCRIPT__", json.dumps(PAGE_SCRIPT)).replace("__LIMITS__", json.dumps(LIMITS))
+
+
+class _CellWatch:
+    """Whether the kernel is running a cell now (IPython's ``pre_run_cell`` and ``post_run_cell``).
+
+    While a cell runs, the kernel reads no message from the browser, so no
+    view can answer a frame: :class:`FrameFlow` then sends on a timer instead.
+    Outside IPython (a script) no cell ever runs.
+    """
+
+    busy = False
+    _installed = False
+
+    @classmethod
+    def install(cls) -> None:
+        if cls._installed:
+            return
+        try:
+            from IPython import get_ipython
+        except ImportError:
+            return
+        shell = get_ipython()
+        if shell is None:
+            return
+        shell.events.register("pre_run_cell", cls._begin)
+        shell.events.register("post_run_cell", cls._end)
+        cls._installed = True
+
+    @classmethod
+    def _begin(cls, *_args) -> None:
+        cls.busy = True
+
+    @classmethod
+    def _end(cls, *_args) -> None:
+        cls.busy = False
+
+
+class MeshcatWidget(anywidget.AnyWidget):
+    """A live meshcat scene in a notebook output, over the kernel's connection.
+
+    Args:
+        label: what the view shows (its iframe's title, the console's messages).
+        height: height of the view, px.
+
+    Attributes:
+        rejected: how many frames a browser refused (a bad command: the browser's console says
+            which), and ``last_rejection``, its reason.
+    """
+
+    _esm = _esm()
+    label = traitlets.Unicode("").tag(sync=True)
+    height = traitlets.Int(380).tag(sync=True)
+
+    def __init__(self, label: str = "meshcat", height: int = 380):
+        super().__init__(label=label, height=height)
+        _CellWatch.install()
+        # The flow is touched by the visualizer's thread (commands, frames) and the kernel's thread
+        # (a view's hello and drawn): the lock keeps each change of the flow and the send that follows
+        # it together, so the messages leave in the order the flow made them.
+        self._lock = threading.Lock()
+        self.flow = FrameFlow()
+        self.rejected = 0
+        self.last_rejection = ""
+        self.hellos = 0
+        self.on_msg(self._on_message)
+
+    def __repr__(self) -> str:  # the same text every run (a saved output's text/plain)
+        return f"MeshcatWidget({self.label!r})"
+
+    def window(self) -> WidgetWindow:
+        """A meshcat "window" sending into this widget (for ``meshcat.Visualizer(window=...)``)."""
+        return WidgetWindow(self)
+
+    def visualizer(self):
+        """A ``meshcat.Visualizer`` drawing into this widget, owned by the calling thread."""
+        import meshcat
+
+        return meshcat.Visualizer(window=self.window())
+
+    # ---- the drawing thread -------------------------------------------------------------------
+    def put(self, commands: list[dict]) -> None:
+        """Take lowered meshcat commands, and send a frame if a view can draw one now (any thread).
+
+        Raises:
+            ValueError: a command is not one of meshcat's scene commands.
+        """
+        with self._lock:
+            for command in commands:
+                self.flow.put(command)
+            self._send_frame()
+
+    def _send_frame(self) -> None:  # with self._lock held
+        buffers = self.flow.take(time.monotonic(), busy=_CellWatch.busy)
+        if buffers is not None:
+            self.send({"type": "frame"}, buffers)
+
+    # ---- the kernel's thread: what the browser says ------------------------------------------------
+    def _on_message(self, _widget, content, buffers) -> None:
+        kind = content.get("type") if isinstance(content, dict) else None
+        if kind == "viewer_js":
+            self.send({"type": "viewer_js"}, [viewer_script_gzip()])
+        elif kind == "hello":
+            with self._lock:
+                self.hellos += 1
+                self.send({"type": "scene", "to": str(content.get("id", ""))}, self.flow.scene(time.monotonic()))
+        elif kind == "drawn":
+            with self._lock:
+                self.flow.drawn()
+                self._send_frame()
+        elif kind == "ping":
+            self.send({"type": "pong"})
+        elif kind == "rejected":
+            self.rejected += 1
+            self.last_rejection = str(content.get("reason", ""))[:300]
+
+
+class WidgetWindow:
+    """The meshcat "window" of a :class:`MeshcatWidget`: where a ``meshcat.Visualizer`` sends.
+
+    It stands in for meshcat's ``ViewerWindow`` (a connection to meshcat's
+    server): ``send`` takes one command, and :meth:`send_transforms` a frame's
+    transforms at once (:class:`tutorial.view.scene.Scene` uses it when present).
+    """
+
+    zmq_url = None  # no server: tutorial.view.scene.Scene sends through this window
+
+    def __init__(self, widget: MeshcatWidget):
+        self.widget = widget
+        self.web_url = f"(a Jupyter widget in the notebook: {widget.label})"
+
+    def send(self, command) -> None:
+        """One meshcat command (``SetObject``, ``SetTransform``, ``SetProperty``, ``Delete``, ``SetAnimation``)."""
+        self.widget.put([command.lower()])
+
+    def send_transforms(self, transforms: list) -> None:
+        """A frame: ``[(meshcat path, 4x4 pose, translation in m), ...]``, sent as one message."""
+        from meshcat.commands import SetTransform
+
+        self.widget.put([SetTransform(np.asarray(matrix), path).lower() for path, matrix in transforms])
