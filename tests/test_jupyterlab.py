@@ -382,10 +382,13 @@ def output_text(cell) -> str:
 
 # ---- what every notebook must show after Run All ------------------------------------------------------------
 FRAMES_JS = """frames => frames.map(f => {
+    const live = f.classList.contains('rtt-live-view');  // a live view: a widget (tutorial/view/widget)
     const child = f.closest('.jp-OutputArea-child');
     const next = child && child.nextElementSibling;
-    const doc = f.hasAttribute('srcdoc') ? f.contentDocument : null;  // a recording: same origin
-    return {src: f.getAttribute('src'), caption: next ? next.textContent : '',
+    const caption = live ? f.parentElement.querySelector('.rtt-caption') : next;
+    const doc = f.contentDocument;  // a live view and a recording are srcdoc pages: same origin
+    return {live: live, scenes: live && f.parentElement.rttView ? f.parentElement.rttView.scenes : null,
+            caption: caption ? caption.textContent : '',
             canvases: doc ? doc.querySelectorAll('canvas').length : null,
             panes: doc ? Array.from(doc.querySelectorAll('.pane'), p => {
                 const r = p.getBoundingClientRect(); return [r.left, r.right]; }) : []};
@@ -397,14 +400,15 @@ def check_views(lane: Lane, stem: str) -> list[str]:
     frames = lane.page.locator(f"{CELLS} .jp-OutputArea-output iframe")
     seen = []
     for k, info in enumerate(frames.evaluate_all(FRAMES_JS)):
-        frame, src, caption = frames.nth(k), info["src"], info["caption"]
-        what = f"{stem} view {k} ({'live ' + src if src else 'recording'})"
-        if src is not None:  # a live page: its server answers, it is no error page, and its caption says live
+        frame, live, caption = frames.nth(k), info["live"], info["caption"]
+        what = f"{stem} view {k} ({'live' if live else 'recording'})"
+        if live:  # a live widget: it has its scene from the kernel, and its caption says live
             assert "(live)" in caption, f"{what}: its caption says {caption!r}"
-            assert NO_PROXY.open(src, timeout=5).status == 200, f"{what}: the server does not answer"
-            content = frame.element_handle().content_frame()
-            assert not content.url.startswith("chrome-error"), f"{what} shows the browser's error page"
-            content.locator("canvas").first.wait_for(state="attached", timeout=lane.ms(30))
+            scenes = lambda: frames.evaluate_all(FRAMES_JS)[k]["scenes"]  # noqa: B023, E731 - called in this iteration
+            lane.poll(f"{what}: its scene from the kernel", scenes, 30)
+            frame.element_handle().content_frame().locator("canvas").first.wait_for(
+                state="attached", timeout=lane.ms(30)
+            )
             panes = [None]
         else:
             assert "(live)" not in caption, f"{what}: its caption says live: {caption!r}"
@@ -426,7 +430,7 @@ def check_views(lane: Lane, stem: str) -> list[str]:
             30,
             every=0.1,
         )
-        seen.append(f"view {k}: {'live' if src else 'recording'}, {len(panes)} pane(s)")
+        seen.append(f"view {k}: {'live' if live else 'recording'}, {len(panes)} pane(s)")
     return seen
 
 
@@ -482,7 +486,7 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
     reset = code_cell_index(cells, lambda src: src.startswith("reset()"), after=teleop)
     run_up_to(lane, cells, teleop)
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
-    view = view_cell.locator("iframe[src^='http://127.0.0.1:']")
+    view = view_cell.locator("iframe.rtt-live-view")
     line = panel.locator(".widget-html-content", has_text="/rtt:")
     start, stop = panel.get_by_role("button", name="Start"), panel.get_by_role("button", name="Stop")
     line.filter(has_text="running").wait_for(timeout=lane.ms(30))
@@ -523,9 +527,9 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
     # the section's reset(): the view becomes its recording, the panel closes and says so
     select_cell(lane, reset)  # then Run > Run Selected Cell and Do not Advance
     run(lane, "notebook:run-cell", code_positions(cells, reset, reset), "the section's reset()", 30)
-    recording = view_cell.locator("iframe[srcdoc]")
+    recording = view_cell.locator("iframe[srcdoc]:not(.rtt-live-view)")
     recording.wait_for(timeout=lane.ms(30))
-    assert view_cell.locator("iframe[src]").count() == 0, "a live page is left after reset()"
+    assert view_cell.locator("iframe.rtt-live-view").count() == 0, "a live page is left after reset()"
     assert "Recorded" in output_text(view_cell), output_text(view_cell)
     lane.tank_in(recording, "01_live_5_recording")
     assert "closed by reset()" in output_text(panel), output_text(panel)
@@ -541,7 +545,7 @@ def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
     )
     run_up_to(lane, cells, teleop)
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
-    live = view_cell.locator("iframe[src^='http://127.0.0.1:']")
+    live = view_cell.locator("iframe.rtt-live-view")
     assert live.count() == 2, f"notebook 03 shows {live.count()} live views, not two"
     left, right = live.nth(0).bounding_box(), live.nth(1).bounding_box()
     assert abs(left["y"] - right["y"]) < 2 and left["x"] + left["width"] <= right["x"] + 1, (left, right)
@@ -567,14 +571,15 @@ def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
     lane.poll("the viewer's view turning the turret (03_live_viewer_turned.png)", turned, 30)
     panel.get_by_role("button", name="release sticks").click()
 
-    # Kernel > Restart while both run: the runs and their servers stop, and the kernel can no longer
-    # say so; the output itself must: a notice over the last frames, and the caption.
+    # Kernel > Restart while both run: the runs and their widgets stop, and the kernel can no longer
+    # say so; the output itself must: a notice over each view's last frame, and the captions.
     restart_kernel(lane)
-    box = view_cell.locator("div[id^='rtt-live-']")
-    box.get_by_text("Not live any more").wait_for(timeout=lane.ms(20))
+    notices = view_cell.locator(".rtt-not-live")
+    lane.poll("a notice over each view", lambda: notices.count() == 2 and notices, 20)
+    assert all("Not live any more" in t for t in notices.all_inner_texts()), notices.all_inner_texts()
     caption = output_text(view_cell)
     assert "(not live)" in caption and "(live)" not in caption, caption
-    lane.tank_in(box, "03_after_kernel_restart")  # the last frames, under the notice
+    lane.tank_in(live.nth(0), "03_after_kernel_restart")  # the last frame, under the notice
     panel.screenshot(path=str(lane.shots / "03_panel_after_kernel_restart.png"))
 
 

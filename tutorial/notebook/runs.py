@@ -209,7 +209,7 @@ class BackgroundApp:
     def _run(self) -> None:
         from tutorial.app.app import App
 
-        app = vis = None
+        app = None
         try:
             vis = self.view.visualizer() if self.view is not None else None
             app = App(
@@ -238,8 +238,6 @@ class BackgroundApp:
                     self.summary = app.summary()
                 except BaseException as exc:  # noqa: BLE001
                     self.error = self.error or exc
-            if vis is not None:
-                vis.window.zmq_socket.close(linger=0)
             self._opened.set()
             self._set_status(self._ended_status())
 

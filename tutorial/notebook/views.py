@@ -95,8 +95,8 @@ class LiveView:
     def set_status(self, status: str) -> None:
         """Say what the view shows now (the caption under the page)."""
         self.status = status
-        for d in list(self._displays):
-            d.refresh_caption()
+        if not self.closed:
+            self.widget.status = status
 
     # ---- kernel thread ---------------------------------------------------------------------
     def recording(self):
@@ -132,7 +132,7 @@ class LiveView:
 
 
 class _Display:
-    """One output showing one or more views side by side, with a caption under them."""
+    """One output showing one or more views side by side (each with its caption), then their recordings."""
 
     def __init__(self, views: list[LiveView], height: int):
         import ipywidgets
@@ -144,35 +144,20 @@ class _Display:
         for v in views:
             v.widget.height = height
             v.widget.layout = ipywidgets.Layout(flex="1 1 0%", min_width="0")
-        page = (
-            views[0].widget
-            if len(views) == 1
-            else ipywidgets.HBox([v.widget for v in views], layout=ipywidgets.Layout(width="100%", grid_gap="4px"))
-        )
-        self._box = None if len(views) == 1 else page
+        self._box = None
+        page = views[0].widget
+        if len(views) > 1:
+            self._box = page = ipywidgets.HBox([v.widget for v in views], layout=ipywidgets.Layout(grid_gap="4px"))
         self.page = display(page, display_id=True)
-        self.caption = display(HTML(self._caption()), display_id=True)
+        self.caption = display(HTML(""), display_id=True)  # says "recorded" once the page is a recording
         for v in views:
             v._displays.append(self)
-
-    def _caption(self) -> str:
-        parts = []
-        for v in self.views:
-            state = "recording" if v.closed else "live"
-            parts.append(f"<b>{html.escape(v.label)}</b> ({state}): {html.escape(v.status)}")
-        return '<div style="font-size: 90%">' + " &nbsp;|&nbsp; ".join(parts) + "</div>"
-
-    def refresh_caption(self) -> None:
-        from IPython.display import HTML
-
-        self.caption.update(HTML(self._caption()))
 
     def view_closed(self) -> None:
         """Once every view of this output has closed, show their recordings side by side."""
         from IPython.display import HTML
 
         if not all(v.closed for v in self.views):
-            self.refresh_caption()
             return
         scenes = [v.recording() for v in self.views]
         if any(s is None for s in scenes):
@@ -241,11 +226,8 @@ class MeshcatPage:
         """Display the live page, with a caption, in this cell's output."""
         from IPython.display import HTML, display
 
-        self._handle = display(self.widget, display_id=True)
-        self._caption = display(
-            HTML(f'<div style="font-size: 90%"><b>{html.escape(self.label)}</b> (live)</div>'),
-            display_id=True,
-        )
+        self._handle = display(self.widget, display_id=True)  # its caption says "(live)"
+        self._caption = display(HTML(""), display_id=True)  # says "a saved copy" once it has closed
 
     def close(self) -> None:
         """Leave a still copy of the scene in the output, then close the widget (kernel thread)."""

@@ -114,7 +114,7 @@ function check(viewer, buffers) {
     if (!cmd || typeof cmd !== "object" || !KNOWN.includes(cmd.type)) {
       throw new Error(`not a meshcat scene command: type ${cmd && cmd.type}`);
     }
-    if (cmd.type !== "set_animation") {
+    if (cmd.type !== "set_animation" && cmd.type !== "set_transforms") {  // those two have no path of their own
       if (typeof cmd.path !== "string" || cmd.path.length > LIMITS.max_path_chars) {
         throw new Error(`${cmd.type}: the path is not a string of at most ${LIMITS.max_path_chars} characters`);
       }
@@ -145,12 +145,33 @@ function render({ model, el }) {
   const frame = document.createElement("iframe");
   frame.style.cssText = `width: 100%; height: ${model.get("height")}px; border: none; display: block`;
   frame.title = label;
+  frame.className = "rtt-live-view";
   el.appendChild(frame);
+  // Under the view: what it shows now (the widget's status, set by the kernel), or that it is not live.
+  const caption = document.createElement("div");
+  caption.className = "rtt-caption";
+  caption.style.cssText = "font-size: 90%; margin-top: 2px";
+  el.appendChild(caption);
+  const showCaption = (live) => {
+    const status = model.get("status");
+    caption.innerHTML = "";
+    const name = document.createElement("b");
+    name.textContent = label;
+    caption.appendChild(name);
+    caption.appendChild(document.createTextNode(
+      live ? ` (live)${status ? ": " + status : ""}`
+        : " (not live): its kernel has gone, so nothing runs; run the section again for a live view."));
+  };
+  showCaption(true);
+  model.on("change:status", () => {
+    if (!notice) showCaption(true);
+  });
   // What the view has done, for a test or a curious learner: el.rttView in the browser's console.
   const stats = { id, frames: 0, dropped: 0, scenes: 0, errors: [] };
   el.rttView = stats;
   let viewer = null;
   let gone = false;
+  let notice = null;  // the "not live any more" notice, while it shows
 
   const answer = () => {
     // Once the frame after this message has been drawn: meshcat draws in its animation frame, which it
@@ -166,8 +187,11 @@ function render({ model, el }) {
   const onMessage = (msg, buffers) => {
     if (msg && msg.type === "pong") {
       stats.ponged = Date.now();
-      if (notice) notice.remove();
-      notice = null;
+      if (notice) {
+        notice.remove();
+        notice = null;
+        showCaption(true);
+      }
       return;
     }
     if (!viewer || !msg) return;
@@ -194,7 +218,6 @@ function render({ model, el }) {
   // and says so to each model (comm_live_update).  The view then asks its kernel whether it is still
   // there: no answer within PING_MS, and the page says this view is not live any more (its last frame
   // stays).  An answer that comes later (a kernel that was only busy) takes the notice away.
-  let notice = null;
   model.on("comm_live_update", () => {
     const asked = Date.now();
     stats.pinged = asked;
@@ -209,6 +232,7 @@ function render({ model, el }) {
         "background: rgba(255, 236, 179, 0.95); color: #5d4037; font: 13px sans-serif";
       el.style.position = "relative";
       el.appendChild(notice);
+      showCaption(false);
     }, LIMITS.ping_ms);
     try {
       model.send({ type: "ping" });

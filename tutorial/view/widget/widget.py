@@ -100,8 +100,11 @@ class MeshcatWidget(anywidget.AnyWidget):
     """A live meshcat scene in a notebook output, over the kernel's connection.
 
     Args:
-        label: what the view shows (its iframe's title, the console's messages).
+        label: what the view shows (its caption, its iframe's title, the console's messages).
         height: height of the view, px.
+
+    The caption under the view reads "label (live): status"; once the
+    kernel has gone, the page says the view is not live any more.
 
     Attributes:
         rejected: how many frames a browser refused (a bad command: the browser's console says
@@ -111,6 +114,7 @@ class MeshcatWidget(anywidget.AnyWidget):
     _esm = _esm()
     label = traitlets.Unicode("").tag(sync=True)
     height = traitlets.Int(380).tag(sync=True)
+    status = traitlets.Unicode("").tag(sync=True)  # what the view shows now, in its caption (any thread)
 
     def __init__(self, label: str = "meshcat", height: int = 380):
         super().__init__(label=label, height=height)

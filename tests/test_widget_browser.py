@@ -1,0 +1,203 @@
+"""The live view's browser side (tutorial/view/widget/widget.js) in Chromium, with a stand-in for Jupyter.
+
+The widget's module is imported into a blank page and given a model that
+records what the view sends and lets the test send what the kernel would:
+meshcat's script when asked, the scene after the view's hello, frames.  So
+each message a view can be sent is tried exactly, and fast:
+
+- the scene and a frame draw (the box moves on the canvas);
+- every frame is answered with ``drawn``, and only after it was drawn;
+- a message it cannot take (a command that is not msgpack, an unknown
+  command type, a buffer over the limit, a ``set_transforms`` to a path the
+  scene does not have, a non-finite matrix) is named in the console, that
+  frame is dropped whole (nothing of it is drawn), the kernel is told, and
+  the next good frame draws;
+- a scene meant for another view is ignored; the kernel cut off
+  (``comm_live_update`` with no answer to its ping) brings the notice and a
+  caption that says "not live", and an answer takes them away.
+
+The same view in JupyterLab, over a real kernel, reloaded and across hosts:
+tests/test_jupyterlab.py and tests/test_network_lab.py.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+
+import meshcat
+import meshcat.geometry as g
+import msgpack
+import numpy as np
+import pytest
+import umsgpack
+from meshcat.commands import SetObject, SetTransform
+
+from tests.jupyterlab import browser
+from tutorial.view.meshcat_batch import pack_batch
+from tutorial.view.meshcat_page import viewer_script_gzip
+from tutorial.view.widget.widget import LIMITS, MeshcatWidget
+
+pytestmark = pytest.mark.browser
+
+# A stand-in for anywidget's model: records what the view sends, lets the test deliver messages.
+HARNESS = """async ([esm, script, ping_ms]) => {
+  const listeners = {};
+  const state = {label: "test view", height: 300, status: "running"};
+  window.sent = [];
+  window.model = {
+    get: (k) => state[k],
+    on: (name, cb) => { (listeners[name] = listeners[name] || []).push(cb); },
+    off: (name, cb) => { listeners[name] = (listeners[name] || []).filter((c) => c !== cb); },
+    send: (content) => {
+      window.sent.push(content);
+      if (content.type === "viewer_js") {
+        const bytes = Uint8Array.from(atob(script), (c) => c.charCodeAt(0));
+        setTimeout(() => window.deliver({type: "viewer_js"}, [new DataView(bytes.buffer)]), 0);
+      }
+    },
+  };
+  window.deliver = (msg, buffers) => (listeners["msg:custom"] || []).forEach((cb) => cb(msg, buffers || []));
+  window.trigger = (name) => (listeners[name] || []).forEach((cb) => cb());
+  const source = esm.replace(/"ping_ms": \\d+/, `"ping_ms": ${ping_ms}`);
+  const module = await import(URL.createObjectURL(new Blob([source], {type: "text/javascript"})));
+  window.el = document.getElementById("el");
+  module.default.render({model: window.model, el: window.el});
+}"""
+
+# Deliver packed commands (base64) as one message's buffers; "HUGE:n" is n zero bytes, made in the page.
+DELIVER = """([msg, b64s]) => window.deliver(msg, b64s.map((b) => {
+  if (b.startsWith("HUGE:")) return new DataView(new ArrayBuffer(Number(b.slice(5))));
+  const bytes = Uint8Array.from(atob(b), (c) => c.charCodeAt(0));
+  return new DataView(bytes.buffer);
+}))"""
+
+
+def b64(buffers: list) -> list[str]:
+    return [b if isinstance(b, str) else base64.b64encode(b).decode("ascii") for b in buffers]
+
+
+def box_command() -> bytes:
+    return umsgpack.packb(
+        SetObject(
+            g.Box([0.6, 0.6, 0.6]), g.MeshLambertMaterial(color=0xFF0000), meshcat.path.Path(("meshcat", "box"))
+        ).lower()
+    )
+
+
+def move(x: float, path=("meshcat", "box")) -> dict:
+    m = np.eye(4)
+    m[1, 3] = x  # across meshcat's default camera's view
+    return SetTransform(m, meshcat.path.Path(path)).lower()
+
+
+@pytest.fixture(scope="module")
+def view():
+    """A page with one view rendered from the widget's real module, its scene (a red box) delivered."""
+    with browser(width=500, height=420) as page:
+        errors: list[str] = []
+        page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+        page.set_content("<html><body style='margin: 0'><div id='el' style='width: 480px'></div></body></html>")
+        page.evaluate(HARNESS, [MeshcatWidget._esm, base64.b64encode(viewer_script_gzip()).decode("ascii"), 1500])
+        page.wait_for_function("window.sent.some((m) => m.type === 'hello')", timeout=30_000)
+        hello = next(m for m in page.evaluate("window.sent") if m["type"] == "hello")
+        page.evaluate(DELIVER, [{"type": "scene", "to": hello["id"]}, b64([box_command(), msgpack.packb(move(0.0))])])
+        page.wait_for_function("window.el.rttView.scenes === 1", timeout=10_000)
+        yield page, errors
+
+
+def red_x(page) -> float:
+    """Where the red box is across the view, px (mean column of its red pixels)."""
+    from io import BytesIO
+
+    from PIL import Image
+
+    image = np.asarray(Image.open(BytesIO(page.locator("iframe.rtt-live-view").screenshot())).convert("RGB")).astype(
+        int
+    )
+    red = (image[..., 0] > 120) & (image[..., 1] < 60) & (image[..., 2] < 60)
+    assert red.sum() > 50, "no red box in the view"
+    return float(np.nonzero(red)[1].mean())
+
+
+def frame(page, buffers: list[bytes]) -> dict:
+    """Deliver one frame; wait for its answer; the view's counts."""
+    answers = page.evaluate("window.sent.filter((m) => m.type === 'drawn').length")
+    page.evaluate(DELIVER, [{"type": "frame"}, b64(buffers)])
+    page.wait_for_function(f"window.sent.filter((m) => m.type === 'drawn').length > {answers}", timeout=10_000)
+    return page.evaluate("window.el.rttView")
+
+
+def test_scene_and_frames_draw_and_each_is_answered(view):
+    page, errors = view
+    page.wait_for_timeout(300)  # nothing to wait on: the first picture of a static scene
+    at_start = red_x(page)
+    stats = frame(page, [pack_batch([move(1.0)])])
+    assert stats["frames"] >= 2 and stats["dropped"] == 0
+    page.wait_for_timeout(200)  # the frame is drawn (it was answered); the screenshot takes the next
+    moved = red_x(page)
+    assert abs(moved - at_start) > 20, f"the box did not move: {at_start:.0f} -> {moved:.0f} px"
+    assert not errors, errors
+
+
+@pytest.mark.parametrize(
+    "bad, reason",
+    [
+        (b"\xc1\xc1\xc1", "not msgpack"),
+        (msgpack.packb({"type": "capture_image", "path": "/x"}), "not a meshcat scene command"),
+        (pack_batch([move(2.0, ("meshcat", "nothing", "here"))]), "no /meshcat/nothing/here in the scene"),
+        (msgpack.packb(dict(move(2.0), matrix=[float("nan")] + [0.0] * 15)), "not a finite number"),
+        (msgpack.packb(dict(move(2.0), path="/a" * (LIMITS["max_path_parts"] + 1))), "more than"),
+        (f"HUGE:{LIMITS['max_command_bytes'] + 1}", "over the limit"),
+    ],
+    ids=["not-msgpack", "unknown-type", "unknown-path", "nan", "deep-path", "huge"],
+)
+def test_a_bad_message_drops_that_frame_whole_and_the_view_goes_on(view, bad, reason):
+    page, errors = view
+    errors.clear()
+    frame(page, [pack_batch([move(0.0)])])
+    before = page.evaluate("window.el.rttView")
+    x0 = red_x(page)
+    # a good command first, then the bad one: nothing of the frame may be drawn
+    stats = frame(page, [msgpack.packb(move(1.5)), bad])
+    assert stats["dropped"] == before["dropped"] + 1 and stats["frames"] == before["frames"], stats
+    assert reason in stats["errors"][-1], stats["errors"][-1]
+    assert any("dropped a frame" in e and reason in e for e in errors), errors
+    assert page.evaluate("window.sent.at(-2)")["type"] == "rejected"
+    page.wait_for_timeout(200)  # a frame was not drawn: nothing to wait on but the next animation frame
+    assert abs(red_x(page) - x0) < 2, "part of a dropped frame was drawn"
+    after = frame(page, [pack_batch([move(1.5)])])
+    assert after["frames"] == stats["frames"] + 1, "the view did not go on after a bad frame"
+    page.wait_for_timeout(200)
+    assert abs(red_x(page) - x0) > 20, "the good frame after the bad one did not draw"
+
+
+def test_a_scene_for_another_view_is_ignored(view):
+    page, _ = view
+    before = page.evaluate("window.el.rttView")
+    page.evaluate(DELIVER, [{"type": "scene", "to": "another"}, b64([box_command()])])
+    page.evaluate(DELIVER, [{"type": "pong"}, []])  # any message after it: the first has been handled
+    assert page.evaluate("window.el.rttView")["scenes"] == before["scenes"]
+
+
+def test_cut_off_from_its_kernel_the_view_says_it_is_not_live_and_an_answer_takes_that_back(view):
+    page, _ = view
+    caption = page.locator(".rtt-caption")
+    assert caption.inner_text().startswith("test view (live): running")
+    page.evaluate("window.trigger('comm_live_update')")
+    assert page.evaluate("window.sent.at(-1)")["type"] == "ping"
+    notice = page.locator(".rtt-not-live")
+    notice.wait_for(timeout=10_000)
+    assert "Not live any more" in notice.inner_text()
+    assert "(not live)" in caption.inner_text()
+    page.evaluate(DELIVER, [{"type": "pong"}, []])  # the kernel was only slow
+    assert notice.count() == 0 and "(live)" in caption.inner_text()
+    # answered in time: no notice at all
+    page.evaluate("window.trigger('comm_live_update')")
+    page.evaluate(DELIVER, [{"type": "pong"}, []])
+    page.wait_for_timeout(2000)  # past the ping's 1.5 s: the notice would have shown by now
+    assert notice.count() == 0
+
+
+def test_the_module_is_the_widgets_with_its_limits():
+    assert json.dumps(LIMITS) in MeshcatWidget._esm
