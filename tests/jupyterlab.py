@@ -47,6 +47,11 @@ CHROMIUM_FLAGS = [
 # Every URL the browser may load: this server's pages and meshcat's, all on 127.0.0.1, and in-page data.
 _OFF_HOST = re.compile(r"^(?!(https?|wss?)://127\.0\.0\.1[:/]|data:|blob:|about:|chrome-error:)")
 
+
+def _off(host: str) -> re.Pattern:
+    """Every URL but ``host``'s (a test's own network host) and in-page data."""
+    return re.compile(rf"^(?!(https?|wss?)://{re.escape(host)}[:/]|data:|blob:|about:|chrome-error:)")
+
 # Settings for the test's JupyterLab, by extension and plugin.
 SETTINGS = {
     ("apputils-extension", "notification"): {"fetchNews": "false", "checkForUpdates": False},  # no news prompt
@@ -81,10 +86,12 @@ class JupyterLab:
     process group) and their children (e.g. meshcat servers).
     """
 
-    def __init__(self, root: Path, env: dict | None = None, timeout: float = 60.0):
+    def __init__(
+        self, root: Path, env: dict | None = None, timeout: float = 60.0, ip: str = "127.0.0.1", prefix=()
+    ):
         self.root = Path(root)
         self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
+        self.url = f"http://{ip}:{self.port}"
         self._tmp = Path(tempfile.mkdtemp(prefix="rtt-jupyterlab-"))
         for (extension, plugin), values in SETTINGS.items():
             folder = self._tmp / "settings" / "@jupyterlab" / extension
@@ -108,11 +115,12 @@ class JupyterLab:
         jupyter = str(Path(sys.executable).parent / "jupyter")
         self.proc = subprocess.Popen(
             [
+                *prefix,  # e.g. a test host's command (tests/netns.py): the server runs on that host
                 jupyter,
                 "lab",
                 "--allow-root",
                 "--no-browser",
-                "--ip=127.0.0.1",
+                f"--ip={ip}",
                 f"--port={self.port}",
                 "--ServerApp.token=",
                 "--ServerApp.password=",
@@ -127,8 +135,8 @@ class JupyterLab:
         )
         deadline = time.monotonic() + timeout
         while True:
-            with contextlib.suppress(OSError):
-                socket.create_connection(("127.0.0.1", self.port), 0.2).close()
+            # Listening: the server writes its runtime file once its port is open (seen from any host).
+            if list((self._tmp / "runtime").glob("jpserver-*.json")):
                 break
             if self.proc.poll() is not None or time.monotonic() > deadline:
                 self.close()
@@ -178,13 +186,14 @@ class JupyterLab:
 
 
 @contextlib.contextmanager
-def browser(width: int = 1280, height: int = 1000, refused: list | None = None):
+def browser(width: int = 1280, height: int = 1000, refused: list | None = None, host: str = "127.0.0.1"):
     """A Playwright page in headless Debian Chromium; closed at the end.
 
     Args:
         width, height: the viewport, px.
-        refused: if given, every request for anything but 127.0.0.1 is
+        refused: if given, every request for anything but ``host`` is
             appended to it (and refused in any case).
+        host: the one host the page may load from (a test's own network host, or 127.0.0.1).
     """
     from playwright.sync_api import sync_playwright
 
@@ -197,7 +206,7 @@ def browser(width: int = 1280, height: int = 1000, refused: list | None = None):
         b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
         try:
             context = b.new_context(viewport={"width": width, "height": height})
-            context.route(_OFF_HOST, refuse)
+            context.route(_OFF_HOST if host == "127.0.0.1" else _off(host), refuse)
             yield context.new_page()
         finally:
             b.close()

@@ -156,20 +156,54 @@ def test_a_bad_message_drops_that_frame_whole_and_the_view_goes_on(view, bad, re
     page, errors = view
     errors.clear()
     frame(page, [pack_batch([move(0.0)])])
-    before = page.evaluate("window.el.rttView")
+    before = dict(page.evaluate("window.el.rttView"), sent=page.evaluate("window.sent.length"))
     x0 = red_x(page)
     # a good command first, then the bad one: nothing of the frame may be drawn
     stats = frame(page, [msgpack.packb(move(1.5)), bad])
     assert stats["dropped"] == before["dropped"] + 1 and stats["frames"] == before["frames"], stats
     assert reason in stats["errors"][-1], stats["errors"][-1]
     assert any("dropped a frame" in e and reason in e for e in errors), errors
-    assert page.evaluate("window.sent.at(-2)")["type"] == "rejected"
+    told = [m["type"] for m in page.evaluate("window.sent")[before["sent"] :]]
+    assert "rejected" in told, told
     page.wait_for_timeout(200)  # a frame was not drawn: nothing to wait on but the next animation frame
     assert abs(red_x(page) - x0) < 2, "part of a dropped frame was drawn"
     after = frame(page, [pack_batch([move(1.5)])])
     assert after["frames"] == stats["frames"] + 1, "the view did not go on after a bad frame"
     page.wait_for_timeout(200)
     assert abs(red_x(page) - x0) > 20, "the good frame after the bad one did not draw"
+
+
+def test_a_frame_that_draws_and_moves_a_new_body_draws_and_a_dropped_frame_asks_for_the_scene(view):
+    """A run restarted in the same view sends its bodies and their first poses in one frame."""
+    page, errors = view
+    errors.clear()
+    green = umsgpack.packb(
+        SetObject(
+            g.Box([0.3, 0.3, 0.3]), g.MeshLambertMaterial(color=0x00FF00), meshcat.path.Path(("meshcat", "new", "g"))
+        ).lower()
+    )
+    dropped = page.evaluate("window.el.rttView.dropped")
+    stats = frame(page, [green, pack_batch([move(-1.0, ("meshcat", "new")), move(0.5)])])
+    assert stats["dropped"] == dropped, stats["errors"]
+    assert not errors, errors
+    page.wait_for_timeout(3000)  # past the view's 2 s between asking for the scene again
+    n = page.evaluate("window.sent.length")
+    frame(page, [pack_batch([move(0.0, ("meshcat", "not", "drawn"))])])
+    told = [m["type"] for m in page.evaluate("window.sent")[n:]]
+    assert told[:2] == ["rejected", "hello"], f"a dropped frame did not ask for the whole scene again: {told}"
+
+
+def test_a_scene_with_a_bad_command_draws_the_rest(view):
+    page, errors = view
+    errors.clear()
+    hello = [m for m in page.evaluate("window.sent") if m["type"] == "hello"][0]
+    before = page.evaluate("window.el.rttView")
+    page.evaluate(
+        DELIVER, [{"type": "scene", "to": hello["id"]}, b64([b"\xc1", box_command(), msgpack.packb(move(0.2))])]
+    )
+    after = page.evaluate("window.el.rttView")
+    assert after["scenes"] == before["scenes"] + 1 and after["dropped"] == before["dropped"]
+    assert any("left out of the scene" in e for e in errors), errors
 
 
 def test_a_scene_for_another_view_is_ignored(view):

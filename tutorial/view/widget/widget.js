@@ -86,7 +86,7 @@ function hasNode(viewer, path) {
   return true;
 }
 
-function checkTransform(cmd, viewer, inBatch) {
+function checkTransform(cmd, viewer, created) {
   const m = cmd.matrix;
   if (!m || m.length !== 16) throw new Error(`set_transform at ${cmd.path}: the matrix is not 16 numbers`);
   for (let i = 0; i < 16; i++) {
@@ -94,49 +94,68 @@ function checkTransform(cmd, viewer, inBatch) {
       throw new Error(`set_transform at ${cmd.path}: matrix entry ${i} is ${m[i]}, not a finite number`);
     }
   }
-  // A frame's transforms move what the scene has: a path it does not have is an error, not a new node.
-  if (inBatch && !hasNode(viewer, cmd.path)) throw new Error(`set_transforms: no ${cmd.path} in the scene`);
+  // A frame's transforms move what the scene has (or what the same message draws first): a path it does
+  // not have is an error, not a new node.
+  if (created && !created.has(pathParts(cmd.path).join("/")) && !hasNode(viewer, cmd.path)) {
+    throw new Error(`set_transforms: no ${cmd.path} in the scene`);
+  }
 }
 
-// The commands of one message, all checked before any is drawn: a bad one drops the whole frame.
+// One packed command, decoded and checked; throws an Error naming what is wrong.  ``created``: the paths
+// (and their parents) that set_object commands earlier in the same message draw.
+function checkOne(viewer, buffer, created) {
+  if (buffer.byteLength > LIMITS.max_command_bytes) {
+    throw new Error(`a command of ${buffer.byteLength} bytes, over the limit of ${LIMITS.max_command_bytes}`);
+  }
+  let cmd;
+  try {
+    cmd = decode(viewer, new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength));
+  } catch (error) {
+    throw new Error(`a command that is not msgpack: ${error.message}`);
+  }
+  if (!cmd || typeof cmd !== "object" || !KNOWN.includes(cmd.type)) {
+    throw new Error(`not a meshcat scene command: type ${cmd && cmd.type}`);
+  }
+  if (cmd.type !== "set_animation" && cmd.type !== "set_transforms") {  // those two have no path of their own
+    if (typeof cmd.path !== "string" || cmd.path.length > LIMITS.max_path_chars) {
+      throw new Error(`${cmd.type}: the path is not a string of at most ${LIMITS.max_path_chars} characters`);
+    }
+    if (pathParts(cmd.path).length > LIMITS.max_path_parts) {
+      throw new Error(`${cmd.type}: a path of more than ${LIMITS.max_path_parts} parts`);
+    }
+  }
+  if (cmd.type === "set_transform") checkTransform(cmd, viewer, null);
+  if (cmd.type === "set_transforms") {
+    if (!Array.isArray(cmd.commands) || cmd.commands.length > LIMITS.max_commands) {
+      throw new Error(`set_transforms: not a list of at most ${LIMITS.max_commands} commands`);
+    }
+    for (const inner of cmd.commands) {
+      if (!inner || inner.type !== "set_transform" || typeof inner.path !== "string") {
+        throw new Error("set_transforms: an entry that is not a set_transform with a path");
+      }
+      checkTransform(inner, viewer, created);
+    }
+  }
+  if (cmd.type === "set_object") {
+    const parts = pathParts(cmd.path);
+    for (let n = 1; n <= parts.length; n++) created.add(parts.slice(0, n).join("/"));
+  }
+  return cmd;
+}
+
+// The commands of one message, each checked: [good commands, errors].
 function check(viewer, buffers) {
   const commands = [];
+  const errors = [];
+  const created = new Set();
   for (const buffer of buffers) {
-    if (buffer.byteLength > LIMITS.max_command_bytes) {
-      throw new Error(`a command of ${buffer.byteLength} bytes, over the limit of ${LIMITS.max_command_bytes}`);
-    }
-    let cmd;
     try {
-      cmd = decode(viewer, new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength));
+      commands.push(checkOne(viewer, buffer, created));
     } catch (error) {
-      throw new Error(`a command that is not msgpack: ${error.message}`);
+      errors.push(error.message);
     }
-    if (!cmd || typeof cmd !== "object" || !KNOWN.includes(cmd.type)) {
-      throw new Error(`not a meshcat scene command: type ${cmd && cmd.type}`);
-    }
-    if (cmd.type !== "set_animation" && cmd.type !== "set_transforms") {  // those two have no path of their own
-      if (typeof cmd.path !== "string" || cmd.path.length > LIMITS.max_path_chars) {
-        throw new Error(`${cmd.type}: the path is not a string of at most ${LIMITS.max_path_chars} characters`);
-      }
-      if (pathParts(cmd.path).length > LIMITS.max_path_parts) {
-        throw new Error(`${cmd.type}: a path of more than ${LIMITS.max_path_parts} parts`);
-      }
-    }
-    if (cmd.type === "set_transform") checkTransform(cmd, viewer, false);
-    if (cmd.type === "set_transforms") {
-      if (!Array.isArray(cmd.commands) || cmd.commands.length > LIMITS.max_commands) {
-        throw new Error(`set_transforms: not a list of at most ${LIMITS.max_commands} commands`);
-      }
-      for (const inner of cmd.commands) {
-        if (!inner || inner.type !== "set_transform" || typeof inner.path !== "string") {
-          throw new Error("set_transforms: an entry that is not a set_transform with a path");
-        }
-        checkTransform(inner, viewer, true);
-      }
-    }
-    commands.push(cmd);
   }
-  return commands;
+  return [commands, errors];
 }
 
 function render({ model, el }) {
@@ -184,6 +203,13 @@ function render({ model, el }) {
       }
     });
   };
+  let resynced = 0;  // when this view last asked for the whole scene after a dropped frame, ms
+  const say = (error) => {
+    stats.errors.push(error);
+    if (stats.errors.length > 20) stats.errors.shift();
+    console.error(`ros-tank-tutorial view "${label}": ${error}`);
+    model.send({ type: "rejected", reason: String(error).slice(0, 300) });
+  };
   const onMessage = (msg, buffers) => {
     if (msg && msg.type === "pong") {
       stats.ponged = Date.now();
@@ -196,18 +222,21 @@ function render({ model, el }) {
     }
     if (!viewer || !msg) return;
     if (msg.type !== "frame" && !(msg.type === "scene" && msg.to === id)) return;
-    let commands;
-    try {
-      commands = check(viewer, buffers || []);
-    } catch (error) {
+    const [commands, errors] = check(viewer, buffers || []);
+    if (msg.type === "frame" && errors.length > 0) {
+      // A frame is drawn whole or not at all; what it would have changed comes back with the whole scene,
+      // asked for again (at most every 2 s, so a sender of bad frames cannot make it ask all the time).
       stats.dropped += 1;
-      stats.errors.push(error.message);
-      if (stats.errors.length > 20) stats.errors.shift();
-      console.error(`ros-tank-tutorial view "${label}": dropped a frame: ${error.message}`);
-      model.send({ type: "rejected", reason: String(error.message).slice(0, 300) });
+      say(`dropped a frame: ${errors[0]}`);
+      if (Date.now() - resynced > 2000) {
+        resynced = Date.now();
+        model.send({ type: "hello", id });
+      }
       answer();
       return;
     }
+    // The whole scene: every command it can take is drawn, each one it cannot is named.
+    for (const error of errors) say(`left out of the scene: ${error}`);
     for (const cmd of commands) viewer.handle_command(cmd);
     if (msg.type === "scene") stats.scenes += 1;
     stats.frames += 1;
