@@ -203,7 +203,10 @@ def browser(width: int = 1280, height: int = 1000, refused: list | None = None, 
         route.abort("blockedbyclient")
 
     with sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+        flags = CHROMIUM_FLAGS
+        if host != "127.0.0.1":  # the test's own host is the one more address that resolves
+            flags = [f + f", EXCLUDE {host}" if f.startswith("--host-resolver-rules=") else f for f in flags]
+        b = pw.chromium.launch(executable_path=CHROMIUM, args=flags)
         try:
             context = b.new_context(viewport={"width": width, "height": height})
             context.route(_OFF_HOST if host == "127.0.0.1" else _off(host), refuse)
