@@ -52,6 +52,7 @@ def _off(host: str) -> re.Pattern:
     """Every URL but ``host``'s (a test's own network host) and in-page data."""
     return re.compile(rf"^(?!(https?|wss?)://{re.escape(host)}[:/]|data:|blob:|about:|chrome-error:)")
 
+
 # Settings for the test's JupyterLab, by extension and plugin.
 SETTINGS = {
     ("apputils-extension", "notification"): {"fetchNews": "false", "checkForUpdates": False},  # no news prompt
@@ -86,9 +87,7 @@ class JupyterLab:
     process group) and their children (e.g. meshcat servers).
     """
 
-    def __init__(
-        self, root: Path, env: dict | None = None, timeout: float = 60.0, ip: str = "127.0.0.1", prefix=()
-    ):
+    def __init__(self, root: Path, env: dict | None = None, timeout: float = 60.0, ip: str = "127.0.0.1", prefix=()):
         self.root = Path(root)
         self.port = free_port()
         self.url = f"http://{ip}:{self.port}"
