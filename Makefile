@@ -9,6 +9,8 @@
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
 #       make test-hub (the hub with learners as Unix users: slow),
+#       make assignments (the class's nbgrader assignments from the notebooks, into course/),
+#       make grade (collect, autograde, feedback and course/grades.csv), make test-grade (every assignment graded),
 #       make export (write the controllers from the notebooks that build them),
 #       make run-notebooks (run every notebook and save its outputs, the ones nbval checks),
 #       make lock (uv.lock anew: the newest versions pyproject.toml allows), make test-latest (make test against
@@ -18,7 +20,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast test-lab test-hub test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab test-hub test-grade assignments grade test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
 
 UV_VERSION := 0.13.9
 
@@ -47,6 +49,18 @@ test: $(VENV)/.installed lint course/node_modules/.installed
 # own robots (make test runs the hub with two learners under one user, and with a network namespace each).
 test-hub: $(VENV)/.installed course/node_modules/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_hub.py -m slow -q
+
+# Grading every assignment's fake submissions (make test grades notebook 01's): several minutes.
+test-grade: $(VENV)/.installed
+	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_grading.py -m slow -q
+
+# The class's nbgrader course (course/): an assignment from each notebook with exercises, then its release.
+assignments: $(VENV)/.installed
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/assignments.py
+
+# Collect the submissions from the exchange, autograde them, write feedback and course/grades.csv.
+grade: $(VENV)/.installed
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/grade.py
 
 # The unit tier only: no ROS, no process, no browser.
 test-fast: $(VENV)/.installed

@@ -18,6 +18,9 @@
 #                       and 215-232; tests pick their own)
 #   RTT_HUB_PER_LEARNER_NETWORK  "1" when the spawner gives each learner a network namespace (containers,
 #                       pods): domains may then repeat
+#   RTT_NBGRADER_EXCHANGE  nbgrader's exchange, where learners fetch assignments and submit them (default
+#                       the state folder's exchange/; a course's server: /srv/nbgrader/exchange); the teacher's
+#                       course/nbgrader_config.py reads the same variable
 
 import os
 import pwd
@@ -84,6 +87,31 @@ c.Spawner.environment = {
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",  # a learner's nodes never look beyond this machine
     "PATH": f"{ENV_BIN}:/usr/local/bin:/usr/bin:/bin",  # rtt-* in the learner's terminals
 }
+
+# nbgrader for the learners: the course and its exchange (fetch and submit, from the Assignments tab of
+# JupyterLab or `nbgrader fetch_assignment` in a terminal), and no teacher's tools (formgrader, creating
+# assignments) in their JupyterLab.  Their servers read it from a Jupyter configuration folder of the hub's.
+EXCHANGE = Path(os.environ.get("RTT_NBGRADER_EXCHANGE", STATE / "exchange"))
+EXCHANGE.mkdir(parents=True, exist_ok=True)
+EXCHANGE.chmod(0o777)  # every learner writes their submissions into it
+LEARNER_CONFIG = STATE / "learner_jupyter"
+(LEARNER_CONFIG / "labconfig").mkdir(parents=True, exist_ok=True)
+(LEARNER_CONFIG / "nbgrader_config.py").write_text(
+    "c = get_config()  # noqa: F821\n"
+    'c.CourseDirectory.course_id = "ros-tank-tutorial"\n'
+    f"c.Exchange.root = {str(EXCHANGE)!r}\n"
+    "c.Exchange.path_includes_course = True\n"
+)
+(LEARNER_CONFIG / "labconfig" / "page_config.json").write_text(
+    '{"disabledExtensions": {"@jupyter/nbgrader:create-assignment": true, "@jupyter/nbgrader:course-list": true}}\n'
+)
+(LEARNER_CONFIG / "jupyter_server_config.json").write_text(
+    '{"ServerApp": {"jpserver_extensions": {"nbgrader.server_extensions.formgrader": false, '
+    '"nbgrader.server_extensions.course_list": false}}}\n'
+)
+for path in (LEARNER_CONFIG, LEARNER_CONFIG / "labconfig"):
+    path.chmod(0o755)
+c.Spawner.environment["JUPYTER_CONFIG_PATH"] = str(LEARNER_CONFIG)
 
 DOMAINS = DomainBook(
     STATE / "ros_domains.json",

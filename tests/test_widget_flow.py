@@ -200,7 +200,7 @@ def test_the_widget_answers_its_views(widget):
     content, buffers = widget.sent[-1]
     assert content == {"type": "scene", "to": "v1"} and [c["type"] for c in unpack(buffers)] == ["set_object"]
     vis["box"].set_transform(pose(1.0))  # the window has one frame left
-    assert widget.sent[-1][0] == {"type": "frame"}
+    assert widget.sent[-1][0] == {"type": "frame", "n": 1}
     n = len(widget.sent)
     vis["box"].set_transform(pose(2.0))
     vis["box"].set_transform(pose(3.0))

@@ -75,6 +75,16 @@ class Result:
 
     __repr__ = __str__
 
+    def require(self) -> Result:
+        """This result if it passed; else raise, with its one line (how an nbgrader test cell fails).
+
+        Raises:
+            AssertionError: the check failed; the message is the line a learner sees.
+        """
+        if not self.passed:
+            raise AssertionError(str(self))
+        return self
+
 
 def grade(exercise: str, cases: Iterable[Case]) -> Result:
     """Run the cases in order; stop at the first failure.

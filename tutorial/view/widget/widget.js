@@ -192,10 +192,16 @@ function render({ model, el }) {
   let gone = false;
   let notice = null;  // the "not live any more" notice, while it shows
 
-  const answer = () => {
+  // A benchmark's probe (benchmarks/experiments/widget.py sets window.rttProbe to an array): for each
+  // frame, [its number, when it arrived, when it was drawn], on this page's clock, ms.
+  const now = () => performance.timeOrigin + performance.now();
+  const answer = (n) => {
+    const probe = Array.isArray(window.rttProbe) && n !== undefined ? [n, now(), null] : null;
+    if (probe) window.rttProbe.push(probe);
     // Once the frame after this message has been drawn: meshcat draws in its animation frame, which it
     // asked for before this one, so it runs first.
     frame.contentWindow.requestAnimationFrame(() => {
+      if (probe) probe[2] = now();
       try {
         if (!gone) model.send({ type: "drawn" });
       } catch (error) {
@@ -240,7 +246,7 @@ function render({ model, el }) {
     for (const cmd of commands) viewer.handle_command(cmd);
     if (msg.type === "scene") stats.scenes += 1;
     stats.frames += 1;
-    answer();
+    answer(msg.n);
   };
   model.on("msg:custom", onMessage);
   // JupyterLab's widget manager cuts every widget off its kernel when the kernel restarts or stops,

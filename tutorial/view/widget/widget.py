@@ -127,6 +127,7 @@ class MeshcatWidget(anywidget.AnyWidget):
         self.rejected = 0
         self.last_rejection = ""
         self.hellos = 0
+        self.probe: list | None = None  # a benchmark's list: (frame number, monotonic ns when sent) of each frame
         self.on_msg(self._on_message)
 
     def __repr__(self) -> str:  # the same text every run (a saved output's text/plain)
@@ -157,7 +158,10 @@ class MeshcatWidget(anywidget.AnyWidget):
     def _send_frame(self) -> None:  # with self._lock held
         buffers = self.flow.take(time.monotonic(), busy=_CellWatch.busy)
         if buffers is not None:
-            self.send({"type": "frame"}, buffers)
+            n = self.flow.frames_sent
+            self.send({"type": "frame", "n": n}, buffers)
+            if self.probe is not None:
+                self.probe.append((n, time.monotonic_ns()))
 
     # ---- the kernel's thread: what the browser says ------------------------------------------------
     def _on_message(self, _widget, content, buffers) -> None:

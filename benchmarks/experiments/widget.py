@@ -1,0 +1,311 @@
+"""The live view over the notebook's own connection, beside the meshcat page over its own WebSocket, same run.
+
+    python -m benchmarks.experiments.widget [--seconds 8] [--cases tank_50Hz tanks_8] [--remote]
+
+For each case, the Step 3 viewer first runs for real (``browser.tutorial_run``:
+simulation, joystick, viewer) and its frames are taped: every command it
+sent to meshcat, at the moment it sent it.  The tape is then replayed, at
+the same moments, two ways, and each time the state handed to the view is
+timed to the pixel:
+
+- **page**: to the project's meshcat server and its page in Chromium (the
+  page every view was before: a WebSocket of its own), the frames exactly
+  as the viewer sent them; handed -> drawn is the send to the server ->
+  the end of the page's next render (``browser.analyse_bare``);
+- **widget**: in a JupyterLab kernel, into a :class:`MeshcatWidget`
+  shown in JupyterLab in Chromium (the view is 480 x 380 px, as the page);
+  handed -> drawn is the kernel's ``put`` of the state -> the view's
+  animation frame after the frame holding it (``window.rttProbe``).  A
+  state that a newer one replaced before it went out is not counted, as a
+  state the page never drew is not.
+
+``--remote`` also runs the browser on a second host with a 5 Mbit/s link
+(50 ms latency) to the kernel's (``tutorial.network.hosts``; root only):
+the frames the view draws from the kernel per second, and a trivial
+cell's time (tests/lab_browser.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.experiments.browser import CASES, Page, analyse_bare, tutorial_run
+from benchmarks.stats import pct
+
+ROOT = Path(__file__).resolve().parents[2]
+WIDGET_CASES = ("tank_50Hz", "tanks_8")
+
+REPLAY_CELL = """\
+import json, os, threading, time
+import msgpack, umsgpack
+from tutorial.view.widget.widget import MeshcatWidget
+
+tape = json.load(open({tape!r}))
+w = MeshcatWidget("benchmark", 380)
+w.layout.width = "480px"
+w.probe = []
+first = next(i for i, c in enumerate(tape) if c[4] is not None)
+for c in tape[:first]:
+    w.put([umsgpack.unpackb(bytes.fromhex(c[3]))])
+puts = []
+
+def replay():
+    deadline = time.monotonic() + 60
+    while w.hellos == 0 and time.monotonic() < deadline:
+        time.sleep(0.01)  # the view opens when the browser has drawn the output
+    time.sleep(1.0)  # the scene is drawn once before the clock starts
+    t0, base = time.monotonic_ns(), tape[first][0]
+    for c in tape[first:]:
+        wait = (t0 + (c[0] - base) - time.monotonic_ns()) / 1e9
+        if wait > 0:
+            time.sleep(wait)
+        data = bytes.fromhex(c[3])
+        commands = msgpack.unpackb(data)["commands"] if c[1] == "set_transforms" else [msgpack.unpackb(data)]
+        puts.append(time.monotonic_ns())
+        w.put(commands)
+    time.sleep(0.5)
+    with open({out!r} + ".part", "w") as f:
+        json.dump({{"puts": puts, "sent": w.probe, "replaced": w.flow.commands_replaced}}, f)
+    os.replace({out!r} + ".part", {out!r})
+
+threading.Thread(target=replay, daemon=True).start()
+w
+"""
+
+# In the view's iframe: its animation frames, to count the frames per second the view's page draws.
+IFRAME_RAFS = """() => {
+  const f = document.querySelector('iframe.rtt-live-view');
+  if (!f || !f.contentWindow || f.contentWindow.__rafs) return !!(f && f.contentWindow && f.contentWindow.__rafs);
+  const w = f.contentWindow;
+  w.__rafs = [];
+  const tick = () => { w.__rafs.push(performance.timeOrigin + performance.now()); w.requestAnimationFrame(tick); };
+  w.requestAnimationFrame(tick);
+  return true;
+}"""
+
+
+def page_run(tape: list, lead_s: float = 1.0) -> tuple[dict, list]:
+    """Replay ``tape`` as the viewer sent it to the project's server and page; the page's samples and the send log."""
+    import zmq
+
+    from tutorial.view.meshcat_server import start_server
+
+    server = start_server(batch=True)
+    page = None
+    sock = zmq.Context.instance().socket(zmq.DEALER)
+    sock.setsockopt(zmq.LINGER, 0)
+    sock.connect(server.zmq_url)
+    sent: list[tuple[int, int]] = []
+    try:
+        page = Page(server.web_url)
+        first = next(i for i, c in enumerate(tape) if c[4] is not None)
+
+        def send(c) -> None:
+            data = bytes.fromhex(c[3])
+            sock.send_multipart([b"", c[1].encode(), c[2].encode(), data])
+            sent.append((time.monotonic_ns(), zlib.crc32(data)))
+            if not sock.poll(5000):
+                raise RuntimeError("the meshcat server did not answer")
+            sock.recv_multipart()
+
+        for c in tape[:first]:
+            send(c)
+        time.sleep(lead_s)  # not synchronisation: the page draws the scene once before the clock starts
+        t0, base = time.monotonic_ns(), tape[first][0]
+        for c in tape[first:]:
+            wait = (t0 + (c[0] - base) - time.monotonic_ns()) / 1e9
+            if wait > 0:
+                time.sleep(wait)
+            send(c)
+        time.sleep(0.5)  # the last frames reach the page
+        samples = page.samples()
+    finally:
+        if page is not None:
+            page.close()
+        sock.close()
+        server.close()
+    return samples, sent
+
+
+def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
+    """Replay ``tape`` into a MeshcatWidget in a JupyterLab kernel, shown in Chromium; the raw records."""
+    import nbformat
+    from playwright.sync_api import sync_playwright
+
+    from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS, JupyterLab
+
+    tape_file, out = directory / "tape.json", directory / "widget_out.json"
+    tape_file.write_text(json.dumps(tape))
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_code_cell(REPLAY_CELL.format(tape=str(tape_file), out=str(out)))]
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nbformat.write(nb, directory / "replay.ipynb")
+    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}) as lab, sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+        try:
+            page = browser.new_page(viewport={"width": 1000, "height": 800})
+            page.add_init_script("window.rttProbe = [];")
+            page.goto(lab.notebook_url("replay.ipynb", workspace="replay"))
+            page.locator(".jp-Notebook .jp-Cell").first.wait_for(timeout=90_000)
+            deadline = time.monotonic() + 90
+            while "Idle" not in page.locator("#jp-main-statusbar").inner_text():
+                if time.monotonic() > deadline:
+                    raise RuntimeError("the kernel did not start")
+                page.wait_for_timeout(100)
+            page.locator(".jp-Notebook .jp-Cell").first.click()
+            page.keyboard.press("Control+Enter")
+            page.wait_for_function(IFRAME_RAFS, timeout=60_000)
+            deadline = time.monotonic() + timeout_s
+            while not out.exists():
+                if time.monotonic() > deadline:
+                    raise RuntimeError("the kernel's replay did not finish")
+                page.wait_for_timeout(200)
+            probe = page.evaluate("window.rttProbe")
+            rafs = page.evaluate("document.querySelector('iframe.rtt-live-view').contentWindow.__rafs")
+            stats = page.evaluate("document.querySelector('iframe.rtt-live-view').parentElement.rttView")
+            best = None
+            for _ in range(20):
+                a = time.monotonic_ns()
+                t = page.evaluate("performance.timeOrigin + performance.now()")
+                b = time.monotonic_ns()
+                if best is None or b - a < best[0]:
+                    best = (b - a, round(t * 1e6) - (a + b) // 2)
+        finally:
+            browser.close()
+    kernel = json.loads(out.read_text())
+    return dict(kernel, probe=probe, rafs=rafs, offset_ns=best[1], page=stats.get("page"), dropped=stats["dropped"])
+
+
+def analyse_widget(run: dict, warmup: float) -> dict:
+    """handed -> drawn (the kernel's put -> the view's frame after it), and the view's frames/s."""
+    puts = np.array(run["puts"], dtype=np.int64)
+    sent = dict(run["sent"])  # frame number -> monotonic ns sent
+    offset = run["offset_ns"]
+    start_ns = int(puts[0]) + int(warmup * 1e9)
+    handed_to_drawn, sent_to_page, page_to_drawn = [], [], []
+    counted = set()
+    for n, received, drawn in run["probe"]:
+        if drawn is None or n not in sent:
+            continue
+        t_sent = sent[n]
+        i = int(np.searchsorted(puts, t_sent, side="right")) - 1  # the newest state put before it went
+        if i < 0 or puts[i] < start_ns or i in counted:
+            continue
+        counted.add(i)
+        drawn_ns, received_ns = drawn * 1e6 - offset, received * 1e6 - offset
+        handed_to_drawn.append(drawn_ns - puts[i])
+        sent_to_page.append(received_ns - t_sent)
+        page_to_drawn.append(drawn_ns - received_ns)
+    rafs = np.array([t * 1e6 - offset for t in run["rafs"]])
+    rafs = rafs[(rafs >= start_ns) & (rafs <= puts[-1])]
+    fps = round(float((len(rafs) - 1) / ((rafs[-1] - rafs[0]) * 1e-9)), 1) if len(rafs) > 1 else None
+    frames = [t for _, t in run["sent"] if t >= start_ns]
+    return {
+        "handed_to_drawn": pct(handed_to_drawn, 1e-6),
+        "sent_to_page": pct(sent_to_page, 1e-6),
+        "page_to_drawn": pct(page_to_drawn, 1e-6),
+        "frames_per_s": fps,
+        "messages_per_s": round(len(frames) / ((puts[-1] - start_ns) * 1e-9), 1) if frames else None,
+        "states_handed": int((puts >= start_ns).sum()),
+        "states_drawn": len(counted),
+        "dropped": run["dropped"],
+        "page": run["page"],
+    }
+
+
+def widget_vs_page(cases: list[str], seconds: float, warmup: float) -> dict:
+    """Every case: the taped viewer replayed to the WebSocket page and to the widget, in the same run."""
+    out = {}
+    for case in cases:
+        with tempfile.TemporaryDirectory() as d:
+            tape = tutorial_run(case, seconds, Path(d))["tape"]
+            samples, sent = page_run(tape)
+            page = analyse_bare(samples, sent, warmup)
+            widget = analyse_widget(widget_run(tape, Path(d)), warmup)
+        out[case] = {"page": page, "widget": widget}
+        print(f"widget {case}: {json.dumps(out[case])}", flush=True)
+    return out
+
+
+def remote(mbit: float = 5.0) -> dict:
+    """JupyterLab on one host, Chromium on another over a ``mbit`` link: the view's frames/s and a cell's time."""
+    import nbformat
+
+    from tests.jupyterlab import JupyterLab
+    from tutorial.network.hosts import Network
+
+    with tempfile.TemporaryDirectory() as d, Network(("robot", "operator")) as net:
+        robot, operator = net["robot"], net["operator"]
+        nb = nbformat.v4.new_notebook()
+        nb.cells = [
+            nbformat.v4.new_code_cell(
+                "from tutorial.notebook.runs import BackgroundApp, load\n"
+                "from tutorial.notebook.session import init_ros\n\n"
+                "init_ros()\n"
+                'sim = BackgroundApp(load("step2.yaml"), node_name="rtt", label="simulation /rtt").start()\n'
+                "sim.show(height=320)"
+            ),
+            nbformat.v4.new_code_cell("1 + 1"),
+        ]
+        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+        nbformat.write(nb, Path(d) / "remote.ipynb")
+        joystick = subprocess.Popen(
+            robot.command([sys.executable, "-m", "tutorial.tools.rtt_joy", "--demo"]),
+            env=robot.env(PYTHONPATH=str(ROOT)),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        env = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET", "PYTHONPATH": str(ROOT), "RTT_TEST_MODE": None}
+        try:
+            operator.limit_rate(mbit)
+            with JupyterLab(Path(d), env=env, ip=robot.address, prefix=robot.command([])) as lab:
+                url = lab.notebook_url("remote.ipynb", "r")
+                done = subprocess.run(
+                    operator.command([sys.executable, "-m", "tests.lab_browser", url, robot.address]),
+                    cwd=ROOT,
+                    env=operator.env(PYTHONPATH=str(ROOT)),
+                    capture_output=True,
+                    text=True,
+                    timeout=300,
+                )
+                lab.note_processes()
+        finally:
+            joystick.kill()
+            joystick.wait(10)
+        if done.returncode != 0:
+            raise RuntimeError(f"the remote browser failed: {done.stderr[-2000:]}")
+        got = json.loads(done.stdout.strip().splitlines()[-1])
+        got["mbit"] = mbit
+        got["cell_ms_max"] = max(got["cell_ms"])
+        return got
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--seconds", type=float, default=8.0, help="simulated seconds per case (default 8)")
+    p.add_argument("--warmup", type=float, default=2.0, help="s left out at the start of each run (default 2)")
+    p.add_argument("--cases", nargs="+", choices=list(CASES), default=list(WIDGET_CASES))
+    p.add_argument("--remote", action="store_true", help="also the browser on a second host over 5 Mbit/s (root)")
+    args = p.parse_args(argv)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
+    r = {"cases": widget_vs_page(args.cases, args.seconds, args.warmup)}
+    if args.remote:
+        r["remote"] = remote()
+    print(json.dumps(r, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

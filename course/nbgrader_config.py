@@ -1,0 +1,56 @@
+"""nbgrader's configuration for the class: the course is this folder (``make assignments``, ``make grade``).
+
+The exchange, where learners fetch and submit, is the trial hub's
+(``course/.hub/exchange``, which ``make hub`` gives its learners) unless
+``RTT_NBGRADER_EXCHANGE`` names another (a course's server: nbgrader's
+usual ``/srv/nbgrader/exchange``; a test's own folder).  Every learner must
+be able to write to it (``chmod 777``, as nbgrader's documentation says).
+"""
+
+import os
+from pathlib import Path
+
+from nbgrader.preprocessors import (
+    CheckCellMetadata,
+    ClearHiddenTests,
+    ClearMarkScheme,
+    ClearOutput,
+    ClearSolutions,
+    ComputeChecksums,
+    IncludeHeaderFooter,
+    InstantiateTests,
+    LockCells,
+    SaveCells,
+)
+
+from tutorial.exercises.release import ReleaseStubs
+
+c = get_config()  # noqa: F821 - given by nbgrader when it reads this file
+
+c.CourseDirectory.root = str(Path(__file__).resolve().parent)
+c.CourseDirectory.course_id = "ros-tank-tutorial"
+c.Exchange.root = os.environ.get("RTT_NBGRADER_EXCHANGE", str(Path(__file__).resolve().parent / ".hub" / "exchange"))
+c.Exchange.path_includes_course = True
+
+# The release shows each exercise's own stub (tutorial/exercises/release.py), right after nbgrader's
+# ClearSolutions has taken the worked solution out; the rest is nbgrader's own list, in its order.
+c.ClearSolutions.code_stub = {"python": "raise NotImplementedError"}
+c.GenerateAssignment.preprocessors = [
+    IncludeHeaderFooter,
+    InstantiateTests,
+    LockCells,
+    ClearSolutions,
+    ReleaseStubs,
+    ClearOutput,
+    CheckCellMetadata,
+    ComputeChecksums,
+    SaveCells,
+    ClearHiddenTests,
+    ClearMarkScheme,
+    ComputeChecksums,
+    CheckCellMetadata,
+]
+
+# Grading: a cell that runs longer than this (an answer that never returns) is interrupted, its
+# exercise gets 0, and the rest of the notebook is graded.
+c.Execute.timeout = int(os.environ.get("RTT_GRADING_CELL_TIMEOUT", "120"))

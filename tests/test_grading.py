@@ -1,0 +1,220 @@
+"""Grading a class with nbgrader: assignments made from the notebooks, fake submissions graded as a teacher would.
+
+``course/assignments.py`` makes a course in a temporary folder (the
+teacher's ``course/`` is never touched); the fake submissions start from
+the release, as a learner's would:
+
+- the stubs as released: 0 points;
+- the worked solutions pasted in: full points;
+- each wrong answer of tests/test_exercises.py ``MISTAKES`` (the solution
+  with one mistake): it loses exactly its own exercise's points, no other;
+- a check cell edited to pass always: graded with the original check
+  (nbgrader restores read-only test cells), so the stubs still get 0;
+- an answer that never returns: interrupted by the cell timeout, 0 for that
+  exercise, the others graded.
+
+``course/grade.py`` grades them two at a time, each job in a ROS domain of
+its own, writes feedback and the CSV.  One more learner goes the whole way
+with nbgrader's own commands: release, fetch and submit through the
+exchange, then collect, autograde, feedback, export.
+
+``make test`` grades notebook 01's assignment (one wrong answer per
+exercise); ``make test-grade`` all nine, with every wrong answer.
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import json
+import os
+import re
+import sys
+from pathlib import Path
+
+import pytest
+from test_exercises import MISTAKES
+
+from conftest import ROOT
+
+sys.path.insert(0, str(ROOT / "course"))
+
+import assignments  # noqa: E402 - course/ is not a package
+import grade  # noqa: E402
+
+pytestmark = pytest.mark.cross_process
+
+IN_MAKE_TEST = ["01_step1_tank_controller"]
+ALL = sorted(p.stem for p in (ROOT / "notebooks").glob("0[1-9]_*.ipynb"))
+DOMAINS = [int(os.environ["ROS_DOMAIN_ID"]), int(os.environ["ROS_DOMAIN_ID"]) + 101]  # this session's own
+CELL_TIMEOUT_S = 20  # the endless answer is interrupted after this; the lesson's cells take under 10 s here
+
+
+def cells_of(course: Path, name: str, folder: str = "release") -> list[dict]:
+    return json.loads((course / folder / name / f"{name}.ipynb").read_text())["cells"]
+
+
+def grade_id(cell: dict) -> str | None:
+    return cell["metadata"].get("nbgrader", {}).get("grade_id")
+
+
+def solution_of(course: Path, name: str) -> dict[str, str]:
+    """Each answer cell's worked solution (the source's, delimiters taken out), by grade id."""
+    out = {}
+    for cell in cells_of(course, name, "source"):
+        gid = grade_id(cell)
+        if gid and gid.startswith("exercise_"):
+            text = "".join(cell["source"])
+            out[gid] = re.sub(r"^### (BEGIN|END) SOLUTION\n?", "", text, flags=re.M)
+    return out
+
+
+def submission(course: Path, name: str, answers: dict[str, str], checks: dict[str, str] | None = None) -> dict:
+    """The release of ``name`` with the answer cells ``answers`` (by grade id) and check cells ``checks`` put in."""
+    nb = json.loads((course / "release" / name / f"{name}.ipynb").read_text())
+    for cell in nb["cells"]:
+        gid = grade_id(cell)
+        if gid in answers:
+            cell["source"] = answers[gid]
+        if checks and gid in checks:
+            cell["source"] = checks[gid]
+    return nb
+
+
+def exercises_of(name: str) -> list[str]:
+    number = str(int(name[:2]))
+    return sorted(k for k in assignments.POINTS if k.split(".")[0] == number)
+
+
+def submissions(course: Path, name: str, every_mistake: bool = True) -> dict[str, tuple[dict, dict[str, float]]]:
+    """The fake submissions of ``name``: each one's notebook and the points each exercise must get.
+
+    ``every_mistake``: every wrong answer of ``MISTAKES``; else the first of each exercise.
+    """
+    solved = solution_of(course, name)
+    numbers = exercises_of(name)
+    full = {n: float(assignments.POINTS[n]) for n in numbers}
+    zero = dict.fromkeys(numbers, 0.0)
+    out = {
+        "stubs": (submission(course, name, {}), zero),
+        "solutions": (submission(course, name, solved), full),
+        "check-edited": (
+            submission(course, name, {}, {f"check_{n.replace('.', '_')}": "pass  # always passes" for n in numbers}),
+            zero,
+        ),
+    }
+    first = numbers[0]
+    gid = f"exercise_{first.replace('.', '_')}"
+    # the answer never returns: every function and method it defines starts with an endless loop
+    loop = r"\1def \2(\3)\4:\n\1    while True:\n\1        pass\n"
+    endless = re.sub(r"^(\s*)def (\w+)\((.*)\)(.*):\n", loop, solved[gid], flags=re.M)
+    out["endless"] = (submission(course, name, dict(solved, **{gid: endless})), dict(full, **{first: 0.0}))
+    taken = set()
+    for k, (number, right, wrong, _) in enumerate(MISTAKES):
+        if number not in numbers or (not every_mistake and number in taken):
+            continue
+        taken.add(number)
+        key = f"exercise_{number.replace('.', '_')}"
+        assert right in solved[key], f"the solution of {number} no longer has {right!r}"
+        answers = dict(solved, **{key: solved[key].replace(right, wrong)})
+        out[f"mistake-{number}-{k}"] = (submission(course, name, answers), dict(full, **{number: 0.0}))
+    return out
+
+
+def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange: bool = False) -> None:
+    """Make the course, put every fake submission in, grade, and hold each exercise's points to the expected.
+
+    ``exchange``: one more learner (this Unix user) fetches the first assignment from nbgrader's exchange,
+    solves exercise 1 only and submits it, with nbgrader's own commands; grading then collects it.
+    """
+    import getpass
+
+    course, home, exchange_dir = tmp / "course", tmp / "learner", tmp / "exchange"
+    assignments.make(course, release=False)
+    for name in names:
+        assignments.nbgrader(course, "generate_assignment", name, "--force")
+    expected = {}
+    if exchange:
+        name, me = names[0], getpass.getuser()
+        exchange_dir.mkdir()
+        home.mkdir()
+        assignments.nbgrader(course, "release_assignment", name, "--force")
+        # the learner, in their own folder: no course configuration there, as on a learner's server
+        where = ["--course", "ros-tank-tutorial", f"--Exchange.root={exchange_dir}"]
+        assert name in assignments.nbgrader(home, "list", *where)
+        assignments.nbgrader(home, "fetch_assignment", name, *where)
+        fetched = home / name / f"{name}.ipynb"
+        nb = json.loads(fetched.read_text())
+        first = exercises_of(name)[0]
+        gid = f"exercise_{first.replace('.', '_')}"
+        for cell in nb["cells"]:
+            if grade_id(cell) == gid:
+                cell["source"] = solution_of(course, name)[gid]
+        fetched.write_text(json.dumps(nb))
+        assignments.nbgrader(home, "submit", name, *where)
+        expected[(name, me)] = {n: float(assignments.POINTS[n]) if n == first else 0.0 for n in exercises_of(name)}
+    for name in names:
+        for learner, (nb, points) in submissions(course, name, every_mistake).items():
+            folder = course / "submitted" / learner / name
+            folder.mkdir(parents=True)
+            (folder / f"{name}.ipynb").write_text(json.dumps(nb))
+            expected[(name, learner)] = points
+    csv_path = grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS)
+
+    from nbgrader.api import Gradebook
+
+    wrong = []
+    with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
+        for (name, learner), points in sorted(expected.items()):
+            for number, want in points.items():
+                got = gb.find_grade(f"check_{number.replace('.', '_')}", name, name, learner).score
+                if got != want:
+                    wrong.append(f"{name} {learner}: exercise {number} got {got}, expected {want}")
+    assert not wrong, "\n".join(wrong)
+    rows = {(r["assignment"], r["student_id"]): float(r["score"]) for r in csv.DictReader(csv_path.open())}
+    for (name, learner), points in expected.items():
+        assert rows[(name, learner)] == sum(points.values()), (name, learner, rows[(name, learner)])
+        assert (course / "feedback" / learner / name / f"{name}.html").is_file(), f"no feedback for {learner}"
+
+
+def test_the_release_shows_the_notebooks_stubs_and_no_solution(tmp_path):
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    name = IN_MAKE_TEST[0]
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    teacher = json.loads((ROOT / "notebooks" / f"{name}.ipynb").read_text())["cells"]
+    release = cells_of(course, name)
+    stubs = [c for c in release if (grade_id(c) or "").startswith("exercise_")]
+    found = assignments.exercises(teacher)
+    assert ["".join(c["source"]) for c in stubs] == ["".join(teacher[e["stub"]]["source"]) for e in found]
+    text = json.dumps(release)
+    assert "Worked solution" not in text and "BEGIN SOLUTION" not in text
+    checks = [c for c in release if (grade_id(c) or "").startswith("check_")]
+    assert [c["metadata"]["nbgrader"]["points"] for c in checks] == [assignments.POINTS[e["number"]] for e in found]
+    assert all(c["metadata"]["nbgrader"]["locked"] for c in checks)
+    assert all("".join(c["source"]).rstrip().endswith(".require()") for c in checks)
+
+
+def test_a_notebook_without_points_for_an_exercise_is_refused():
+    nb = json.loads((ROOT / "notebooks" / f"{IN_MAKE_TEST[0]}.ipynb").read_text())
+    saved = copy.deepcopy(assignments.POINTS)
+    try:
+        del assignments.POINTS["1.2"]
+        with pytest.raises(ValueError, match="exercise 1.2 has no points"):
+            assignments.source_notebook(nb)
+    finally:
+        assignments.POINTS.clear()
+        assignments.POINTS.update(saved)
+
+
+def test_grading_notebook_01s_assignment(tmp_path, monkeypatch):
+    monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))  # read by the course's nbgrader_config.py
+    monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "exchange"))
+    grade_all(tmp_path, IN_MAKE_TEST, every_mistake=False, exchange=True)
+
+
+@pytest.mark.slow
+def test_grading_every_assignment(tmp_path, monkeypatch):
+    monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))
+    monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "exchange"))
+    grade_all(tmp_path, ALL)
