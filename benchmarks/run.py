@@ -60,6 +60,8 @@ from benchmarks.experiments.scale import scale_curves
 from benchmarks.experiments.scene_update import scene_update_cost
 from benchmarks.experiments.speed import SPEED_PAIRS, SPEED_PAIRS_OTHER, realtime_mode, simulation_speed
 from benchmarks.experiments.startup import startup
+from benchmarks.experiments.widget import WIDGET_CASES, widget_vs_page
+from benchmarks.experiments.widget import remote as widget_remote
 from benchmarks.machine import probe as machine_probe
 from benchmarks.paths import BOOK_STATIC, RESULTS, ROOT
 from benchmarks.plots import plot_browser, plot_latency, plot_scale
@@ -148,6 +150,7 @@ def main(argv=None) -> int:
             seconds, warmup, 1 if args.quick else args.scale_rounds, 8 if args.quick else 20, Path(d)
         )
     r["browser"] = pixel_latency(list(BROWSER_CASES), seconds, warmup)
+    r["widget"] = widget_vs_page(list(WIDGET_CASES), seconds, warmup)
     from tutorial.network.hosts import why_unavailable
 
     hosts_problem = why_unavailable()
@@ -156,6 +159,7 @@ def main(argv=None) -> int:
         print(f"across hosts: skipped ({hosts_problem})", flush=True)
     else:
         r["network"] = across_hosts(6.0 if args.quick else 14.0)
+        r["widget_remote"] = widget_remote(5.0)
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
     r["machine_at_end"] = machine_probe()
     r["targets"] = targets(r)

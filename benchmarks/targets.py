@@ -199,6 +199,49 @@ BROWSER_TARGETS = tuple(
     ),
 )
 
+# The live view in the notebook (a widget over Jupyter's connection) beside the meshcat page over its own
+# WebSocket, the same taped frames, the same run (benchmarks/experiments/widget.py).
+WIDGET_TARGETS = tuple(
+    Target(
+        f"notebook view, {words}: handed -> drawn p99 <= {{limit}}x the meshcat page's",
+        1.2,
+        AT_MOST,
+        read("widget", case, "widget", "handed_to_drawn", "p99"),
+        "{:.1f} ms",
+        against="times",
+        baseline=read("widget", case, "page", "sent_to_drawn", "p99"),
+        needs="widget",
+    )
+    for case, words in (("tank_50Hz", "1 tank at 50 Hz"), ("tanks_8", "8 tanks"))
+) + (
+    Target(
+        "notebook view, 8 tanks: the view's page keeps >= {limit} frames/s",
+        55.0,
+        AT_LEAST,
+        read("widget", "tanks_8", "widget", "frames_per_s"),
+        "{:.1f} frames/s",
+        baseline=read("widget", "tanks_8", "page", "frames_per_s"),
+        baseline_fmt="meshcat page {:.1f} frames/s",
+        needs="widget",
+    ),
+    Target(
+        "notebook view, browser on another host over 5 Mbit/s: the view draws >= {limit} frames/s from the kernel",
+        20.0,
+        AT_LEAST,
+        read("widget_remote", "fps"),
+        "{:.1f} frames/s",
+        needs="widget_remote",
+    ),
+    Target(
+        "notebook view, browser on another host over 5 Mbit/s: a trivial cell answers within {limit} ms (worst of 5)",
+        500.0,
+        AT_MOST,
+        read("widget_remote", "cell_ms_max"),
+        "{:.0f} ms",
+        needs="widget_remote",
+    ),
+)
+
 _NET = "network"
 NETWORK_TARGETS = (
     Target(
@@ -345,6 +388,7 @@ TARGETS = (
     *LATE_JOIN_TARGETS,
     *NETWORK_TARGETS,
     *BROWSER_TARGETS,
+    *WIDGET_TARGETS,
 )
 
 

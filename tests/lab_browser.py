@@ -12,8 +12,9 @@ JSON line of what it measured:
 - ``cell_ms``: how long the trivial cell took, from Shift+Enter to its
   output, five times (while the view is live);
 - ``reload_s``: after saving and reloading the page, the seconds from the
-  reload to the view having its scene again, and ``moved_after``: that it
-  moves again.
+  reload to the view having its scene again (``scene_after_view_s``: from
+  the view's output being back in the page, JupyterLab's own loading left
+  out), and ``moved_after``: that it moves again.
 
 tests/test_network_lab.py runs it on a host of its own (tests/netns.py),
 so the browser reaches the kernel only through Jupyter's port.
@@ -90,8 +91,11 @@ def main(url: str, host: str) -> None:
         page.wait_for_timeout(1000)  # saved: JupyterLab has no event for it a page can wait on
         start = time.monotonic()
         page.reload()
+        wait_for(page, lambda: page.locator(VIEW).count() > 0, "the view's page after a reload", 60)
+        shown = time.monotonic()
         wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the scene after a reload", 60)
         out["reload_s"] = round(time.monotonic() - start, 2)
+        out["scene_after_view_s"] = round(time.monotonic() - shown, 2)  # JupyterLab's own loading left out
         out["moved_after"] = wait_for(page, lambda: moving(page), "moving after reload", 30)
         out["dropped"] = page.evaluate(STATS)["dropped"]
     print(json.dumps(out), flush=True)

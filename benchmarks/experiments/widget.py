@@ -83,10 +83,22 @@ threading.Thread(target=replay, daemon=True).start()
 w
 """
 
+# An experiment: the kernel's WebSocket with Nagle's algorithm off (jupyter_server leaves it on).
+NODELAY_CONFIG = """
+from jupyter_server.services.kernels.websocket import KernelWebsocketHandler
+_open = KernelWebsocketHandler.open
+async def _open_nodelay(self, *args, **kwargs):
+    result = await _open(self, *args, **kwargs)
+    self.set_nodelay(True)
+    return result
+KernelWebsocketHandler.open = _open_nodelay
+"""
+
 # In the view's iframe: its animation frames, to count the frames per second the view's page draws.
 IFRAME_RAFS = """() => {
   const f = document.querySelector('iframe.rtt-live-view');
-  if (!f || !f.contentWindow || f.contentWindow.__rafs) return !!(f && f.contentWindow && f.contentWindow.__rafs);
+  if (!f || !f.contentWindow || !f.contentWindow.viewer) return false;  // meshcat's page not loaded yet
+  if (f.contentWindow.__rafs) return true;
   const w = f.contentWindow;
   w.__rafs = [];
   const tick = () => { w.__rafs.push(performance.timeOrigin + performance.now()); w.requestAnimationFrame(tick); };
@@ -151,7 +163,8 @@ def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
     nb.cells = [nbformat.v4.new_code_cell(REPLAY_CELL.format(tape=str(tape_file), out=str(out)))]
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
     nbformat.write(nb, directory / "replay.ipynb")
-    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}) as lab, sync_playwright() as pw:
+    config = NODELAY_CONFIG if os.environ.get("RTT_BENCH_NODELAY") == "1" else ""
+    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}, server_config=config) as lab, sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
         try:
             page = browser.new_page(viewport={"width": 1000, "height": 800})
