@@ -6,6 +6,8 @@ kernel starts (the Step 2 simulation, a joystick) lives in that domain: A's
 joystick drives A's tank and not B's, and neither sees the other's nodes.
 Both run as this machine's one Unix user (the trial's spawner), where Fast
 DDS's shared memory would carry data between them if their domains met.
+Then each logs in through the hub's form in a Chromium context of their
+own and runs a notebook with Step 2's live view: both views draw.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from conftest import ROOT
 sys.path.insert(0, str(ROOT / "course"))
 
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
-from hub import Hub, Learner  # noqa: E402
+from hub import PASSWORD, Hub, Learner  # noqa: E402
 
 from netns import net, on  # noqa: E402,F401 - net: the network tier's fixture
 
@@ -124,6 +126,61 @@ def test_each_learners_robots_are_their_own(hub):
     assert "rtt_joy" in ra["nodes"] and "rtt_joy" not in rb["nodes"], (ra["nodes"], rb["nodes"])
     assert rb["nodes"].count("rtt") == 1 and ra["nodes"].count("rtt") == 1
     assert ra["warnings"] == [] and rb["warnings"] == []  # no "2 nodes are named /rtt"
+
+    # Each learner in a browser of their own: logged in through the hub's form, a notebook that starts Step 2
+    # with its live view; both views get their scene over their own notebook's connection and draw.
+    both_live_views_draw(hub, ["learner-a", "learner-b"])
+
+
+LIVE = """from tutorial.notebook.runs import BackgroundApp, load
+from tutorial.notebook.session import init_ros
+
+init_ros()
+sim = BackgroundApp(load("{root}/project/step2.yaml"), node_name="rtt", label="simulation /rtt").start()
+sim.show(height=300)"""
+
+
+def both_live_views_draw(hub: Hub, names: list[str]) -> None:
+    """In one Chromium, a context (cookies) per learner: log in, run a live view, see it draw."""
+    import nbformat
+    from playwright.sync_api import sync_playwright
+
+    from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
+
+    for name in names:
+        nb = nbformat.v4.new_notebook()
+        nb.cells = [nbformat.v4.new_code_cell(LIVE.format(root=ROOT))]
+        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+        nbformat.write(nb, hub_state(hub) / "homes" / name / "live.ipynb")
+    stats = "(() => { const f = document.querySelector('iframe.rtt-live-view'); return f && f.parentElement.rttView; })"
+    stats += "()"
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+        try:
+            pages = {}
+            for name in names:
+                page = browser.new_context(viewport={"width": 1000, "height": 800}).new_page()
+                page.goto(hub.url + "/hub/login")
+                page.fill("input[name=username]", name)
+                page.fill("input[name=password]", PASSWORD)
+                page.click("input[type=submit], button[type=submit]")
+                page.wait_for_url(f"**/user/{name}/**", timeout=60_000)
+                page.goto(f"{hub.url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
+                page.locator(".jp-Notebook .jp-Cell").first.wait_for(timeout=90_000)
+                page.wait_for_function(
+                    "document.querySelector('#jp-main-statusbar').innerText.includes('Idle')", timeout=90_000
+                )
+                page.locator(".jp-Notebook .jp-Cell").first.click()
+                page.keyboard.press("Control+Enter")
+                pages[name] = page
+            for name, page in pages.items():
+                page.wait_for_function(f"{stats} && {stats}.scenes >= 1 && {stats}.frames > 5", timeout=90_000)
+                seen = page.evaluate(stats)
+                assert seen["dropped"] == 0, (name, seen)
+                shot = page.locator("iframe.rtt-live-view").screenshot()
+                assert len(shot) > 10_000, f"{name}'s live view is blank"  # a drawn scene, not an empty canvas
+        finally:
+            browser.close()
 
 
 def hub_state(hub: Hub):
