@@ -32,10 +32,9 @@ $(VENV)/.installed: pyproject.toml uv.lock
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
 	$(VENV)/bin/uv sync --locked --inexact --all-extras --python $(PY) --quiet
-	# The Jupyter server extension tutorial.view.widget.nodelay, enabled by the file a pip install puts in the
-	# environment (pyproject.toml's data-files), which an editable install leaves out.
-	install -D -m 644 jupyter-config/jupyter_server_config.d/ros_tank_tutorial.json \
-		$(VENV)/etc/jupyter/jupyter_server_config.d/ros_tank_tutorial.json
+	# The Jupyter server extension tutorial.view.widget.nodelay: enabled by a file a pip install puts in the
+	# environment (pyproject.toml's data-files), and an editable install leaves out.
+	$(PY) -m tutorial.view.widget.nodelay > /dev/null
 	touch $@
 
 venv: $(VENV)/.installed

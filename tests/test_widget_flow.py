@@ -256,3 +256,46 @@ def test_a_scene_drawn_from_another_thread_while_views_answer_keeps_the_flow_in_
 
 def test_busy_limits_are_what_the_docs_say():
     assert flow_module.BUSY_RATE * 60 == flow_module.BUSY_UNANSWERED  # "a minute" of frames while busy
+
+
+def test_the_nodelay_extension_is_enabled_by_the_same_setting_both_ways_and_turns_the_delay_off(tmp_path):
+    """pip's data file and ``python -m tutorial.view.widget.nodelay`` write the same setting; loading the
+    extension makes every kernel WebSocket set TCP_NODELAY once open (and loading twice wraps once)."""
+    import asyncio
+    import json
+
+    from jupyter_server.services.kernels.websocket import KernelWebsocketHandler
+
+    from tutorial.view.widget import nodelay
+
+    from conftest import ROOT
+
+    shipped = json.loads((ROOT / "jupyter-config" / "jupyter_server_config.d" / "ros_tank_tutorial.json").read_text())
+    assert shipped == nodelay.SETTING
+    assert json.loads(nodelay.enable(str(tmp_path)).read_text()) == nodelay.SETTING
+
+    class App:
+        class log:  # noqa: N801 - a stand-in for the server's logger
+            info = staticmethod(lambda *a: None)
+
+    original = KernelWebsocketHandler.open
+    try:
+        calls = []
+
+        async def opened(self, *args, **kwargs):
+            calls.append("open")
+
+        KernelWebsocketHandler.open = opened
+        KernelWebsocketHandler.rtt_nodelay = False
+        nodelay._load_jupyter_server_extension(App)
+        nodelay._load_jupyter_server_extension(App)  # a second load does not wrap again
+
+        class Handler:
+            def set_nodelay(self, value):
+                calls.append(("nodelay", value))
+
+        asyncio.run(KernelWebsocketHandler.open(Handler(), "kernel-id"))
+        assert calls == ["open", ("nodelay", True)]
+    finally:
+        KernelWebsocketHandler.open = original
+        KernelWebsocketHandler.rtt_nodelay = False

@@ -10,14 +10,23 @@ page, "Live views in the notebook").  This extension turns the delay off on
 every kernel WebSocket, as tornado advises (``set_nodelay(True)`` once the
 connection is open).
 
-It is enabled by the file the package installs,
-``etc/jupyter/jupyter_server_config.d/ros_tank_tutorial.json``, so any
-Jupyter server of this environment (``make notebooks``, a hub's learner
-servers) loads it.  It runs once, in the server's process, when the
-server starts.
+It is enabled by the file
+``etc/jupyter/jupyter_server_config.d/ros_tank_tutorial.json`` of the
+environment, so any Jupyter server of it (``make notebooks``, a hub's
+learner servers) loads it.  ``pip install .`` puts the file there (the
+package's data files); an editable install does not, so ``make`` (and a
+server's image after ``pip install -e``) runs
+``python -m tutorial.view.widget.nodelay``, which writes it.  The extension
+runs once, in the server's process, when the server starts.
 """
 
 from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+SETTING = {"ServerApp": {"jpserver_extensions": {"tutorial.view.widget.nodelay": True}}}
 
 
 def _jupyter_server_extension_points() -> list[dict]:
@@ -39,3 +48,15 @@ def _load_jupyter_server_extension(serverapp) -> None:
     KernelWebsocketHandler.open = open_without_delay
     KernelWebsocketHandler.rtt_nodelay = True
     serverapp.log.info("ros-tank-tutorial: kernel WebSockets send each message at once (TCP_NODELAY)")
+
+
+def enable(prefix: str = sys.prefix) -> Path:
+    """Write the file that enables this extension in the environment at ``prefix``; its path."""
+    path = Path(prefix) / "etc" / "jupyter" / "jupyter_server_config.d" / "ros_tank_tutorial.json"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(SETTING, indent=2) + "\n")
+    return path
+
+
+if __name__ == "__main__":
+    print(f"enabled the kernel WebSockets' TCP_NODELAY: {enable()}")
