@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -32,6 +33,25 @@ from tests.jupyterlab import browser
 
 VIEW = "iframe.rtt-live-view"
 STATS = f"() => {{ const f = document.querySelector('{VIEW}'); return f && f.parentElement.rttView || null; }}"
+
+
+def step2_notebook(path: Path, node: str = "rtt") -> None:
+    """Write the notebook this program runs: Step 2 with its live view (node ``node``), then a trivial cell."""
+    import nbformat
+
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [
+        nbformat.v4.new_code_cell(
+            "from tutorial.notebook.runs import BackgroundApp, load\n"
+            "from tutorial.notebook.session import init_ros\n\n"
+            "init_ros()\n"
+            f'sim = BackgroundApp(load("step2.yaml"), node_name="{node}", label="simulation /{node}").start()\n'
+            "sim.show(height=320)"
+        ),
+        nbformat.v4.new_code_cell("1 + 1"),
+    ]
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nbformat.write(nb, path)
 
 
 def screenshot(page) -> np.ndarray:

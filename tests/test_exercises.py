@@ -362,6 +362,99 @@ MISTAKES = [
         "turned 90 degrees",
     ),
     ("9.1", "        raise KeyError(frame)\n", "        return np.eye(4)\n", "'GUN'"),
+    # More wrong answers, as learners write them: at least six per exercise, each caught by its clause.
+    (
+        "1.1",
+        "turn_left = DPAD_TURN * joy.axis(axes, joy.DPAD_H)",
+        "turn_left = DPAD_SPEED * joy.axis(axes, joy.DPAD_H)",
+        "(left)",
+    ),
+    (
+        "1.1",
+        "forward = DPAD_SPEED * joy.axis(axes, joy.DPAD_V)",
+        "forward = DPAD_SPEED * (joy.axis(axes, joy.DPAD_V) + joy.axis(axes, 1))",
+        "(left stick up, D-pad released)",
+    ),
+    (
+        "1.1",
+        "forward = DPAD_SPEED * joy.axis(axes, joy.DPAD_V)",
+        "forward = -DPAD_SPEED * joy.axis(axes, joy.DPAD_V)",
+        "(up)",
+    ),
+    (
+        "1.2",
+        "            self.a_down = down\n",
+        "            self.a_down = self.a_down or down\n",
+        "(press, release, press)",
+    ),
+    ("1.2", "if down and not self.a_down:", "if not down and self.a_down:", "(press, release, press)"),
+    ("1.2", "buttons[joy.BUTTON_A] == 1", "buttons[1] == 1", "(A held for 10 repeats, then released)"),
+    ("2.1", "            return False\n        self.selected", "        self.selected", "joints='GUN'"),
+    ("2.1", "self.selected = names or config.body.joint_names", "self.selected = names", "joints=''"),
+    (
+        "2.1",
+        'names = [n.strip() for n in config.parameters["joints"].split(",") if n.strip()]',
+        'names = config.parameters["joints"].split(",")',
+        "joints=' TURRET_P , TURRET_Y '",
+    ),
+    ("3.1", 'self.rejected["wrong_model"] += 1', 'self.rejected["unknown_name"] += 1', "(the crane's message)"),
+    ("3.1", "if not names or not names <= ours:", "if not names or names != ours:", "(only one of the tank's joints)"),
+    ("4.1", "self.peak = max(self.peak, math.hypot(a[0], a[1]))", "self.peak = math.hypot(a[0], a[1])", "(at rest"),
+    (
+        "4.1",
+        "self.peak = max(self.peak, math.hypot(a[0], a[1]))",
+        "self.peak = max(self.peak, abs(a[0]))",
+        "(hitting the wall",
+    ),
+    ("4.2", "            self.last_report = now\n", "", "threshold=10.0, the wall"),
+    (
+        "5.1",
+        "np.array([self.accel[0], self.accel[1], 0.0])",
+        "np.array([self.accel[0], 0.0, 0.0])",
+        "(driving over a bump)",
+    ),
+    (
+        "5.2",
+        "stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec",
+        "stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9",
+        "(a restarted publisher)",
+    ),
+    (
+        "5.2",
+        "stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec",
+        "stamp = msg.header.stamp.sec * 1_000_000_000",
+        "(in order)",
+    ),
+    ("6.1", 'msg.encoding = "mono8"', 'msg.encoding = "rgb8"', "towards the crate"),
+    ("7.1", "pushed = not released", "pushed = True", "let go, then repeated at 20 Hz"),
+    (
+        "7.1",
+        "times.append((log_time - first) * 1e-9)",
+        "times.append((log_time - first) * 1e-6)",
+        "forward for 1 s, then let go",
+    ),
+    ("7.1", "released = all(a == 0.0 for a in msg.axes)", "released = msg.axes[1] == 0.0", "two pushes"),
+    ("7.2", "moving = dt > 0", "moving = dt >= 0", "two states with one stamp"),
+    ("7.2", "return 0.0, math.nan", "return 0.0, 0.0", "a single state"),
+    (
+        "7.2",
+        "speeds = np.abs(dq[moving] / dt[moving])",
+        "speeds = np.abs(dq[moving]) / np.mean(dt)",
+        "steady at 1 rad/s",
+    ),
+    ("8.1", "history=HistoryPolicy.KEEP_LAST,", "history=HistoryPolicy.KEEP_ALL,", "keep last 1"),
+    (
+        "8.1",
+        "    return QoSProfile(\n",
+        "    from rclpy.qos import qos_profile_sensor_data\n\n"
+        "    return qos_profile_sensor_data\n    return QoSProfile(\n",
+        "keep last 1",
+    ),
+    ("8.1", "depth=1,  # the newest", "depth=5,  # the newest", "keep last 1"),
+    ("8.2", "return 15.0, 70", "return 15.0, 100", "within 0.5 Mbit/s"),
+    ("8.2", "return 15.0, 70", "return 70, 15.0", "at least 10 pictures/s"),
+    ("8.2", "return 15.0, 70", "return 25.0, 60", "within 0.5 Mbit/s"),
+    ("9.1", "while frame in newest:", "if frame in newest:", "world -> CHASSIS -> TURRET"),
 ]
 
 
@@ -374,3 +467,9 @@ def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught
     assert caught_by in result.case, (caught_by, str(result))
     assert result.case in result.message, str(result)  # the failing input is in the line
     assert "not done yet" not in result.message
+    assert "Hint:" in result.message, f"the line for {wrong!r} gives no hint: {result}"
+
+
+def test_every_exercise_has_six_wrong_answers():
+    counts = {number: sum(m[0] == number for m in MISTAKES) for number in EXERCISES}
+    assert all(n >= 6 for n in counts.values()), counts

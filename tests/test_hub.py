@@ -132,26 +132,15 @@ def test_each_learners_robots_are_their_own(hub):
     both_live_views_draw(hub, ["learner-a", "learner-b"])
 
 
-LIVE = """from tutorial.notebook.runs import BackgroundApp, load
-from tutorial.notebook.session import init_ros
-
-init_ros()
-sim = BackgroundApp(load("{root}/project/step2.yaml"), node_name="rtt", label="simulation /rtt").start()
-sim.show(height=300)"""
-
-
 def both_live_views_draw(hub: Hub, names: list[str]) -> None:
     """In one Chromium, a context (cookies) per learner: log in, run a live view, see it draw."""
-    import nbformat
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
+    from tests.lab_browser import step2_notebook
 
     for name in names:
-        nb = nbformat.v4.new_notebook()
-        nb.cells = [nbformat.v4.new_code_cell(LIVE.format(root=ROOT))]
-        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-        nbformat.write(nb, hub_state(hub) / "homes" / name / "live.ipynb")
+        step2_notebook(hub_state(hub) / "homes" / name / "live.ipynb")
     stats = "(() => { const f = document.querySelector('iframe.rtt-live-view'); return f && f.parentElement.rttView; })"
     stats += "()"
     with sync_playwright() as pw:

@@ -24,32 +24,16 @@ import subprocess
 import sys
 from pathlib import Path
 
-import nbformat
 import pytest
 
 from tests.jupyterlab import JupyterLab
+from tests.lab_browser import step2_notebook
 
 from netns import net, on  # noqa: F401 - the fixture
 
 pytestmark = pytest.mark.network
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def notebook(path: Path, node: str) -> None:
-    nb = nbformat.v4.new_notebook()
-    nb.cells = [
-        nbformat.v4.new_code_cell(
-            "from tutorial.notebook.runs import BackgroundApp, load\n"
-            "from tutorial.notebook.session import init_ros\n\n"
-            "init_ros()\n"
-            f'sim = BackgroundApp(load("step2.yaml"), node_name="{node}", label="simulation /{node}").start()\n'
-            "sim.show(height=320)"
-        ),
-        nbformat.v4.new_code_cell("1 + 1"),
-    ]
-    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-    nbformat.write(nb, path)
 
 
 def browse(host, url: str, address: str) -> dict:
@@ -68,8 +52,8 @@ def browse(host, url: str, address: str) -> dict:
 
 def test_a_live_view_reaches_a_browser_through_jupyters_port_alone(net, procs, tmp_path):  # noqa: F811
     robot, operator = net["robot"], net["operator"]
-    notebook(tmp_path / "remote.ipynb", "rtt")
-    notebook(tmp_path / "local.ipynb", "rtt_local")
+    step2_notebook(tmp_path / "remote.ipynb", "rtt")
+    step2_notebook(tmp_path / "local.ipynb", "rtt_local")
     on(procs, robot, "tutorial.tools.rtt_joy", "--demo")
     env = {
         "ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET",  # the robot host's own subnet: nothing else is on it

@@ -296,13 +296,14 @@ def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True,
     }
 
 
-def bare_run(tape: list, lead_s: float = 1.0) -> tuple[dict, list]:
+def bare_run(tape: list, lead_s: float = 1.0, batch: bool = False) -> tuple[dict, list]:
     """Replay ``tape`` to a bare meshcat server and page, at its moments; the page's samples and the send log.
 
     The tape is first turned into meshcat's own protocol (:func:`bare_commands`:
     one ``set_transform`` per body, as meshcat-python sends them), and the
     server is meshcat's own with its own page (``start_server(batch=False)``,
-    bound to 127.0.0.1).  The scene's commands (every one before the first
+    bound to 127.0.0.1).  ``batch=True`` replays the frames as the viewer sent
+    them, to the project's server and page instead.  The scene's commands (every one before the first
     transform that names a body) go first, then each transform at its
     recorded offset from the first.  Sends are pipelined (a DEALER socket,
     then the replies), so a frame's commands leave together.
@@ -311,8 +312,8 @@ def bare_run(tape: list, lead_s: float = 1.0) -> tuple[dict, list]:
 
     from tutorial.view.meshcat_server import start_server
 
-    tape = bare_commands(tape)
-    server = start_server(batch=False)
+    tape = tape if batch else bare_commands(tape)
+    server = start_server(batch=batch)
     page = None
     sock = zmq.Context.instance().socket(zmq.DEALER)
     sock.setsockopt(zmq.LINGER, 0)

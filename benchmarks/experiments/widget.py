@@ -35,12 +35,11 @@ import subprocess
 import sys
 import tempfile
 import time
-import zlib
 from pathlib import Path
 
 import numpy as np
 
-from benchmarks.experiments.browser import CASES, Page, analyse_bare, tutorial_run
+from benchmarks.experiments.browser import CASES, analyse_bare, bare_run, tutorial_run
 from benchmarks.stats import pct
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -105,49 +104,6 @@ IFRAME_RAFS = """() => {
   w.requestAnimationFrame(tick);
   return true;
 }"""
-
-
-def page_run(tape: list, lead_s: float = 1.0) -> tuple[dict, list]:
-    """Replay ``tape`` as the viewer sent it to the project's server and page; the page's samples and the send log."""
-    import zmq
-
-    from tutorial.view.meshcat_server import start_server
-
-    server = start_server(batch=True)
-    page = None
-    sock = zmq.Context.instance().socket(zmq.DEALER)
-    sock.setsockopt(zmq.LINGER, 0)
-    sock.connect(server.zmq_url)
-    sent: list[tuple[int, int]] = []
-    try:
-        page = Page(server.web_url)
-        first = next(i for i, c in enumerate(tape) if c[4] is not None)
-
-        def send(c) -> None:
-            data = bytes.fromhex(c[3])
-            sock.send_multipart([b"", c[1].encode(), c[2].encode(), data])
-            sent.append((time.monotonic_ns(), zlib.crc32(data)))
-            if not sock.poll(5000):
-                raise RuntimeError("the meshcat server did not answer")
-            sock.recv_multipart()
-
-        for c in tape[:first]:
-            send(c)
-        time.sleep(lead_s)  # not synchronisation: the page draws the scene once before the clock starts
-        t0, base = time.monotonic_ns(), tape[first][0]
-        for c in tape[first:]:
-            wait = (t0 + (c[0] - base) - time.monotonic_ns()) / 1e9
-            if wait > 0:
-                time.sleep(wait)
-            send(c)
-        time.sleep(0.5)  # the last frames reach the page
-        samples = page.samples()
-    finally:
-        if page is not None:
-            page.close()
-        sock.close()
-        server.close()
-    return samples, sent
 
 
 def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
@@ -243,7 +199,7 @@ def widget_vs_page(cases: list[str], seconds: float, warmup: float) -> dict:
     for case in cases:
         with tempfile.TemporaryDirectory() as d:
             tape = tutorial_run(case, seconds, Path(d))["tape"]
-            samples, sent = page_run(tape)
+            samples, sent = bare_run(tape, batch=True)
             page = analyse_bare(samples, sent, warmup)
             widget = analyse_widget(widget_run(tape, Path(d)), warmup)
         out[case] = {"page": page, "widget": widget}
@@ -253,26 +209,13 @@ def widget_vs_page(cases: list[str], seconds: float, warmup: float) -> dict:
 
 def remote(mbit: float = 5.0) -> dict:
     """JupyterLab on one host, Chromium on another over a ``mbit`` link: the view's frames/s and a cell's time."""
-    import nbformat
-
     from tests.jupyterlab import JupyterLab
+    from tests.lab_browser import step2_notebook
     from tutorial.network.hosts import Network
 
     with tempfile.TemporaryDirectory() as d, Network(("robot", "operator")) as net:
         robot, operator = net["robot"], net["operator"]
-        nb = nbformat.v4.new_notebook()
-        nb.cells = [
-            nbformat.v4.new_code_cell(
-                "from tutorial.notebook.runs import BackgroundApp, load\n"
-                "from tutorial.notebook.session import init_ros\n\n"
-                "init_ros()\n"
-                'sim = BackgroundApp(load("step2.yaml"), node_name="rtt", label="simulation /rtt").start()\n'
-                "sim.show(height=320)"
-            ),
-            nbformat.v4.new_code_cell("1 + 1"),
-        ]
-        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-        nbformat.write(nb, Path(d) / "remote.ipynb")
+        step2_notebook(Path(d) / "remote.ipynb")
         joystick = subprocess.Popen(
             robot.command([sys.executable, "-m", "tutorial.tools.rtt_joy", "--demo"]),
             env=robot.env(PYTHONPATH=str(ROOT)),

@@ -31,24 +31,13 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def soak(minutes: float, every_s: float = 15.0) -> dict:
-    import nbformat
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS, JupyterLab
+    from tests.lab_browser import step2_notebook
 
     with tempfile.TemporaryDirectory() as d:
-        nb = nbformat.v4.new_notebook()
-        nb.cells = [
-            nbformat.v4.new_code_cell(
-                "from tutorial.notebook.runs import BackgroundApp, load\n"
-                "from tutorial.notebook.session import init_ros\n\n"
-                "init_ros()\n"
-                'sim = BackgroundApp(load("step2.yaml"), node_name="rtt", label="simulation /rtt").start()\n'
-                "sim.show(height=320)"
-            )
-        ]
-        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-        nbformat.write(nb, Path(d) / "soak.ipynb")
+        step2_notebook(Path(d) / "soak.ipynb")
         joystick = subprocess.Popen(
             [sys.executable, "-m", "tutorial.tools.rtt_joy", "--demo"],
             stdout=subprocess.DEVNULL,

@@ -167,6 +167,10 @@ def check_selected_joints(cls) -> Result:
 
     def refuses(joints: str):
         call = f"{cls.__name__} with joints={joints!r}"
+        hint = (
+            "configure() should return False when a name is not in config.body.joint_names "
+            "(and log why with config.log.error)."
+        )
 
         def run():
             try:
@@ -175,13 +179,9 @@ def check_selected_joints(cls) -> Result:
                 if not_done(exc):
                     raise
                 return
-            raise CaseFailed(
-                f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.",
-                "configure() should return False when a name is not in config.body.joint_names "
-                "(and log why with config.log.error).",
-            )
+            raise CaseFailed(f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.", hint)
 
-        return Case(call, run)
+        return Case(call, run, hint)
 
     return grade(
         "Exercise 2.1, publish chosen joints",

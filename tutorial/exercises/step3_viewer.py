@@ -208,6 +208,15 @@ def check_wrong_model(cls) -> Result:
                 "order does not matter: the names are all the tank's.",
             ),
             expect(
+                "only one of the tank's joints",
+                [message(["TURRET_P"], [0.2])],
+                1,
+                {},
+                {"TURRET_Y": 0.0, "TURRET_P": 0.2},
+                "a message naming some of this body's joints (and nothing else) is this body's: apply it, "
+                "as a robot that publishes its joints in groups does.",
+            ),
+            expect(
                 "the crane's message",
                 [message(["SLEW", "LUFF", "TROLLEY"], [0.5, 0.2, 1.0])],
                 0,
