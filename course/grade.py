@@ -55,9 +55,11 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
     """Grade ``assignments`` in ``course``; the grades' CSV.
 
     Raises:
-        RuntimeError: an nbgrader command failed (its output is in the message).
+        GradingError: some submissions could not be graded; the others were, and the CSV was written.
+        RuntimeError: another nbgrader command failed (its output is in the message).
     """
     ids = list(ids)
+    failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
     if jobs > len(ids):
         raise ValueError(f"{jobs} jobs need {jobs} ROS domains, {len(ids)} given")
     for assignment in assignments:
@@ -66,12 +68,18 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
         who = learners(course, assignment)
 
         def worker(k: int, who=who, assignment=assignment) -> None:
-            """Learners k, k + jobs, ... one after another, in domain ids[k]: never two kernels in one domain."""
+            """Learners k, k + jobs, ... one after another, in domain ids[k]: never two kernels in one domain.
+
+            A submission nbgrader cannot grade (its kernel died, say) is named, and the others are graded.
+            """
             env = dict(
                 os.environ, ROS_DOMAIN_ID=str(ids[k]), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RTT_TEST_MODE="1"
             )
             for learner in who[k::jobs]:
-                nbgrader(course, "autograde", assignment, "--student", learner, "--force", env=env)
+                try:
+                    nbgrader(course, "autograde", assignment, "--student", learner, "--force", env=env)
+                except RuntimeError as error:
+                    failed.append(f"{assignment}, {learner}: {str(error).splitlines()[0]}")
 
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(worker, range(jobs)))  # list(): a worker's exception is raised here
@@ -79,7 +87,22 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
             nbgrader(course, "generate_feedback", assignment, "--force")
     csv = course / "grades.csv"
     nbgrader(course, "export", "--to", str(csv))
+    if failed:
+        raise GradingError(csv, failed)
     return csv
+
+
+class GradingError(RuntimeError):
+    """Some submissions could not be graded (the others were, and the CSV was written).
+
+    Attributes:
+        csv: the grades' CSV (an ungraded submission has no score in it).
+        failed: one line per submission: assignment, learner, what nbgrader said.
+    """
+
+    def __init__(self, csv: Path, failed: list[str]):
+        super().__init__(f"{len(failed)} submission(s) could not be graded:\n" + "\n".join(failed))
+        self.csv, self.failed = csv, failed
 
 
 def main(argv=None) -> int:
@@ -92,7 +115,11 @@ def main(argv=None) -> int:
     args = p.parse_args(argv)
     course = args.course.resolve()
     names = args.assignments or sorted(p.name for p in (course / "release").iterdir() if p.is_dir())
-    csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=domains(args.domains))
+    try:
+        csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=domains(args.domains))
+    except GradingError as error:
+        print(f"graded {', '.join(names)}: {error.csv}, but {error}", file=sys.stderr)
+        return 1
     print(f"graded {', '.join(names)}: {csv}; feedback in {course / 'feedback'}")
     return 0
 

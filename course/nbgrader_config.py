@@ -52,5 +52,9 @@ c.GenerateAssignment.preprocessors = [
 ]
 
 # Grading: a cell that runs longer than this (an answer that never returns) is interrupted, its
-# exercise gets 0, and the rest of the notebook is graded.
+# exercise gets 0, and the rest of the notebook is graded.  An answer that never returns on a thread of
+# its own (a camera's render thread) cannot be interrupted and slows the kernel for the rest of the
+# notebook: its outputs may come late, which must not end the grading of the notebook.
 c.Execute.timeout = int(os.environ.get("RTT_GRADING_CELL_TIMEOUT", "120"))
+c.Execute.raise_on_iopub_timeout = False
+c.Execute.iopub_timeout = 30

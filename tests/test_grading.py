@@ -16,7 +16,8 @@ the release, as a learner's would:
 ``course/grade.py`` grades them two at a time, each job in a ROS domain of
 its own, writes feedback and the CSV.  One more learner goes the whole way
 with nbgrader's own commands: release, fetch and submit through the
-exchange, then collect, autograde, feedback, export.
+exchange, then collect, autograde, feedback, export; and a submission that
+is not a notebook is named as ungradable while the others are graded.
 
 ``make test`` grades notebook 01's assignment (one wrong answer per
 exercise); ``make test-grade`` all nine, with every wrong answer.
@@ -159,7 +160,16 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
             folder.mkdir(parents=True)
             (folder / f"{name}.ipynb").write_text(json.dumps(nb))
             expected[(name, learner)] = points
-    csv_path = grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS)
+    if exchange:  # and a submission nbgrader cannot read: named, and the others graded all the same
+        broken = course / "submitted" / "broken" / names[0]
+        broken.mkdir(parents=True)
+        (broken / f"{names[0]}.ipynb").write_text("{ not a notebook")
+        with pytest.raises(grade.GradingError) as caught:
+            grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS)
+        assert [line.split(":")[0] for line in caught.value.failed] == [f"{names[0]}, broken"], caught.value.failed
+        csv_path = caught.value.csv
+    else:
+        csv_path = grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS)
 
     from nbgrader.api import Gradebook
 
@@ -214,6 +224,7 @@ def test_grading_notebook_01s_assignment(tmp_path, monkeypatch):
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(2400)  # about 150 notebooks run, two at a time
 def test_grading_every_assignment(tmp_path, monkeypatch):
     monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))
     monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "exchange"))

@@ -182,9 +182,10 @@ function render({ model, el }) {
         : " (not live): its kernel has gone, so nothing runs; run the section again for a live view."));
   };
   showCaption(true);
-  model.on("change:status", () => {
+  const onStatus = () => {
     if (!notice) showCaption(true);
-  });
+  };
+  model.on("change:status", onStatus);
   // What the view has done, for a test or a curious learner: el.rttView in the browser's console.
   const stats = { id, frames: 0, dropped: 0, scenes: 0, errors: [] };
   el.rttView = stats;
@@ -253,7 +254,7 @@ function render({ model, el }) {
   // and says so to each model (comm_live_update).  The view then asks its kernel whether it is still
   // there: no answer within PING_MS, and the page says this view is not live any more (its last frame
   // stays).  An answer that comes later (a kernel that was only busy) takes the notice away.
-  model.on("comm_live_update", () => {
+  const onCutOff = () => {
     const asked = Date.now();
     stats.pinged = asked;
     setTimeout(() => {
@@ -274,7 +275,8 @@ function render({ model, el }) {
     } catch (error) {
       // a model cut off its kernel may refuse to send: the answer will not come, and the notice shows
     }
-  });
+  };
+  model.on("comm_live_update", onCutOff);
 
   // Each time the frame (re)loads its page: a new viewer, which asks for the whole scene.
   frame.addEventListener("load", () => {
@@ -299,6 +301,8 @@ function render({ model, el }) {
   return () => {
     gone = true;
     model.off("msg:custom", onMessage);
+    model.off("change:status", onStatus);
+    model.off("comm_live_update", onCutOff);
   };
 }
 
