@@ -94,7 +94,6 @@ class JupyterLab:
         timeout: float = 60.0,
         ip: str = "127.0.0.1",
         prefix=(),
-        server_config: str = "",
     ):
         self.root = Path(root)
         self.port = free_port()
@@ -113,9 +112,6 @@ class JupyterLab:
             "IPYTHONDIR": "ipython",
         }
         self.env = dict(os.environ, **{k: str(self._tmp / v) for k, v in home.items()})
-        if server_config:  # the server's own configuration file (jupyter_server_config.py), e.g. an experiment's
-            (self._tmp / "config").mkdir(parents=True, exist_ok=True)
-            (self._tmp / "config" / "jupyter_server_config.py").write_text(server_config)
         for key, value in (env or {}).items():
             if value is None:
                 self.env.pop(key, None)

@@ -84,15 +84,27 @@ def moving(page) -> int:
     return n if n > 200 else 0
 
 
+def run_first_cell(page, url: str, most_s: float = 90.0) -> None:
+    """Open the notebook at ``url`` in JupyterLab, wait until its kernel is idle, and run its first cell.
+
+    Raises:
+        playwright's TimeoutError: the notebook or its kernel was not ready within ``most_s`` s.
+    """
+    page.goto(url)
+    cells = page.locator(".jp-Notebook .jp-Cell")
+    cells.first.wait_for(timeout=most_s * 1000)
+    page.wait_for_function(
+        "document.querySelector('#jp-main-statusbar').innerText.includes('Idle')", timeout=most_s * 1000
+    )
+    cells.first.click()
+    page.keyboard.press("Control+Enter")
+
+
 def main(url: str, host: str) -> None:
     out: dict = {}
     with browser(width=1100, height=900, host=host) as page:
-        page.goto(url)
+        run_first_cell(page, url)
         cells = page.locator(".jp-Notebook .jp-Cell")
-        cells.first.wait_for(timeout=90_000)
-        wait_for(page, lambda: "Idle" in page.locator("#jp-main-statusbar").inner_text(), "the kernel idle", 90)
-        cells.first.click()
-        page.keyboard.press("Shift+Enter")
         wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the live view's scene", 90)
         wait_for(page, lambda: (page.evaluate(STATS) or {}).get("frames", 0) > 10, "frames in the view", 60)
         out["moved"] = wait_for(page, lambda: moving(page), "the view moving", 30)

@@ -137,12 +137,10 @@ def both_live_views_draw(hub: Hub, names: list[str]) -> None:
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
-    from tests.lab_browser import step2_notebook
+    from tests.lab_browser import STATS, run_first_cell, step2_notebook
 
     for name in names:
         step2_notebook(hub_state(hub) / "homes" / name / "live.ipynb")
-    stats = "(() => { const f = document.querySelector('iframe.rtt-live-view'); return f && f.parentElement.rttView; })"
-    stats += "()"
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
         try:
@@ -154,17 +152,12 @@ def both_live_views_draw(hub: Hub, names: list[str]) -> None:
                 page.fill("input[name=password]", PASSWORD)
                 page.click("input[type=submit], button[type=submit]")
                 page.wait_for_url(f"**/user/{name}/**", timeout=60_000)
-                page.goto(f"{hub.url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
-                page.locator(".jp-Notebook .jp-Cell").first.wait_for(timeout=90_000)
-                page.wait_for_function(
-                    "document.querySelector('#jp-main-statusbar').innerText.includes('Idle')", timeout=90_000
-                )
-                page.locator(".jp-Notebook .jp-Cell").first.click()
-                page.keyboard.press("Control+Enter")
+                run_first_cell(page, f"{hub.url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
                 pages[name] = page
             for name, page in pages.items():
-                page.wait_for_function(f"{stats} && {stats}.scenes >= 1 && {stats}.frames > 5", timeout=90_000)
-                seen = page.evaluate(stats)
+                drawing = f"(() => {{ const s = ({STATS})(); return s && s.scenes >= 1 && s.frames > 5; }})()"
+                page.wait_for_function(drawing, timeout=90_000)
+                seen = page.evaluate(STATS)
                 assert seen["dropped"] == 0, (name, seen)
                 shot = page.locator("iframe.rtt-live-view").screenshot()
                 assert len(shot) > 10_000, f"{name}'s live view is blank"  # a drawn scene, not an empty canvas

@@ -147,6 +147,18 @@ window.__rtt = {msgs: [], renders: [], render_ms: [], rafs: []};
 """
 
 
+def clock_offset_ns(page, tries: int = 20) -> int:
+    """A Playwright page's clock minus ``time.monotonic_ns()``, ns (:meth:`Page.clock_offset_ns` says why so)."""
+    best = None
+    for _ in range(tries):
+        a = time.monotonic_ns()
+        t = page.evaluate("performance.timeOrigin + performance.now()")
+        b = time.monotonic_ns()
+        if best is None or b - a < best[0]:
+            best = (b - a, round(t * 1e6) - (a + b) // 2)
+    return best[1]
+
+
 class Page:
     """A headless Chromium page on a meshcat URL, with :data:`PAGE_PROBE` in it (one thread only)."""
 
@@ -177,14 +189,7 @@ class Page:
         case of eight tanks once matched no state at all).  Of ``tries`` readings, the one with the shortest round trip
         is kept; the uncertainty is half of it (well under 1 ms here).
         """
-        best = None
-        for _ in range(tries):
-            a = time.monotonic_ns()
-            t = self.page.evaluate("performance.timeOrigin + performance.now()")
-            b = time.monotonic_ns()
-            if best is None or b - a < best[0]:
-                best = (b - a, round(t * 1e6) - (a + b) // 2)
-        return best[1]
+        return clock_offset_ns(self.page, tries)
 
     def samples(self) -> dict:
         """``{"msgs": [[ms, crc32], ...], "renders": [ms], "render_ms": [ms], "rafs": [ms], "offset_ns": ns,

@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks.experiments.browser import CASES, analyse_bare, bare_run, tutorial_run
+from benchmarks.experiments.browser import CASES, analyse_bare, bare_run, clock_offset_ns, tutorial_run
 from benchmarks.stats import pct
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -82,17 +82,6 @@ threading.Thread(target=replay, daemon=True).start()
 w
 """
 
-# An experiment: the kernel's WebSocket with Nagle's algorithm off (jupyter_server leaves it on).
-NODELAY_CONFIG = """
-from jupyter_server.services.kernels.websocket import KernelWebsocketHandler
-_open = KernelWebsocketHandler.open
-async def _open_nodelay(self, *args, **kwargs):
-    result = await _open(self, *args, **kwargs)
-    self.set_nodelay(True)
-    return result
-KernelWebsocketHandler.open = _open_nodelay
-"""
-
 # In the view's iframe: its animation frames, to count the frames per second the view's page draws.
 IFRAME_RAFS = """() => {
   const f = document.querySelector('iframe.rtt-live-view');
@@ -112,6 +101,7 @@ def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS, JupyterLab
+    from tests.lab_browser import STATS, run_first_cell
 
     tape_file, out = directory / "tape.json", directory / "widget_out.json"
     tape_file.write_text(json.dumps(tape))
@@ -119,21 +109,12 @@ def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
     nb.cells = [nbformat.v4.new_code_cell(REPLAY_CELL.format(tape=str(tape_file), out=str(out)))]
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
     nbformat.write(nb, directory / "replay.ipynb")
-    config = NODELAY_CONFIG if os.environ.get("RTT_BENCH_NODELAY") == "1" else ""
-    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}, server_config=config) as lab, sync_playwright() as pw:
+    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}) as lab, sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
         try:
             page = browser.new_page(viewport={"width": 1000, "height": 800})
             page.add_init_script("window.rttProbe = [];")
-            page.goto(lab.notebook_url("replay.ipynb", workspace="replay"))
-            page.locator(".jp-Notebook .jp-Cell").first.wait_for(timeout=90_000)
-            deadline = time.monotonic() + 90
-            while "Idle" not in page.locator("#jp-main-statusbar").inner_text():
-                if time.monotonic() > deadline:
-                    raise RuntimeError("the kernel did not start")
-                page.wait_for_timeout(100)
-            page.locator(".jp-Notebook .jp-Cell").first.click()
-            page.keyboard.press("Control+Enter")
+            run_first_cell(page, lab.notebook_url("replay.ipynb", workspace="replay"))
             page.wait_for_function(IFRAME_RAFS, timeout=60_000)
             deadline = time.monotonic() + timeout_s
             while not out.exists():
@@ -142,18 +123,12 @@ def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
                 page.wait_for_timeout(200)
             probe = page.evaluate("window.rttProbe")
             rafs = page.evaluate("document.querySelector('iframe.rtt-live-view').contentWindow.__rafs")
-            stats = page.evaluate("document.querySelector('iframe.rtt-live-view').parentElement.rttView")
-            best = None
-            for _ in range(20):
-                a = time.monotonic_ns()
-                t = page.evaluate("performance.timeOrigin + performance.now()")
-                b = time.monotonic_ns()
-                if best is None or b - a < best[0]:
-                    best = (b - a, round(t * 1e6) - (a + b) // 2)
+            stats = page.evaluate(STATS)
+            offset_ns = clock_offset_ns(page)
         finally:
             browser.close()
     kernel = json.loads(out.read_text())
-    return dict(kernel, probe=probe, rafs=rafs, offset_ns=best[1], page=stats.get("page"), dropped=stats["dropped"])
+    return dict(kernel, probe=probe, rafs=rafs, offset_ns=offset_ns, page=stats.get("page"), dropped=stats["dropped"])
 
 
 def analyse_widget(run: dict, warmup: float) -> dict:

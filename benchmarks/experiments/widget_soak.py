@@ -34,7 +34,7 @@ def soak(minutes: float, every_s: float = 15.0) -> dict:
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS, JupyterLab
-    from tests.lab_browser import step2_notebook
+    from tests.lab_browser import STATS, run_first_cell, step2_notebook
 
     with tempfile.TemporaryDirectory() as d:
         step2_notebook(Path(d) / "soak.ipynb")
@@ -48,19 +48,11 @@ def soak(minutes: float, every_s: float = 15.0) -> dict:
                 with sync_playwright() as pw:
                     browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
                     page = browser.new_page(viewport={"width": 1000, "height": 800})
-                    page.goto(lab.notebook_url("soak.ipynb", workspace="soak"))
-                    page.locator(".jp-Notebook .jp-Cell").first.wait_for(timeout=90_000)
+                    run_first_cell(page, lab.notebook_url("soak.ipynb", workspace="soak"))
                     page.wait_for_function(
-                        "document.querySelector('#jp-main-statusbar').innerText.includes('Idle')", timeout=90_000
+                        f"(() => {{ const s = ({STATS})(); return s && s.frames > 60; }})()", timeout=90_000
                     )
-                    page.locator(".jp-Notebook .jp-Cell").first.click()
-                    page.keyboard.press("Control+Enter")
-                    page.wait_for_function(
-                        "(() => { const f = document.querySelector('iframe.rtt-live-view');"
-                        " return f && f.parentElement.rttView && f.parentElement.rttView.frames > 60; })()",
-                        timeout=90_000,
-                    )
-                    frames = page.evaluate("document.querySelector('iframe.rtt-live-view').parentElement.rttView")
+                    frames = page.evaluate(STATS)
                     browser.close()  # the tab is gone
                 lab.note_processes()
                 kernels = [

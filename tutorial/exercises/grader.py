@@ -87,17 +87,6 @@ class Result:
         return self
 
 
-class _Kept(logging.Handler):
-    """Keeps the log records of a check's cases instead of printing them."""
-
-    def __init__(self):
-        super().__init__()
-        self.records: list[logging.LogRecord] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.records.append(record)
-
-
 def grade(exercise: str, cases: Iterable[Case]) -> Result:
     """Run the cases in order; stop at the first failure.
 
@@ -111,13 +100,13 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
         saying which input failed, how, and the hint.
     """
     logger = logging.getLogger("rtt")
-    kept, propagate = _Kept(), logger.propagate
-    logger.addHandler(kept)
+    quiet, propagate = logging.NullHandler(), logger.propagate
+    logger.addHandler(quiet)  # a handler, so Python's last-resort handler does not print to stderr
     logger.propagate = False
     try:
         return _run_cases(exercise, cases)
     finally:
-        logger.removeHandler(kept)
+        logger.removeHandler(quiet)
         logger.propagate = propagate
 
 

@@ -179,7 +179,7 @@ def check_selected_joints(cls) -> Result:
                 if not_done(exc):
                     raise
                 return
-            raise CaseFailed(f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.", hint)
+            raise CaseFailed(f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.")
 
         return Case(call, run, hint)
 
