@@ -177,3 +177,57 @@ def plot_browser(r: dict, path: Path) -> Path:
     fig.savefig(path, dpi=80)
     plt.close(fig)
     return path
+
+
+def plot_learners(r: dict, path: Path) -> Path:
+    """A class on one server: real-time factor, state age, CPU and memory against the number of learners."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from benchmarks.targets import LEARNERS_TARGETS
+
+    runs = r["learners"]
+    ns = sorted(int(n) for n in runs)
+    data = [runs[str(n)] for n in ns]
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7), constrained_layout=True)
+    ax = axes[0, 0]
+    ax.plot(ns, [d["real_time_factor_min"] for d in data], "o-", label="lowest learner")
+    ax.plot(ns, [float(np.median(d["real_time_factor"])) for d in data], "s--", label="median learner")
+    ax.axhline(LEARNERS_TARGETS[0].limit, color="grey", ls=":", lw=1)
+    ax.set_title("real-time factor")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    ax.plot(ns, [d["age_ms_p99_max"] for d in data], "o-", label="p99, worst learner")
+    ax.plot(ns, [d["age_ms_pooled"]["p50"] for d in data], "s--", label="p50, all learners")
+    ax.axhline(LEARNERS_TARGETS[1].limit * data[0]["age_ms_p99_max"], color="grey", ls=":", lw=1)
+    ax.set_yscale("log")
+    ax.set_title("viewer: state age when applied, ms")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    roles = sorted({k for d in data for k in d["cores_by_role"]})
+    bottom = np.zeros(len(ns))
+    for role in roles:
+        values = np.array([d["cores_by_role"].get(role, 0.0) for d in data])
+        ax.bar([str(n) for n in ns], values, bottom=bottom, label=role)
+        bottom += values
+    ax.plot([str(n) for n in ns], [d["cores_busy"] for d in data], "k.-", label="machine busy")
+    ax.axhline(r["machine"]["cpus"], color="red", ls=":", lw=1)
+    ax.set_title("CPU cores")
+    ax.legend(fontsize=7)
+    ax = axes[1, 1]
+    ax.plot(ns, [d["memory_mb_per_learner_mean"] for d in data], "o-", label="per learner (PSS)")
+    ax.axhline(LEARNERS_TARGETS[2].limit, color="grey", ls=":", lw=1)
+    ax.set_ylim(0, None)
+    ax.set_title("memory per learner, MB")
+    for a in axes.flat:
+        a.set_xlabel("learners on one hub")
+        a.grid(alpha=0.3)
+    cores = r["machine"]["cpus"]
+    source = r.get("source", "make bench")
+    fig.suptitle(f"A class on one server ({cores} cores; {source}, {r['when']}, {r.get('commit', '?')})")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return path

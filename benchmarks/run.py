@@ -17,6 +17,10 @@ because absolute times on a shared machine vary:
 * late join: a viewer's and a recorder's wait for the state a running
   publisher keeps, under the project's Fast DDS profile and Fast DDS's
   defaults, and what each profile costs an idle participant;
+* a class on one server: 1 to 16 learners on ``make hub``'s JupyterHub,
+  each running Step 3 in their kernel with its live views streaming to a
+  client that does not draw: each learner's real-time factor, the viewer's
+  state age, memory per learner, CPU by process (one learner is the baseline);
 * scale curves: N tanks in one world (each with its Step 1 controller and
   Step 2 publisher, driven by one ``rtt-joy --demo``) and one viewer
   mirroring all N, for N = 1, 2, 4, 8; the same for one arm of 6, 12, 24
@@ -55,6 +59,7 @@ from benchmarks.experiments.browser import CASES as BROWSER_CASES
 from benchmarks.experiments.browser import pixel_latency
 from benchmarks.experiments.cross_process import latency_rounds
 from benchmarks.experiments.late_join import late_join
+from benchmarks.experiments.learners import LEARNERS, learners_per_server
 from benchmarks.experiments.network import measure as across_hosts
 from benchmarks.experiments.scale import scale_curves
 from benchmarks.experiments.scene_update import scene_update_cost
@@ -64,7 +69,7 @@ from benchmarks.experiments.widget import WIDGET_CASES, widget_vs_page
 from benchmarks.experiments.widget import remote as widget_remote
 from benchmarks.machine import probe as machine_probe
 from benchmarks.paths import BOOK_STATIC, RESULTS, ROOT
-from benchmarks.plots import plot_browser, plot_latency, plot_scale
+from benchmarks.plots import plot_browser, plot_latency, plot_learners, plot_scale
 from benchmarks.report import print_report, runs_table, targets_markdown
 from benchmarks.targets import targets
 
@@ -160,6 +165,7 @@ def main(argv=None) -> int:
     else:
         r["network"] = across_hosts(6.0 if args.quick else 14.0)
         r["widget_remote"] = widget_remote(5.0)
+    r["learners"] = learners_per_server((1, 2) if args.quick else LEARNERS, 8.0 if args.quick else 20.0, warmup + 1.0)
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
     r["machine_at_end"] = machine_probe()
     r["targets"] = targets(r)
@@ -168,6 +174,7 @@ def main(argv=None) -> int:
         str(plot_scale(r, plots / "bench_scale.png")),
         str(plot_latency(r, plots / "bench_latency.png")),
         str(plot_browser(r, plots / "bench_browser.png")),
+        str(plot_learners(r, plots / "bench_learners.png")),
     ]
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -242,6 +242,45 @@ WIDGET_TARGETS = tuple(
     ),
 )
 
+# A class on one server: N learners on make hub's JupyterHub, each running Step 3 with its live views at the
+# hub's frame rate (benchmarks/experiments/learners.py); the baseline is one learner alone, same run.
+LEARNERS_AT = "8"
+LEARNERS_TARGETS = (
+    Target(
+        f"a class on one server, {LEARNERS_AT} learners (Step 3, live views): every learner's real-time factor "
+        ">= {limit}",
+        0.99,
+        AT_LEAST,
+        read("learners", LEARNERS_AT, "real_time_factor_min"),
+        "{:.3f}",
+        baseline=read("learners", "1", "real_time_factor_min"),
+        baseline_fmt="one learner {:.3f}",
+        needs="learners",
+    ),
+    Target(
+        f"a class on one server, {LEARNERS_AT} learners: the viewer's state age p99 (worst learner) <= {{limit}}x "
+        "one learner's",
+        2.0,
+        AT_MOST,
+        read("learners", LEARNERS_AT, "age_ms_p99_max"),
+        "{:.1f} ms",
+        against="times",
+        baseline=read("learners", "1", "age_ms_p99_max"),
+        needs="learners",
+    ),
+    Target(
+        f"a class on one server, {LEARNERS_AT} learners: memory per learner (PSS of their server and all it "
+        "started) <= {limit} MB",
+        1024.0,
+        AT_MOST,
+        read("learners", LEARNERS_AT, "memory_mb_per_learner_mean"),
+        "{:.0f} MB",
+        baseline=read("learners", "1", "memory_mb_per_learner_mean"),
+        baseline_fmt="one learner {:.0f} MB",
+        needs="learners",
+    ),
+)
+
 _NET = "network"
 NETWORK_TARGETS = (
     Target(
@@ -389,6 +428,7 @@ TARGETS = (
     *NETWORK_TARGETS,
     *BROWSER_TARGETS,
     *WIDGET_TARGETS,
+    *LEARNERS_TARGETS,
 )
 
 

@@ -16,6 +16,8 @@
 #   RTT_HUB_PYTHON      the Python of the learners' environment (default this project's .venv)
 #   RTT_HUB_DOMAINS     the ROS domains to give out, comma-separated (default: every one a server has, 1-101
 #                       and 215-232; tests pick their own)
+#   RTT_HUB_FRAME_RATE  the learners' live views' frames per second, at most (default 20: a server's CPU is
+#                       shared; a learner's own machine draws 60)
 #   RTT_HUB_PER_LEARNER_NETWORK  "1" when the spawner gives each learner a network namespace (containers,
 #                       pods): domains may then repeat
 #   RTT_NBGRADER_EXCHANGE  nbgrader's exchange, where learners fetch assignments and submit them (default
@@ -86,6 +88,9 @@ c.Spawner.start_timeout = 120
 c.Spawner.environment = {
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",  # a learner's nodes never look beyond this machine
     "PATH": f"{ENV_BIN}:/usr/local/bin:/usr/bin:/bin",  # rtt-* in the learner's terminals
+    # Live views draw at most this many frames a second (tutorial/app/frames.py; 60 on a learner's own
+    # machine): each frame costs the server, and the book's Benchmarks page says how many learners it holds.
+    "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
 }
 
 # nbgrader for the learners: the course and its exchange (fetch and submit, from the Assignments tab of

@@ -53,3 +53,25 @@ def test_late_join_summary_and_targets():
     assert viewer["pass"] and viewer["measured"] == "0.30 s" and "2.40 s" in viewer["baseline"]
     assert not recorder["pass"]
     assert [t.row({}) for t in LATE_JOIN_TARGETS if t.needs is None or {}.get(t.needs)] == []
+
+
+def test_learners_targets_and_plot(tmp_path):
+    """A class on one server: each target's verdict from the class of 8 against one learner, and the plot."""
+    from benchmarks.plots import plot_learners
+    from benchmarks.targets import LEARNERS_TARGETS
+
+    def one(n, rtf, age_p99, mb):
+        return {
+            "real_time_factor": [rtf] * n, "real_time_factor_min": rtf, "age_ms_p99_max": age_p99,
+            "age_ms_pooled": {"p50": age_p99 / 3}, "memory_mb_per_learner_mean": mb, "cores_busy": 0.25 * n,
+            "cores_by_role": {"kernels": 0.16 * n, "learners' servers": 0.05 * n},
+        }  # fmt: skip
+
+    run = {"machine": {"cpus": 2}, "when": "now", "learners": {"1": one(1, 1.0, 0.8, 277), "8": one(8, 1.0, 1.5, 232)}}
+    rtf, age, memory = (t.row(run) for t in LEARNERS_TARGETS)
+    assert rtf["pass"] and age["pass"] and memory["pass"] and age["measured"] == "1.5 ms"
+    run["learners"]["8"] = one(8, 0.98, 1.7, 1100)  # behind real time, ages past 2 x 0.8 ms, over 1 GiB
+    assert not any(t.row(run)["pass"] for t in LEARNERS_TARGETS)
+    assert [t.row({}) for t in LEARNERS_TARGETS if t.needs is None or {}.get(t.needs)] == []  # not run: left out
+    path = plot_learners(run, tmp_path / "bench_learners.png")
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

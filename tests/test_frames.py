@@ -134,3 +134,38 @@ def test_complete_bursts_back_to_back_are_drawn_at_most_frame_rate_times_a_secon
     app, frames = viewer
     step_for(app, 1.0, post=move_all)  # every posted call completes a burst
     assert FRAME_RATE * 0.5 <= len(frames) <= FRAME_RATE + 2, len(frames)
+
+
+@pytest.mark.unit
+def test_the_frame_rate_comes_from_the_environment_or_a_clear_error():
+    """A class's server sets RTT_FRAME_RATE (course/jupyterhub_config.py); a learner's machine keeps 60."""
+    from tutorial.app.frames import frame_rate
+
+    assert frame_rate(None) == 60.0 and frame_rate(" ") == 60.0
+    assert frame_rate("20") == 20.0 and frame_rate("1") == 1.0 and frame_rate("240") == 240.0
+    for bad in ("0", "0.5", "241", "-20", "nan", "inf", "twenty"):
+        with pytest.raises(ValueError, match=r"RTT_FRAME_RATE must be frames per second from 1 to 240"):
+            frame_rate(bad)
+
+
+@pytest.mark.cross_process
+def test_a_class_server_s_frame_rate_paces_the_views(tmp_path):
+    """With RTT_FRAME_RATE=20 a simulating view draws 20 frames a second, not 60 (a subprocess: read at import)."""
+    import subprocess
+    import sys
+
+    code = (
+        "from tutorial.app.frames import FRAME_RATE, FramePacer\n"
+        "p = FramePacer(); n = 0; now = 0.0\n"  # one second of the frame clock, each frame drawn when due
+        "while True:\n"
+        "    now = p.next_frame_due(True, [])\n"
+        "    if now > 1.0: break\n"
+        "    p.drawn(now, []); n += 1\n"
+        "print(FRAME_RATE, n)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], env={**__import__("os").environ, "RTT_FRAME_RATE": "20"},
+        capture_output=True, text=True, timeout=60, check=True,
+    )  # fmt: skip
+    rate, frames = out.stdout.split()
+    assert float(rate) == 20.0 and 19 <= int(frames) <= 21, out.stdout

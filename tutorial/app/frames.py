@@ -11,8 +11,31 @@ arrows' versions).
 from __future__ import annotations
 
 import math
+import os
 
-FRAME_RATE = 60.0  # Hz, the most often the scene is redrawn
+
+def frame_rate(text: str | None) -> float:
+    """The views' frame rate, Hz, from the text of ``RTT_FRAME_RATE`` (None or blank: 60).
+
+    A class's server sets it lower (``course/jupyterhub_config.py``): every
+    frame of a live view in a notebook costs the server CPU, in the kernel,
+    in the learner's Jupyter server and in the hub's proxy.
+
+    Raises:
+        ValueError: not a number of frames per second from 1 to 240.
+    """
+    if text is None or not text.strip():
+        return 60.0
+    try:
+        rate = float(text)
+    except ValueError:
+        rate = math.nan
+    if not 1.0 <= rate <= 240.0:  # a NaN fails too
+        raise ValueError(f"RTT_FRAME_RATE must be frames per second from 1 to 240, got {text!r}")
+    return rate
+
+
+FRAME_RATE = frame_rate(os.environ.get("RTT_FRAME_RATE"))  # Hz, the most often the scene is redrawn
 SETTLE = 0.004  # s: a frame waits this long after a change for more of the same burst (see next_frame_due)
 SETTLE_MAX = 0.008  # s: ... and at most this long after the first change it shows
 
