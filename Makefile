@@ -6,6 +6,7 @@
 #       make notebooks (JupyterLab on notebooks/), make hub (a class's JupyterHub on 127.0.0.1:8000, course/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
+#       make mutate (mutation testing of the lessons and the library's core: about an hour),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
 #       make test-hub (the hub with learners as Unix users: slow),
@@ -20,7 +21,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: demo test test-fast test-lab test-hub test-grade assignments grade test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
+.PHONY: demo test test-fast test-lab test-hub test-grade mutate assignments grade test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
 
 UV_VERSION := 0.13.9
 
@@ -64,6 +65,14 @@ assignments: $(VENV)/.installed
 # Collect the submissions from the exchange, autograde them, write feedback and course/grades.csv.
 grade: $(VENV)/.installed
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/grade.py
+
+# Mutation testing (mutmut, configured in pyproject.toml) of the modules the notebooks build and the core they
+# stand on: each mutant is a small change to one function, run against the tests that call it; the report says
+# how many the tests caught and lists every survivor, with why it cannot be caught or that a test is missing.
+# About an hour here; mutants/ keeps the results, so a second run only tests what changed.
+mutate: $(VENV)/.installed
+	RTT_TEST_MODE=1 $(VENV)/bin/mutmut run
+	$(PY) scripts/mutation_report.py
 
 # The unit tier only: no ROS, no process, no browser.
 test-fast: $(VENV)/.installed

@@ -279,3 +279,61 @@ def test_without_egl_rtt_run_refuses_with_one_line_saying_why(egl):
     assert lines[0].startswith("cannot render camera Kinect offscreen (MUJOCO_GL=egl; "), r.stderr
     assert lines[1] == "rtt-run: controller RttCameraImagePublisher refused to configure", r.stderr
     assert "Traceback" not in r.stdout + r.stderr
+
+
+class NoNode:
+    """A node that must not be used: a refused configure creates no publisher."""
+
+    def create_publisher(self, *args):
+        raise AssertionError("a refused configure created a publisher")
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize(
+    ("parameters", "says"),
+    [
+        ({"rate": 0.0}, "rate must be > 0 Hz, got 0.0"),
+        ({"rate": -5.0}, "rate must be > 0 Hz, got -5.0"),
+        ({"rate": math.nan}, "rate must be > 0 Hz, got nan"),
+        ({"rate": 30.0, "compressed_format": "gif"}, "one of ('jpeg', 'png'), jpeg_quality: 1..100; got 'gif', 80"),
+        ({"rate": 30.0, "jpeg_quality": 0}, "got 'jpeg', 0"),
+        ({"rate": 30.0, "jpeg_quality": 101}, "got 'jpeg', 101"),
+    ],
+)  # fmt: skip
+def test_a_configure_with_bad_parameters_is_refused_saying_why(caplog, parameters, says):
+    import logging
+
+    model = build_world(load_project(PROJECT / "step6.yaml").models, time_step=0.001)
+    log = logging.getLogger("test.camera")
+    config = ControllerConfig(
+        name="C", body=Body(model, mujoco.MjData(model), "Tank"), node=NoNode(), parameters=parameters, log=log
+    )
+    with caplog.at_level(logging.ERROR, logger="test.camera"):
+        assert RttCameraImagePublisher().configure(config) is False
+    assert says in caplog.text
+
+
+@pytest.mark.unit
+def test_a_body_without_a_camera_or_its_resolution_is_refused_saying_which(caplog, tmp_path):
+    import logging
+
+    from tutorial.core.world import ModelEntry
+
+    path = tmp_path / "cams.xml"
+    path.write_text(
+        '<mujoco><worldbody><body name="head"><geom type="sphere" size="0.1"/>'
+        '<camera name="eye"/></body></worldbody></mujoco>'
+    )
+    model = build_world([ModelEntry("Room", ROOT / "model" / "room.xml"), ModelEntry("Bot", path)])
+    log = logging.getLogger("test.camera")
+    with caplog.at_level(logging.ERROR, logger="test.camera"):
+        for body, says in (
+            ("Room", "body Room has no camera"),
+            ("Bot", 'camera eye: give it resolution="W H" in its model'),
+        ):
+            config = ControllerConfig(
+                name="C", body=Body(model, mujoco.MjData(model), body), node=NoNode(), parameters={"rate": 30.0},
+                log=log,
+            )  # fmt: skip
+            assert RttCameraImagePublisher().configure(config) is False
+            assert says in caplog.text, caplog.text

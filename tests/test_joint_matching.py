@@ -139,3 +139,30 @@ def test_a_table_written_by_hand(mixed, names, positions, applied, rejected):
     assert r.applied == pytest.approx(applied)
     assert {i: reason for i, _, reason in r.rejected} == rejected
     assert set(r.missing) == {"pan", "spin", "lift"} - set(applied)
+
+
+def test_a_position_that_is_not_a_number_is_rejected_never_raised(tank):
+    """A buggy publisher's value that float() refuses counts as not finite; the call itself never raises."""
+    r = match_joint_state(tank.joint_infos, ["TURRET_Y", "TURRET_P"], ["left", 0.2])
+    assert r.applied == {"TURRET_P": 0.2} and r.rejected == [(0, "TURRET_Y", "not_finite")]
+    r = match_joint_state(tank.joint_infos, ["TURRET_Y"], [object()])
+    assert r.applied == {} and r.counts() == {"not_finite": 1}
+
+
+def test_the_tolerance_includes_its_edge_at_both_limits(tank):
+    """A position exactly the tolerance past a limit is applied (the range is closed); any further is not."""
+    from tutorial.interfaces.joint_state import HINGE_TOLERANCE
+
+    info = tank.joint("TURRET_P").info
+    for edge, outward in ((info.lower - HINGE_TOLERANCE, -1e-9), (info.upper + HINGE_TOLERANCE, 1e-9)):
+        assert match_joint_state(tank.joint_infos, ["TURRET_P"], [edge]).applied == {"TURRET_P": edge}
+        beyond = edge + outward
+        assert match_joint_state(tank.joint_infos, ["TURRET_P"], [beyond]).counts() == {"out_of_range": 1}
+
+
+def test_the_original_loop_never_reads_past_an_array(tank):
+    """It stops at the shortest of the model's joints, the names and the positions."""
+    names, positions = ["TURRET_Y", "TURRET_P", "X"], [0.1, 0.2, 0.3]
+    assert match_like_the_original(tank.joint_names, names, positions) == {0: 0.1, 1: 0.2}  # 3 entries, 2 joints
+    assert match_like_the_original(tank.joint_names + ["X"], names[:2], positions) == {0: 0.1, 1: 0.2}
+    assert match_like_the_original(tank.joint_names + ["X"], names, positions[:2]) == {0: 0.1, 1: 0.2}

@@ -40,6 +40,47 @@ def test_turret_rate_is_0_002_rad_per_ms_at_full_stick():
     assert pitch * 0.001 == pytest.approx(-0.002)  # stick pushed forward: barrel goes down, as in the original
 
 
+# Written by hand from the original's formulas (ROS's joy convention: stick up and stick left are +1).
+# (left stick H, left stick V) -> (left track, right track), m/s.
+TRACK_TABLE = [
+    ((0.0, 1.0), (2.0, 2.0)),  # forward
+    ((0.0, -1.0), (-2.0, -2.0)),  # backward
+    ((1.0, 0.0), (-1.0, 1.0)),  # turn left on the spot
+    ((-1.0, 0.0), (1.0, -1.0)),  # turn right on the spot
+    ((0.5, 0.5), (0.5, 1.5)),  # forward and left
+    ((-0.5, 0.5), (1.5, 0.5)),  # forward and right
+    ((0.5, -0.5), (-1.5, -0.5)),  # backward, stick left
+    ((-0.5, -0.5), (-0.5, -1.5)),  # backward, stick right
+    ((0.0, 0.2), (0.4, 0.4)),  # at the dead zone's edge: taken as it is
+    ((0.0, -0.2), (-0.4, -0.4)),
+    ((0.2, 0.0), (-0.2, 0.2)),
+    ((0.3, 0.19), (-0.3, 0.3)),  # forward inside the dead zone, turning outside it
+    ((0.19, -0.19), (0.0, 0.0)),
+]
+# (right stick H, right stick V) -> (TURRET_Y rate, TURRET_P rate), rad/s.
+TURRET_TABLE = [
+    ((-1.0, 0.0), (2.0, 0.0)),  # stick right: clockwise from above
+    ((1.0, 0.0), (-2.0, 0.0)),
+    ((0.0, 1.0), (0.0, -2.0)),  # pushed forward: the barrel goes down
+    ((0.0, -1.0), (0.0, 2.0)),
+    ((0.15, -0.15), (-0.3, 0.3)),  # at the dead zone's edge
+    ((-0.5, 0.5), (1.0, -1.0)),
+    ((0.149, -0.149), (0.0, 0.0)),
+]
+
+
+@pytest.mark.parametrize(("stick", "expected"), TRACK_TABLE)
+def test_track_velocities_by_a_table_written_by_hand(stick, expected):
+    got = tc.track_velocities(axes(lh=stick[0], lv=stick[1]))
+    assert got == pytest.approx(expected, abs=1e-12)
+    assert all(math.copysign(1.0, v) == 1.0 for v in got if v == 0.0)  # a stopped track prints 0.0, not -0.0
+
+
+@pytest.mark.parametrize(("stick", "expected"), TURRET_TABLE)
+def test_turret_rates_by_a_table_written_by_hand(stick, expected):
+    assert tc.turret_rates(axes(rh=stick[0], rv=stick[1])) == pytest.approx(expected, abs=1e-12)
+
+
 def test_pd_torque_uses_the_original_gains():
     assert tc.pd_torque(0.1, 0.0, 0.0, 0.0) == pytest.approx(20.0)
     assert tc.pd_torque(0.0, 0.0, 0.0, 0.2) == pytest.approx(-10.0)
@@ -142,3 +183,29 @@ def test_no_timeout_before_the_first_joy_and_none_when_disabled():
     controller.on_joy(joy(axes(lv=0.5)))
     run(controller, model, data, 2000)
     assert controller.timeouts == 0 and controller.tracks[0].dq_target == pytest.approx(1.0)
+
+
+def test_the_safe_stop_and_the_resume_are_reported_once_each_with_where_the_tank_is():
+    """report() posts one status line per event to the main thread, each under a key of its own."""
+    controller, model, data = make_controller(joy_timeout=0.5)
+    posted = []
+
+    def call_later(func, record, key=None):  # the main thread's queue: what was posted, and with which key
+        posted.append((func, record, key))
+
+    output = object()
+    node = SimpleNamespace(get_fully_qualified_name=lambda: "/rtt")
+    controller.config = SimpleNamespace(call_later=call_later, output=output, node=node)
+    controller.on_joy(joy(axes(lv=0.5)))
+    run(controller, model, data, 600)  # 0.6 s: the joystick went silent after its one Joy
+    controller.on_joy(joy(axes(lv=0.5)))
+    run(controller, model, data, 5)
+    assert [r["event"] for _, r, _ in posted] == ["joy_timeout", "joy_resumed"]
+    assert all(func is output for func, _, _ in posted) and posted[0][2] is not posted[1][2] is not None
+    stop, resume = posted[0][1], posted[1][1]
+    assert stop["node"] == "/rtt" and stop["t"] == pytest.approx(0.5, abs=0.002)
+    assert stop["line"] == "[/rtt] no /joy for 0.50 s: tracks stopped, turret held"
+    assert resume["line"] == "[/rtt] /joy is back: driving again" and resume["t"] == pytest.approx(0.6, abs=0.002)
+    root = Body(model, data, "Tank").root_pose()[0]
+    assert resume["root_position"] == pytest.approx([round(float(v), 4) for v in root], abs=0.01)
+    assert stop["root_position"][0] != 0.0 and set(stop) == {"event", "node", "t", "root_position", "line"}
