@@ -1,0 +1,161 @@
+"""The Step 3 monitor in this process: what it says and shows, message by message (notebook 03's lesson).
+
+A stand-in node keeps the subscriptions; each callback is called as the spin
+thread would, and the main thread's posted work runs on a real
+:class:`MainLoop` owned by the test.
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import mujoco
+import pytest
+
+from tutorial.controllers.joint_state_subscriber import RttJointStateMonitor
+from tutorial.core.body import Body
+from tutorial.core.call_later import MainLoop
+from tutorial.core.controller import ControllerConfig
+from tutorial.core.world import ModelEntry, build_world
+
+from conftest import MODEL
+
+pytestmark = pytest.mark.unit
+
+
+class Node:
+    def __init__(self):
+        self.subscriptions, self.destroyed = [], []
+
+    def get_fully_qualified_name(self):
+        return "/rtt_viewer"
+
+    def create_subscription(self, msg_type, topic, callback, qos, event_callbacks=None):
+        sub = SimpleNamespace(topic=topic, callback=callback, qos=qos, events=event_callbacks)
+        self.subscriptions.append(sub)
+        return sub
+
+    def destroy_subscription(self, sub):
+        self.destroyed.append(sub)
+
+
+def state(t, names, positions):
+    sec = int(t)
+    return SimpleNamespace(
+        header=SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=round((t - sec) * 1e9))),
+        name=list(names),
+        position=list(positions),
+    )
+
+
+def make_monitor():
+    """A configured monitor of the tank, its stand-in node, the main thread's loop and the status records."""
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    body = Body(model, mujoco.MjData(model), "Tank")
+    loop, node, out = MainLoop(), Node(), []
+    config = ControllerConfig(
+        name="RttJointStateMonitor", body=body, node=node, parameters={}, call_later=loop.call_later,
+        call_every=loop.call_every, output=out.append,
+    )  # fmt: skip
+    m = RttJointStateMonitor()
+    assert m.configure(config)
+    return SimpleNamespace(m=m, loop=loop, node=node, out=out, body=body)
+
+
+@pytest.fixture
+def monitor():
+    return make_monitor()
+
+
+def events(out, kind):
+    return [r for r in out if r.get("event") == kind]
+
+
+def test_it_subscribes_live_and_late_and_reports_its_first_state(monitor):
+    live, late = monitor.node.subscriptions
+    assert live.topic == late.topic == "/Tank/joint_state"
+    assert live.qos.durability.name == "VOLATILE" and late.qos.durability.name == "TRANSIENT_LOCAL"
+    assert live.events is not None and live.events.matched == monitor.m.on_matched
+    live.callback(state(1.5, ["TURRET_Y", "TURRET_P"], [0.3, 0.1]))
+    assert monitor.out == []  # the spin thread only posts
+    monitor.loop.process_pending()
+    assert monitor.body.joint_positions() == pytest.approx({"TURRET_Y": 0.3, "TURRET_P": 0.1})
+    (first,) = events(monitor.out, "first_state")
+    assert first == {
+        "event": "first_state", "node": "/rtt_viewer", "topic": "/Tank/joint_state",
+        "message": "first joint state on /Tank/joint_state: 2/2 joints matched",
+        "line": "[/rtt_viewer] first joint state on /Tank/joint_state: 2/2 joints matched", "matched": 2, "joints": 2,
+    }  # fmt: skip
+    assert monitor.node.destroyed == [late]  # live states flow: the late subscription goes
+    live.callback(state(1.52, ["TURRET_Y"], [0.4]))
+    monitor.loop.process_pending()
+    assert len(events(monitor.out, "first_state")) == 1  # once
+
+
+def test_stamps_that_go_back_are_reported_and_the_new_run_shown(monitor):
+    live = monitor.node.subscriptions[0]
+    for t, q in ((5.0, 0.2), (0.02, -0.2)):
+        live.callback(state(t, ["TURRET_Y"], [q]))
+        monitor.loop.process_pending()
+    (back,) = events(monitor.out, "stamps_back")
+    assert back["message"] == "/Tank/joint_state: stamps went back from 5.000 s to 0.020 s (a new run?): showing it"
+    assert monitor.body.joint_positions()["TURRET_Y"] == pytest.approx(-0.2)
+    live.callback(state(0.04, ["TURRET_Y"], [-0.1]))  # forward again: nothing more to say
+    monitor.loop.process_pending()
+    s = monitor.m.summary()
+    assert s["stamps_back"] == 1 and s["applied"] == 3 and s["received"] == 3 and s["late_states"] == 0
+    assert s["topic"] == "/Tank/joint_state" and s["rejected"] == {}
+    assert s["last_positions"] == {"TURRET_Y": -0.1, "TURRET_P": 0.0}
+
+
+def test_a_late_state_is_shown_only_while_no_live_one_came(monitor):
+    live, late = monitor.node.subscriptions
+    late.callback(state(12.25, ["TURRET_P", "X"], [0.2, 1.0]))
+    monitor.loop.process_pending()
+    (shown,) = events(monitor.out, "late_state")
+    assert shown["message"] == (
+        "/Tank/joint_state: showing the newest state published before this viewer started (t = 12.250 s)"
+    )
+    assert shown["stamp"] == 12.25 and shown["matched"] == 1 and shown["joints"] == 2
+    assert monitor.body.joint_positions()["TURRET_P"] == pytest.approx(0.2)
+    assert monitor.node.destroyed == [late] and monitor.m.summary()["late_states"] == 1
+    # A live state came first: a late one that arrives after it is not shown.
+    other = make_monitor()
+    live2, late2 = other.node.subscriptions
+    live2.callback(state(1.0, ["TURRET_P"], [0.05]))
+    other.loop.process_pending()
+    late2.callback(state(0.5, ["TURRET_P"], [0.3]))
+    other.loop.process_pending()
+    assert events(other.out, "late_state") == [] and other.m.summary()["late_states"] == 0
+    assert other.body.joint_positions()["TURRET_P"] == pytest.approx(0.05)
+
+
+def test_publishers_are_counted_and_two_are_a_warning(monitor):
+    live = monitor.node.subscriptions[0]
+    for count in (1, 2, 1):
+        monitor.m.on_matched(SimpleNamespace(current_count=count))
+        monitor.loop.process_pending()
+    assert [(r["count"], r["node"], r["topic"]) for r in events(monitor.out, "publishers")] == [
+        (1, "/rtt_viewer", "/Tank/joint_state"), (2, "/rtt_viewer", "/Tank/joint_state"),
+        (1, "/rtt_viewer", "/Tank/joint_state"),
+    ]  # fmt: skip
+    (warning,) = events(monitor.out, "warning")
+    assert warning["message"] == (
+        "2 publishers on /Tank/joint_state: the view mixes their states and cannot tell which robot it is showing"
+    )
+    monitor.m.on_matched(SimpleNamespace(current_count=3))
+    monitor.m.on_matched(SimpleNamespace(current_count=0))  # two at once: the newest count wins
+    monitor.loop.process_pending()
+    assert events(monitor.out, "publishers")[-1]["count"] == 0 and len(events(monitor.out, "warning")) == 1
+    assert live.callback  # the live subscription stays
+
+
+def test_rejections_are_counted_by_reason_and_unconfigure_drops_both_subscriptions(monitor):
+    live, late = monitor.node.subscriptions
+    live.callback(state(1.0, ["TURRET_Y", "TURRET_Y", "wheel"], [0.1, 0.2, 0.3]))
+    monitor.loop.process_pending()
+    live.callback(state(1.1, ["TURRET_P"], [float("nan")]))
+    monitor.loop.process_pending()
+    assert monitor.m.summary()["rejected"] == {"duplicate_name": 2, "not_finite": 1, "unknown_name": 1}
+    monitor.m.unconfigure()
+    assert late in monitor.node.destroyed and live in monitor.node.destroyed
