@@ -344,7 +344,7 @@ async def _measure(hub, learners, seconds: float, warmup: float, directory: Path
         "learners": n,
         "window_s": round((window[1] - window[0]) / 1e9, 1),
         "common_window": common,
-        "first_state_s": first_state_s,  # from the last learner's run starting to each viewer's first state
+        "first_state_s": first_state_s,  # from every learner's run cell having returned to each viewer's first state
         "real_time_factor": [f["real_time_factor"] for f in figures],
         "real_time_factor_min": min(f["real_time_factor"] for f in figures),
         "age_ms_p99": [f["age_ms_p99"] for f in figures],
