@@ -330,3 +330,93 @@ def test_a_timer_that_is_due_runs_at_once_and_is_not_waited_for():
     loop.run_once(5.0)  # would wait 5 s, but the timer is due in 0.02 s: the wait ends then
     assert ticks and time.monotonic() - start < 1.0
     assert ticks[0] - start >= 0.019
+
+
+def test_a_loop_owned_by_another_thread_refuses_this_one_saying_how_to_post():
+    other = threading.Thread(target=lambda: None)
+    other.start()
+    other.join(10)
+    loop = MainLoop(owner=other)
+    try:
+        loop.process_pending()
+    except WrongThreadError as exc:
+        assert str(exc) == "MainLoop: only its owner thread may run posted calls; other threads must use call_later()"
+    else:
+        raise AssertionError("the loop ran its calls on a thread that does not own it")
+
+
+class FlushCounting:
+    """Stands in for ``sys.stdout``: counts flushes, so an error shows in a notebook at once."""
+
+    def __init__(self):
+        self.text, self.flushes = "", 0
+
+    def write(self, text):
+        self.text += text
+
+    def flush(self):
+        self.flushes += 1
+
+
+def test_an_error_in_a_call_is_flushed_at_once(monkeypatch):
+    import sys
+
+    out = FlushCounting()
+    monkeypatch.setattr(sys, "stdout", out)
+    loop = MainLoop()
+    loop.call_later(int, "not a number")
+    loop.process_pending()
+    assert "[call_later] error in int:" in out.text and out.flushes >= 1
+
+
+class FakeClock:
+    """Stands in for the module ``time`` of call_later: time moves only when the loop waits."""
+
+    def __init__(self, now=100.0):
+        self.now = now
+
+    def monotonic(self):
+        return self.now
+
+
+class FakeClockLoop(MainLoop):
+    """A MainLoop whose waits move the fake clock by what they would wait, and are recorded."""
+
+    def __init__(self, clock):
+        super().__init__()
+        self.clock, self.waits = clock, []
+
+    def _wait(self, timeout):
+        self.waits.append(timeout)
+        self.clock.now += timeout
+
+
+def test_a_timer_runs_exactly_when_due_and_not_a_moment_before(monkeypatch):
+    from tutorial.core import call_later
+
+    clock = FakeClock()
+    monkeypatch.setattr(call_later, "time", clock)
+    loop, ticks = MainLoop(), []
+    loop.call_every(1.0, lambda: ticks.append(clock.now))
+    clock.now = 100.5
+    loop.process_pending()
+    assert ticks == []  # half a period: not yet
+    clock.now = 101.0
+    loop.process_pending()
+    assert ticks == [101.0]  # due at 101.0 s exactly: runs
+    clock.now = 101.75
+    loop.process_pending()
+    assert ticks == [101.0]
+
+
+def test_run_until_polls_every_10_ms_by_default_and_stops_at_its_deadline_exactly(monkeypatch):
+    from tutorial.core import call_later
+
+    clock = FakeClock()
+    monkeypatch.setattr(call_later, "time", clock)
+    loop = FakeClockLoop(clock)
+    assert loop.run_until(lambda: False, timeout=1.0, poll=0.25) is False
+    assert loop.waits == [0.25] * 4 and clock.now == 101.0  # nothing left at the deadline: no wait of 0 s more
+    loop = FakeClockLoop(clock)
+    assert loop.run_until(lambda: False, timeout=0.5) is False
+    assert loop.waits[0] == 0.01

@@ -90,7 +90,7 @@ def test_a_body_without_imu_is_refused_with_its_name(caplog):
         name="RttImuStatePublisher", body=Body(model, data, "Crane"), node=FakeNode(), parameters={"rate": 20.0}
     )
     assert not pub.RttImuStatePublisher().configure(config)
-    assert "body Crane: the body has no accelerometer on a site" in caplog.text
+    assert caplog.messages == ["body Crane: the body has no accelerometer on a site"]
 
 
 def test_an_imu_site_off_the_link_origin_names_its_own_frame(tmp_path):
@@ -323,7 +323,7 @@ def test_period_mean_is_the_mean_of_what_was_added_and_starts_over():
     np.testing.assert_array_equal(mean.take(), [2.0, 2.0, 2.0])
     mean.add(np.array([5.0, 0.0, -5.0]))
     np.testing.assert_array_equal(mean.take(), [5.0, 0.0, -5.0])  # the first two are gone
-    with pytest.raises(ZeroDivisionError, match="no reading"):
+    with pytest.raises(ZeroDivisionError, match=r"^PeriodMean\.take: no reading was added$"):
         mean.take()
 
 
@@ -469,3 +469,39 @@ def test_recorded_arrows_appear_and_hide_in_a_browser(tmp_path):
         r, g, b = image[..., 0], image[..., 1], image[..., 2]
         red_pixels[label] = int(((r > g + 0.3) & (r > b + 0.3)).sum())
     assert red_pixels["shown"] > 50 and red_pixels["hidden"] == 0, red_pixels
+
+
+def test_the_publishers_summary_holds_the_newest_message_rounded_and_unconfigure_drops_it():
+    controller, node, _ = run_publisher(0.5)
+    m = node.publisher.sent[-1]
+    summary = controller.summary()
+    assert summary == {
+        "topic": "/Tank/imu", "rate": 20.0, "frame_id": "CHASSIS", "published": 10,
+        "last_linear_acceleration": [round(float(v), 6) for v in m.accel],
+        "last_angular_velocity": [round(float(v), 6) for v in m.gyro],
+    }  # fmt: skip
+    assert summary["last_linear_acceleration"] != [0.0, 0.0, 0.0] and summary["last_angular_velocity"] != [0.0] * 3
+    destroyed = []
+    node.destroy_publisher = destroyed.append
+    controller.unconfigure()
+    assert destroyed == [node.publisher]
+
+
+def test_a_publisher_that_never_published_summarises_without_readings(caplog):
+    import logging
+
+    model, data = tank_world()
+    controller = pub.RttImuStatePublisher()
+    log = logging.getLogger("test.imu")
+    config = ControllerConfig(
+        name="x", body=Body(model, data, "Tank"), node=FakeNode(), parameters={"rate": 5.0}, log=log
+    )
+    assert controller.configure(config)
+    assert controller.summary() == {"topic": "/Tank/imu", "rate": 5.0, "frame_id": "CHASSIS", "published": 0}
+    with caplog.at_level(logging.ERROR, logger="test.imu"):
+        assert not pub.RttImuStatePublisher().configure(
+            ControllerConfig(
+                name="x", body=Body(model, data, "Tank"), node=FakeNode(), parameters={"rate": -0.5}, log=log
+            )
+        )
+    assert caplog.messages == ["rate must be >= 0 Hz, got -0.5"]

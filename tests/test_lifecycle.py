@@ -99,3 +99,11 @@ def test_a_callback_that_raises_ends_the_run_and_is_reported(tmp_path, node):
         app.close()
     assert "a subscription callback raised" in app.summary()["error"]
     assert "cannot handle 'x'" in app.summary()["error"]
+
+
+def test_the_base_controllers_steps_say_go_on():
+    """A controller that overrides only ``configure`` runs: the base ``initialize``, ``start``, ``control`` say True."""
+    from tutorial.core.controller import SimpleController
+
+    c = SimpleController()
+    assert c.initialize(None) is True and c.start() is True and c.control() is True

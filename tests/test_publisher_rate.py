@@ -75,3 +75,63 @@ def test_the_step2_publisher_sends_the_start_state_then_one_per_period_then_the_
     stamps = [round(t, 3) for t, _ in node.publisher.sent]
     assert stamps == [0.0, 10.0, 10.5]  # start, one period later, the final state
     assert node.publisher.sent[1][1] != start_pitch  # the barrel sagged: a later state, not the start again
+
+
+def test_the_step2_publisher_counts_what_it_sent_refuses_a_negative_rate_and_lets_the_final_state_be_acked(caplog):
+    import logging
+
+    import mujoco
+    from rclpy.duration import Duration
+
+    from tutorial.controllers.joint_state_publisher import RttJointStatePublisher
+    from tutorial.core.body import Body
+    from tutorial.core.controller import ControllerConfig, ControllerIO
+    from tutorial.core.world import ModelEntry, build_world
+
+    from conftest import MODEL
+
+    class Publisher:
+        def __init__(self):
+            self.sent, self.acked_within = 0, []
+
+        def publish(self, msg):
+            self.sent += 1
+
+        def wait_for_all_acked(self, timeout):
+            self.acked_within.append(timeout)
+            return True
+
+    class Node:
+        def __init__(self):
+            self.publishers, self.destroyed = [], []
+
+        def create_publisher(self, msg_type, topic, qos):
+            self.publishers.append((topic, Publisher()))
+            return self.publishers[-1][1]
+
+        def destroy_publisher(self, publisher):
+            self.destroyed.append(publisher)
+
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    data = mujoco.MjData(model)
+    body = Body(model, data, "Tank")
+    log = logging.getLogger("test.step2")
+    node = Node()
+    with caplog.at_level(logging.ERROR, logger="test.step2"):
+        refused = RttJointStatePublisher().configure(
+            ControllerConfig(name="P", body=body, node=node, parameters={"rate": -1.0}, log=log)
+        )
+    assert refused is False and node.publishers == []
+    assert caplog.messages == ["rate must be >= 0 Hz, got -1.0"]
+    controller = RttJointStatePublisher()
+    assert controller.configure(ControllerConfig(name="P", body=body, node=node, parameters={"rate": 0.0}, log=log))
+    assert controller.summary() == {"topic": "/Tank/joint_state", "rate": 0.0, "published": 0}
+    assert controller.initialize(ControllerIO(body=body, time_step=0.001, node=node, data=data))
+    assert controller.start()
+    for _ in range(5):
+        assert controller.control()  # rate 0: every step after the first (start() sent that state)
+    controller.stop()
+    ((topic, publisher),) = node.publishers
+    assert publisher.sent == 6 and controller.summary() == {"topic": topic, "rate": 0.0, "published": 6}
+    controller.unconfigure()
+    assert publisher.acked_within == [Duration(seconds=1)] and node.destroyed == [publisher]

@@ -27,9 +27,10 @@ pytestmark = pytest.mark.unit
 class Publisher:
     """Stands in for an rclpy publisher: keeps a copy of each message's fields that matter here."""
 
-    def __init__(self, topic, qos):
-        self.topic, self.qos, self.sent = topic, qos, []
+    def __init__(self, msg_type, topic, qos):
+        self.msg_type, self.topic, self.qos, self.sent = msg_type, topic, qos, []
         self.destroyed = False
+        self.acked_within = []  # each wait_for_all_acked's timeout
 
     def publish(self, msg):
         if hasattr(msg, "data"):
@@ -50,6 +51,7 @@ class Publisher:
         )
 
     def wait_for_all_acked(self, timeout):
+        self.acked_within.append(timeout)
         return True
 
 
@@ -58,7 +60,7 @@ class Node:
         self.publishers = {}
 
     def create_publisher(self, msg_type, topic, qos):
-        self.publishers[topic] = Publisher(topic, qos)
+        self.publishers[topic] = Publisher(msg_type, topic, qos)
         return self.publishers[topic]
 
     def destroy_publisher(self, publisher):
@@ -139,5 +141,21 @@ def test_a_negative_rate_is_refused_saying_why(caplog):
     config.log = logging.getLogger("test.robot_model")
     with caplog.at_level(logging.ERROR, logger="test.robot_model"):
         assert controller.configure(config) is False
-    assert "rate must be >= 0 Hz, got -1.0" in caplog.text
+    assert caplog.messages == ["rate must be >= 0 Hz, got -1.0"]
     assert node.publishers == {}  # nothing published, nothing to clean up
+
+
+def test_the_description_names_its_source_and_unconfigure_waits_for_the_final_pose_to_be_acked():
+    from nav_msgs.msg import Odometry
+    from rclpy.duration import Duration
+    from std_msgs.msg import String
+
+    *_, node, controller, config = tank()
+    assert controller.configure(config)
+    description, odometry = node.publishers["/Tank/robot_description"], node.publishers["/Tank/odom"]
+    assert (description.msg_type, odometry.msg_type) == (String, Odometry)
+    (urdf,) = description.sent
+    assert "from body Tank of the simulation: robot Tank" in urdf
+    controller.unconfigure()
+    assert odometry.acked_within == [Duration(seconds=1)]  # reliable subscribers get the final pose, 1 s at most
+    assert odometry.destroyed and description.destroyed

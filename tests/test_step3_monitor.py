@@ -159,3 +159,120 @@ def test_rejections_are_counted_by_reason_and_unconfigure_drops_both_subscriptio
     assert monitor.m.summary()["rejected"] == {"duplicate_name": 2, "not_finite": 1, "unknown_name": 1}
     monitor.m.unconfigure()
     assert late in monitor.node.destroyed and live in monitor.node.destroyed
+
+
+class Clock:
+    def __init__(self, now=10.0):
+        self.now = now
+
+    def __call__(self):
+        return self.now
+
+
+def make_timed_monitor():
+    """A monitor on the test's clock, its timers kept instead of run: ``(period, func)`` each."""
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    body = Body(model, mujoco.MjData(model), "Tank")
+    loop, node, out, timers = MainLoop(), Node(), [], []
+    config = ControllerConfig(
+        name="RttJointStateMonitor", body=body, node=node, parameters={}, call_later=loop.call_later,
+        call_every=lambda period, func: timers.append((period, func)), output=out.append,
+    )  # fmt: skip
+    m = RttJointStateMonitor()
+    assert m.configure(config)
+    clock = Clock()
+    m.status.clock = clock
+    m.status._last_report = clock.now
+    return SimpleNamespace(m=m, loop=loop, node=node, out=out, body=body, timers=timers, clock=clock)
+
+
+def test_the_status_line_and_the_stale_watch_run_on_their_timers_and_name_the_node():
+    t = make_timed_monitor()
+    assert t.timers == [(1.0, t.m.report_status), (0.25, t.m.check_stale)]
+    live = t.node.subscriptions[0]
+    t.clock.now = 10.5
+    live.callback(state(1.0, ["TURRET_Y", "X"], [0.3, 1.0]))  # arrives at 10.5 s
+    t.clock.now = 10.75
+    t.loop.process_pending()  # shown a quarter of a second later
+    t.clock.now = 11.0
+    t.m.report_status()
+    (status,) = events(t.out, "status")
+    assert status == {
+        "event": "status", "rate_hz": 1.0, "received": 1, "applied": 1, "age_ms": 500.0, "matched": 1, "joints": 2,
+        "rejected": {"unknown_name": 1}, "stale": False, "stamps_back": 0, "node": "/rtt_viewer",
+    }  # fmt: skip
+    t.clock.now = 12.0
+    t.m.check_stale()
+    (stale,) = events(t.out, "stale")
+    assert stale == {"event": "stale", "silent_s": 1.5, "node": "/rtt_viewer"}
+
+
+def test_the_late_state_is_in_the_status_line_with_its_age_and_matches():
+    t = make_timed_monitor()
+    late = t.node.subscriptions[1]
+    t.clock.now = 10.25
+    late.callback(state(3.0, ["TURRET_P", "Y"], [0.2, 0.0]))
+    t.clock.now = 10.5
+    t.loop.process_pending()
+    t.clock.now = 11.0
+    t.m.report_status()
+    (status,) = events(t.out, "status")
+    assert (status["age_ms"], status["matched"], status["applied"], status["received"]) == (750.0, 1, 0, 0)
+
+
+def test_a_second_late_state_after_the_first_is_not_shown():
+    t = make_timed_monitor()
+    live, late = t.node.subscriptions
+    late.callback(state(3.0, ["TURRET_P"], [0.2]))
+    t.loop.process_pending()
+    assert t.node.destroyed == [late]
+    late.callback(state(4.0, ["TURRET_P"], [-0.1]))  # was already on its way when the subscription went
+    t.loop.process_pending()
+    assert t.body.joint_positions()["TURRET_P"] == pytest.approx(0.2)
+    assert len(events(t.out, "late_state")) == 1 and t.m.summary()["late_states"] == 1
+    assert t.node.destroyed == [late]  # dropped once
+    t.m.unconfigure()
+    assert t.node.destroyed == [late, live]
+
+
+def test_equal_stamps_are_not_going_back_and_each_going_back_is_counted():
+    t = make_timed_monitor()
+    live = t.node.subscriptions[0]
+    for stamp in (2.0, 2.0, 1.0, 3.0, 0.5):
+        live.callback(state(stamp, ["TURRET_Y"], [0.1]))
+        t.loop.process_pending()
+    assert [r["message"] for r in events(t.out, "stamps_back")] == [
+        "/Tank/joint_state: stamps went back from 2.000 s to 1.000 s (a new run?): showing it",
+        "/Tank/joint_state: stamps went back from 3.000 s to 0.500 s (a new run?): showing it",
+    ]
+    assert t.m.summary()["stamps_back"] == 2
+
+
+def test_the_summary_rounds_positions_to_the_nanoradian():
+    t = make_timed_monitor()
+    live = t.node.subscriptions[0]
+    live.callback(state(1.0, ["TURRET_Y"], [0.12345678912345]))
+    t.loop.process_pending()
+    assert t.m.summary()["last_positions"]["TURRET_Y"] == 0.123456789
+
+
+def test_the_notebooks_plain_subscriber_hands_each_message_to_the_main_thread():
+    from tutorial.controllers.joint_state_subscriber import RttJointStateSubscriber
+
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    body = Body(model, mujoco.MjData(model), "Tank")
+    loop, node = MainLoop(), Node()
+    config = ControllerConfig(name="S", body=body, node=node, call_later=loop.call_later)
+    s = RttJointStateSubscriber()
+    assert s.configure(config)
+    (sub,) = node.subscriptions
+    assert sub.topic == "/Tank/joint_state" and sub.events is None
+    sub.callback(state(1.0, ["TURRET_Y"], [0.5]))
+    sub.callback(state(1.02, ["TURRET_Y"], [0.6]))  # the newer replaces the one still waiting
+    assert body.joint_positions()["TURRET_Y"] == 0.0  # the callback touched nothing
+    assert loop.process_pending() == 1
+    assert body.joint_positions()["TURRET_Y"] == pytest.approx(0.6)
+    assert s.summary() == {"topic": "/Tank/joint_state", "applied": 1, "rejected": {},
+                           "last_positions": {"TURRET_Y": 0.6, "TURRET_P": 0.0}}  # fmt: skip
+    s.unconfigure()
+    assert node.destroyed == [sub]

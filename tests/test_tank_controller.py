@@ -78,7 +78,9 @@ def test_track_velocities_by_a_table_written_by_hand(stick, expected):
 
 @pytest.mark.parametrize(("stick", "expected"), TURRET_TABLE)
 def test_turret_rates_by_a_table_written_by_hand(stick, expected):
-    assert tc.turret_rates(axes(rh=stick[0], rv=stick[1])) == pytest.approx(expected, abs=1e-12)
+    got = tc.turret_rates(axes(rh=stick[0], rv=stick[1]))
+    assert got == pytest.approx(expected, abs=1e-12)
+    assert all(math.copysign(1.0, v) == 1.0 for v in got if v == 0.0)  # a still turret rate is 0.0, not -0.0
 
 
 def test_pd_torque_uses_the_original_gains():
@@ -209,3 +211,123 @@ def test_the_safe_stop_and_the_resume_are_reported_once_each_with_where_the_tank
     root = Body(model, data, "Tank").root_pose()[0]
     assert resume["root_position"] == pytest.approx([round(float(v), 4) for v in root], abs=0.01)
     assert stop["root_position"][0] != 0.0 and set(stop) == {"event", "node", "t", "root_position", "line"}
+
+
+class StandInNode:
+    """Keeps the subscriptions made and destroyed."""
+
+    def __init__(self):
+        self.subscriptions, self.destroyed = [], []
+
+    def get_fully_qualified_name(self):
+        return "/rtt"
+
+    def create_subscription(self, msg_type, topic, callback, qos):
+        sub = SimpleNamespace(msg_type=msg_type, topic=topic, callback=callback, qos=qos)
+        self.subscriptions.append(sub)
+        return sub
+
+    def destroy_subscription(self, sub):
+        self.destroyed.append(sub)
+
+
+def configure(parameters, log=None):
+    import logging
+
+    from tutorial.core.controller import ControllerConfig
+
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    node = StandInNode()
+    config = ControllerConfig(
+        name="RttTankController", body=Body(model, mujoco.MjData(model), "Tank"), node=node, parameters=parameters,
+        log=log or logging.getLogger("test.tank"),
+    )  # fmt: skip
+    controller = tc.RttTankController()
+    return controller, controller.configure(config), node
+
+
+def test_configure_subscribes_joy_and_unconfigure_drops_it_once():
+    from sensor_msgs.msg import Joy
+
+    from tutorial.interfaces import joy as joy_interface
+
+    controller, ok, node = configure({"joy_timeout": 0.0})
+    assert ok and controller.joy_timeout == 0.0  # 0 is allowed: the safe stop off
+    (sub,) = node.subscriptions
+    assert (sub.msg_type, sub.topic, sub.callback, sub.qos) == (
+        Joy, "/joy", controller.on_joy, joy_interface.joy_subscriber_qos()
+    )  # fmt: skip
+    controller.unconfigure()
+    controller.unconfigure()
+    assert node.destroyed == [sub]
+    controller, ok, node = configure({})
+    assert ok and controller.joy_timeout == 0.5  # the default
+
+
+def test_a_negative_joy_timeout_is_refused_saying_why(caplog):
+    import logging
+
+    with caplog.at_level(logging.ERROR, logger="test.tank"):
+        controller, ok, node = configure({"joy_timeout": -0.1})
+    assert ok is False and node.subscriptions == []
+    assert caplog.messages == ["joy_timeout must be >= 0 s, got -0.1"]
+
+
+def test_a_controller_never_configured_unconfigures_quietly_and_has_the_default_safe_stop():
+    controller = tc.RttTankController()
+    controller.unconfigure()
+    assert controller.take_input() == (0, (), ())
+    assert controller.summary() == {"joy_received": 0, "joy_malformed": 0, "joy_timeouts": 0}
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    data = mujoco.MjData(model)
+    assert controller.initialize(ControllerIO(body=Body(model, data, "Tank"), time_step=0.001, node=None, data=data))
+    controller.on_joy(joy(axes(lv=0.5)))
+    for _ in range(600):
+        controller.control()
+    assert controller.stopped and controller.summary()["joy_timeouts"] == 1  # the default 0.5 s
+
+
+def test_before_any_joy_the_turret_reference_stays_where_it_was():
+    controller, model, data = make_controller()
+    before = list(controller.q_ref)
+    run(controller, model, data, 200)
+    assert controller.q_ref == before and controller.rates == (0.0, 0.0)
+
+
+def test_the_safe_stop_trips_at_the_timeout_itself_and_every_silence_is_counted():
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    data = mujoco.MjData(model)
+    controller = tc.RttTankController()
+    controller.joy_timeout = 0.5
+    assert controller.initialize(ControllerIO(body=Body(model, data, "Tank"), time_step=0.25, node=None, data=data))
+    for silence in (1, 2):
+        controller.on_joy(joy(axes(lv=0.5)))
+        assert controller.control() and not controller.stopped  # the new Joy
+        assert controller.control() and not controller.stopped  # 0.25 s silent
+        assert controller.control() and controller.stopped  # 0.5 s silent: exactly the timeout
+        assert controller.summary()["joy_timeouts"] == silence
+
+
+def test_well_formed_joys_are_not_counted_as_malformed():
+    controller, _, _ = make_controller()
+    for _ in range(3):
+        controller.on_joy(joy(axes(lv=0.5)))
+    assert controller.summary() == {"joy_received": 3, "joy_malformed": 0, "joy_timeouts": 0}
+
+
+def test_a_report_rounds_the_time_to_the_millisecond_and_the_position_to_a_tenth_of_a_millimetre():
+    controller, model, data = make_controller()
+    posted = []
+    controller.config = SimpleNamespace(
+        call_later=lambda func, record, key=None: posted.append(record), output=None,
+        node=SimpleNamespace(get_fully_qualified_name=lambda: "/rtt"),
+    )  # fmt: skip
+    data.time = 1.23456
+    data.qpos[:3] = [0.123456, -2.345678, 0.0501234]
+    mujoco.mj_kinematics(model, data)
+    controller.report("joy_timeout", "text")
+    (record,) = posted
+    assert record == {
+        "event": "joy_timeout", "node": "/rtt", "t": 1.235, "root_position": [0.1235, -2.3457, 0.0501],
+        "line": "[/rtt] text",
+    }  # fmt: skip
