@@ -6,7 +6,7 @@
 #       make notebooks (JupyterLab on notebooks/), make hub (a class's JupyterHub on 127.0.0.1:8000, course/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
-#       make mutate (mutation testing of the lessons and the library's core: about 30 minutes),
+#       make mutate (mutation testing of the lessons and the library's core: about 25 minutes),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
 #       make test-hub (the hub with learners as Unix users: slow),
@@ -69,7 +69,7 @@ grade: $(VENV)/.installed
 # Mutation testing (mutmut, configured in pyproject.toml) of the modules the notebooks build and the core they
 # stand on: each mutant is a small change to one function, run against the tests that call it; the report says
 # how many the tests caught and lists every survivor, with why it cannot be caught or that a test is missing.
-# About 30 minutes here.  mutmut keeps its results in mutants/ and re-tests only functions whose code changed:
+# About 25 minutes here.  mutmut keeps its results in mutants/ and re-tests only functions whose code changed:
 # after adding tests, rm -rf mutants for a full run.
 mutate: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(VENV)/bin/mutmut run

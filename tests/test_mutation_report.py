@@ -1,0 +1,62 @@
+"""``make mutate``'s report: the score leaves out only the listed equivalent mutants, and the list is not stale."""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import inspect
+import tomllib
+
+import pytest
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.unit
+
+
+def load_report():
+    spec = importlib.util.spec_from_file_location("mutation_report", ROOT / "scripts" / "mutation_report.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_score_leaves_out_the_listed_equivalents_and_fails_on_an_unexplained_survivor(
+    tmp_path, monkeypatch, capsys
+):
+    report = load_report()
+    status = {f"pkg.mod.x_f__mutmut_{k}": "killed" for k in range(1, 19)}
+    status |= {"pkg.mod.xǁCǁg__mutmut_1": "timeout", "pkg.mod.xǁCǁg__mutmut_2": "survived"}
+    monkeypatch.setattr(report, "results", lambda: status)
+    monkeypatch.setattr(report, "EQUIVALENT", tmp_path / "none.toml")
+    assert report.main([]) == 1  # 19 of 20 caught is 95 %, but one survivor has no reason
+    out = capsys.readouterr().out
+    assert "20 mutants: 19 caught (95.0%); 0 equivalent" in out
+    assert "pkg.mod.xǁCǁg__mutmut_2 [survived]: no reason: a test is missing" in out
+    listed = tmp_path / "equivalent.toml"
+    listed.write_text('"pkg.mod.xǁCǁg__mutmut_2" = "behaves as the original"\n')
+    monkeypatch.setattr(report, "EQUIVALENT", listed)
+    assert report.main(["--write", str(tmp_path / "m.json")]) == 0
+    assert "score, equivalent ones left out: 100.0% (target 90%)" in capsys.readouterr().out
+    status["pkg.mod.x_f__mutmut_1"] = "survived"  # 18 of 19: 94.7 %, still over 90 %, but unexplained
+    assert report.main([]) == 1
+    assert report.module("tutorial.core.call_later.xǁMainLoopǁrun_once__mutmut_9") == "tutorial.core.call_later"
+    assert report.module("tutorial.controllers.tank_controller.x_track_velocities__mutmut_3") == (
+        "tutorial.controllers.tank_controller"
+    )
+
+
+def test_every_listed_equivalent_mutant_names_a_function_that_exists_and_says_why():
+    listed = tomllib.loads((ROOT / "tests" / "equivalent_mutants.toml").read_text())
+    assert listed
+    for name, why in listed.items():
+        head = name.split("__mutmut_")[0]
+        module_name, _, function = head.rpartition(".")
+        module = importlib.import_module(module_name)
+        if function.startswith("xǁ"):
+            _, cls, method = function.split("ǁ")
+            target = getattr(getattr(module, cls), method)
+        else:
+            target = getattr(module, function.removeprefix("x_"))
+        assert inspect.isfunction(target), name
+        assert len(why) > 20, name
