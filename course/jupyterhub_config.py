@@ -88,7 +88,7 @@ c.Spawner.start_timeout = 120
 c.Spawner.environment = {
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",  # a learner's nodes never look beyond this machine
     "PATH": f"{ENV_BIN}:/usr/local/bin:/usr/bin:/bin",  # rtt-* in the learner's terminals
-    # Live views draw at most this many frames a second (tutorial/app/frames.py; 60 on a learner's own
+    # Live views draw at most this many frames a second (tutorial/app/frame_clock.py; 60 on a learner's own
     # machine): each frame costs the server, and the book's Benchmarks page says how many learners it holds.
     "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
 }

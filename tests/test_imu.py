@@ -399,7 +399,7 @@ def recorded_arrows(visible_per_frame, fps=15.0):
 
 
 def test_a_recording_draws_the_arrows_and_animates_them_with_the_bodies():
-    from tutorial.view.overlays import arrow_poses
+    from tutorial.view.meshcat_overlays import arrow_poses
 
     _, commands = recorded_arrows([False, True, True, True])
     path = "/meshcat/rtt_overlays/Tank/acceleration"

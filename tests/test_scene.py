@@ -191,7 +191,7 @@ class CommandVisualizer(RecordingVisualizer):
 
 def tip_of(shaft, head):
     """Where an arrow drawn with these transforms ends: the cone's apex, and where its shaft starts."""
-    from tutorial.view.overlays import HEAD_LENGTH
+    from tutorial.view.meshcat_overlays import HEAD_LENGTH
 
     apex = head @ np.array([0.0, HEAD_LENGTH / 2, 0.0, 1.0])
     tail = shaft @ np.array([0.0, -0.5, 0.0, 1.0])  # the shaft is a unit cylinder along meshcat's Y
@@ -199,7 +199,7 @@ def tip_of(shaft, head):
 
 
 def test_an_arrow_is_drawn_from_its_origin_to_origin_plus_vector():
-    from tutorial.view.overlays import arrow_transforms
+    from tutorial.view.meshcat_overlays import arrow_transforms
 
     for origin, vector in [
         ((0, 0, 0.1), (0.3, 0.4, 0.0)),
@@ -215,7 +215,7 @@ def test_an_arrow_is_drawn_from_its_origin_to_origin_plus_vector():
 
 
 def test_overlays_send_only_changed_arrows_and_hide_without_moving():
-    from tutorial.view.overlays import MeshcatOverlays, Overlays
+    from tutorial.view.meshcat_overlays import MeshcatOverlays, Overlays
 
     overlays = Overlays()
     red = overlays.arrow("Tank/acceleration", (1.0, 0.2, 0.2))

@@ -54,7 +54,7 @@ import numpy as np
 from benchmarks.paths import ROOT
 from benchmarks.procs import py
 from benchmarks.stats import pct
-from tutorial.network.program import HostProgram
+from tutorial.network.host_program import HostProgram
 
 SIM_PROJECT = "benchmarks/projects/tank_net_sim.yaml"
 VIEW_PROJECT = "benchmarks/projects/tank_view.yaml"

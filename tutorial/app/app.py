@@ -22,7 +22,7 @@ from collections.abc import Callable
 import mujoco
 
 from tutorial.app.descriptions import DESCRIPTION_TIMEOUT, receive_descriptions
-from tutorial.app.frames import FRAME_RATE, FramePacer
+from tutorial.app.frame_clock import FRAME_RATE, FramePacer
 from tutorial.app.summary import app_summary
 from tutorial.core.body import Body
 from tutorial.core.controller import ControllerConfig
@@ -31,7 +31,7 @@ from tutorial.core.overlays import Overlays
 from tutorial.core.project import Project, check_parameter
 from tutorial.core.simulator import Attachment, Simulator
 from tutorial.core.world import build_world
-from tutorial.view.overlays import MeshcatOverlays
+from tutorial.view.meshcat_overlays import MeshcatOverlays
 
 DEFAULT_NODE_NAME = "rtt"
 GRAPH_CHECK_PERIOD = 2.0  # s, how often the node graph is checked for a twin name
@@ -248,7 +248,7 @@ class App:
         """Run posted calls, and draw a frame when there is something new to show (owner thread).
 
         Waits for posted calls at most ``timeout`` s, and never past the time
-        the next frame is due (:meth:`next_frame_due`, :mod:`tutorial.app.frames`).
+        the next frame is due (:meth:`next_frame_due`, :mod:`tutorial.app.frame_clock`).
 
         Returns:
             False when the app is done (duration reached, simulation ended or stop requested).

@@ -14,7 +14,7 @@ Foxglove open them.  One job per module:
 :mod:`tutorial.bag.recover`      :func:`recover`: a closed, indexed copy of a damaged or unclosed file
 :mod:`tutorial.bag.writer`       the MCAP file as rosbag2 lays it out; the write-through policy
 :mod:`tutorial.bag.qos`          ``offered_qos_profiles``: rosbag2's YAML and its QoS adaptations
-:mod:`tutorial.bag.tf`           :class:`TfRecording`: ``/tf``, ``/tf_static`` from descriptions and states
+:mod:`tutorial.bag.record_tf`           :class:`TfRecording`: ``/tf``, ``/tf_static`` from descriptions and states
 ===============================  ===========================================================
 
 The messages' full definitions come from :mod:`tutorial.interfaces.definitions`;

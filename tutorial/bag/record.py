@@ -76,7 +76,7 @@ class BagRecorder:
         output: called with each status line (default ``print``).
         tf: also record every body's robot description, odometry and joint
             states, and write ``/tf``, ``/tf_static`` and ``/robot_description``
-            computed from them (:mod:`tutorial.bag.tf`).
+            computed from them (:mod:`tutorial.bag.record_tf`).
         tf_frame_prefix: with ``tf``, put before every frame of a body;
             ``{body}`` in it is the body's name (``"{body}/"`` for several robots).
         write_through: the writer's policy (:class:`~tutorial.bag.writer.BagWriter`);
@@ -116,7 +116,7 @@ class BagRecorder:
         if not self.topics_wanted and not all_topics and not tf:
             raise ValueError("name the topics to record, or record all topics")
         if tf:
-            from tutorial.bag.tf import check_frame_prefix
+            from tutorial.bag.record_tf import check_frame_prefix
 
             check_frame_prefix(tf_frame_prefix)  # before the file is made
         self.all_topics = all_topics
@@ -125,7 +125,7 @@ class BagRecorder:
         self.path = self.writer.path
         self.tf = None
         if tf:  # the TF computation is its own module's; the recorder only feeds it
-            from tutorial.bag.tf import TfRecording
+            from tutorial.bag.record_tf import TfRecording
 
             self.tf = TfRecording(self.writer, self._say, tf_frame_prefix)
         self._given_node = node

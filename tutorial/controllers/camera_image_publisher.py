@@ -290,9 +290,8 @@ class RttCameraImagePublisher(SimpleController):
     def publish_compressed(self, pixels: np.ndarray, time_s: float) -> None:
         """Encode and publish the picture on ``.../compressed``, if anyone subscribes.
 
-        As image_transport does, nothing is encoded for nobody: a JPEG
-        costs under 1 ms here, a PNG about 3 ms, on this thread, never
-        the simulation's.  Only subscribed topics cross a link (DDS sends to
+        As image_transport does, nothing is encoded for nobody.  The
+        encoding runs on this thread, never the simulation's.  Only subscribed topics cross a link (DDS sends to
         matched readers only), so a remote viewer of the compressed topic
         never pulls the 230 kB raw pictures.
         """

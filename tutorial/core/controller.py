@@ -53,7 +53,7 @@ class ControllerConfig:
             as the program was asked); main thread only.
         log: a ``logging.Logger`` for the controller.
         overlays: arrows to draw over the App's 3D view (see
-            :mod:`tutorial.view.overlays`); main thread only.  Headless, they
+            :mod:`tutorial.view.meshcat_overlays`); main thread only.  Headless, they
             are numbers only.
     """
 

@@ -9,7 +9,7 @@ not talk to meshcat themselves.  A controller gets ``config.overlays`` in
 
 :meth:`Arrow.set` only stores numbers: nothing here knows meshcat.  The App
 draws the arrows that changed on its next frame
-(:class:`tutorial.view.overlays.MeshcatOverlays`); a headless App draws
+(:class:`tutorial.view.meshcat_overlays.MeshcatOverlays`); a headless App draws
 nothing, but the numbers are there all the same, so a status line or a test
 can read what would be drawn (:attr:`Arrow.length`, :attr:`Arrow.visible`).
 Everything here belongs to the main thread.

@@ -13,7 +13,7 @@ on the ``foxglove-sdk`` package's server:
 * the robot in 3D: from each body's robot description, odometry and joint
   states it computes ``/tf``, ``/tf_static`` and ``/robot_description``
   exactly as ``rtt-bag record --tf`` writes them (the same
-  :class:`tutorial.bag.tf.TfRecording`), and serves them as
+  :class:`tutorial.bag.record_tf.TfRecording`), and serves them as
   channels too.  Foxglove's 3D panel draws the URDF from
   ``/robot_description`` at the frames TF gives.
 
@@ -70,7 +70,7 @@ class _Listener:
 class _ChannelSink:
     """A :class:`tutorial.bag.writer.BagWriter` look-alike that logs to Foxglove channels (spin thread).
 
-    :class:`tutorial.bag.tf.TfRecording` writes through it: ``add_topic``
+    :class:`tutorial.bag.record_tf.TfRecording` writes through it: ``add_topic``
     advertises a channel, ``write`` logs a message (and keeps the newest of a
     latched topic).
     """
@@ -98,7 +98,7 @@ class FoxgloveBridge:
         output: called with each status line.
         tf_frame_prefix: put before every frame of a body on ``/tf`` and
             ``/tf_static``; ``{body}`` in it is the body's name
-            (:class:`tutorial.bag.tf.TfRecording`).
+            (:class:`tutorial.bag.record_tf.TfRecording`).
 
     Raises:
         RuntimeError: the server cannot listen there (the port is taken).
@@ -117,7 +117,7 @@ class FoxgloveBridge:
         output=print,
         tf_frame_prefix: str = "",
     ):
-        from tutorial.bag.tf import check_frame_prefix
+        from tutorial.bag.record_tf import check_frame_prefix
 
         self.tf_frame_prefix = check_frame_prefix(tf_frame_prefix)
         self.host, self.requested_port = host, port
@@ -144,7 +144,7 @@ class FoxgloveBridge:
         import foxglove
         import rclpy
 
-        from tutorial.bag.tf import TfRecording
+        from tutorial.bag.record_tf import TfRecording
         from tutorial.ros.spin import SpinThread
 
         self.context = foxglove.Context()

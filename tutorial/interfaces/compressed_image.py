@@ -19,15 +19,14 @@ Foxglove decode our pictures; ``data`` holds the JPEG or PNG file, whole.
 * PNG: lossless (every pixel exact), ten times bigger and slower to make.
   For pictures that are measured.
 
-**The encoder** is Pillow, which bundles libjpeg-turbo (and zlib).  Against
-simplejpeg (another libjpeg-turbo binding) on this tutorial's 320 x 240
-pictures, both at 4:2:0 chroma subsampling: encoding a JPEG took 0.19 ms
-with Pillow and 0.13 ms with simplejpeg, decoding it 0.34 and 0.10 ms; a
-picture takes 4 to 30 ms to *render*, so either is lost in that.  Pillow
-also writes PNG (2.6 ms at compression level 1), is already installed
-(matplotlib needs it) and is one of Python's best-kept libraries: Pillow it
-is.  (PyTurboJPEG needs the system's libjpeg-turbo 3, which Debian 12 does
-not have.)  ``python -m benchmarks.experiments.network --encoders`` measures it again.
+**The encoder** is Pillow, which bundles libjpeg-turbo (and zlib).
+simplejpeg (another libjpeg-turbo binding) encodes and decodes this
+tutorial's pictures a little faster, but the difference is lost in the time
+a picture takes to *render* (``benchmarks/RESULTS.md``, *Choices measured*).
+Pillow also writes PNG, is already installed (matplotlib needs it) and is
+one of Python's best-kept libraries: Pillow it is.  (PyTurboJPEG needs the
+system's libjpeg-turbo 3, which Debian 12 does not have.)
+``python -m benchmarks.experiments.network --encoders`` measures them.
 
 **Sharing a thin link with the joint states.**  A raw 320 x 240 rgb8 picture
 is 230 400 bytes: 55 Mbit/s at 30 Hz, ten times a 5 Mbit/s link; the link's
@@ -44,9 +43,9 @@ measured by ``python -m benchmarks.experiments.network``:
    ``8 x bytes / bandwidth``: a 4 kB JPEG on 5 Mbit/s, 6.4 ms, the longest
    a joint state queues behind it; ``quality`` and ``rate`` set the
    camera's share (3 to 4 kB a picture at quality 80: 0.7 to 1 Mbit/s at
-   30 Hz).  Measured on 5 Mbit/s with this camera on: joint-state age p99
-   5.9 ms at the remote monitor, against 4.3 ms on the clean link (and
-   55 ms at the median with the raw camera subscribed instead).
+   30 Hz).  The joint states' age at a remote monitor on 5 Mbit/s, with
+   this camera and with the raw one, is on the Benchmarks page, *Across
+   hosts*.
 3. *Best effort, keep last 1* (:func:`compressed_image_qos`): a picture
    that is lost is never sent again, and none waits in a queue behind a
    newer one; a reliable picture topic would resend lost fragments into

@@ -4,7 +4,7 @@ JointState says how the body's joints are set; it does not say where the
 body is.  The odometry does: the pose of the body's URDF root link (the
 tank's ``CHASSIS``) in the world, and its velocity, stamped with simulation
 time.  With the joint states and the robot description it is all a TF tree
-needs (:mod:`tutorial.bag.tf`).
+needs (:mod:`tutorial.bag.record_tf`).
 
 Frames and units (REP 103, REP 105):
 

@@ -162,8 +162,8 @@ def record_replay(
         camera: optional ``(position, target)`` for the initial view, m.
         root: the meshcat path everything is drawn under.
         animate: False draws the first frame only.
-        overlays: optional :class:`tutorial.view.overlays.Overlays` whose arrows to draw too,
-            as ``overlay_frames`` says: one :meth:`~tutorial.view.overlays.Overlays.snapshot`
+        overlays: optional :class:`tutorial.view.meshcat_overlays.Overlays` whose arrows to draw too,
+            as ``overlay_frames`` says: one :meth:`~tutorial.view.meshcat_overlays.Overlays.snapshot`
             per frame (the arrows of a run are not in ``qpos``).
 
     Raises:
@@ -188,7 +188,7 @@ def record_replay(
     if camera is not None:
         scene.set_camera(*camera)
     if overlays is not None:
-        from tutorial.view.overlays import draw_arrow_snapshot
+        from tutorial.view.meshcat_overlays import draw_arrow_snapshot
 
         draw_arrow_snapshot(vis, overlays, overlay_frames[0])
     if not animate or len(frames) < 2:
@@ -211,7 +211,7 @@ def record_replay(
             clip.set_property(int(frame), "quaternion", "quaternion", poses[frame, k, 3:].tolist())
         animation.clips[vis[scene.body_path(body)].path] = clip
     if overlays is not None:
-        from tutorial.view.overlays import add_arrow_clips
+        from tutorial.view.meshcat_overlays import add_arrow_clips
 
         add_arrow_clips(vis, overlays, overlay_frames, animation, fps, decimals=DECIMALS)
     vis.set_animation(animation, play=True, repetitions=np.inf)

@@ -11,8 +11,8 @@ instead of failing.  Main thread (the notebook's) only.
 
 from __future__ import annotations
 
+from tutorial.network.host_program import HostProgram, python
 from tutorial.network.hosts import Host, Network, why_unavailable
-from tutorial.network.program import HostProgram, python
 
 
 class TwoHosts:

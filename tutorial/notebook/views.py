@@ -73,7 +73,7 @@ class LiveView:
         Args:
             model: the run's ``MjModel``.
             camera: ``(position, target)`` the run placed its camera at, m, for the recording.
-            overlays: the run's :class:`tutorial.view.overlays.Overlays` (arrows its controllers
+            overlays: the run's :class:`tutorial.view.meshcat_overlays.Overlays` (arrows its controllers
                 draw), recorded with each frame; None when it has none.
         """
         with self._lock:

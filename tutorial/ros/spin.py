@@ -31,9 +31,9 @@ def make_executor(context):
     and ``create_task()`` hang when called from another thread while it
     spins (``SpinThread`` never does that).  It is not kept out for losing
     messages: reading one stream at the same time, the two executors missed
-    about the same messages (``python -m benchmarks.delivery``), although a
-    CI run once lost one of 10 messages sent 250 ms apart with it (cause
-    not found).  ``RTT_EXECUTOR=events`` selects it, for measuring.
+    about the same messages (``python -m benchmarks.delivery``; what it
+    found is in ``benchmarks/RESULTS.md``, *Tried, measured, not kept*).
+    ``RTT_EXECUTOR=events`` selects it, for measuring.
 
     Args:
         context: the ``rclpy.context.Context`` of the node(s) to spin.

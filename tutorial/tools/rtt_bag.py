@@ -43,7 +43,7 @@ _say = functools.partial(print, flush=True)
 
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``rtt-bag`` (ROS arguments are removed before it parses)."""
-    from tutorial.bag.tf import add_frame_prefix_argument
+    from tutorial.bag.record_tf import add_frame_prefix_argument
 
     p = argparse.ArgumentParser(
         prog=PROG,

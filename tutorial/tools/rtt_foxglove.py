@@ -32,7 +32,7 @@ def main(argv: list[str] | None = None) -> int:
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
-    from tutorial.bag.tf import add_frame_prefix_argument
+    from tutorial.bag.record_tf import add_frame_prefix_argument
     from tutorial.foxglove.bridge import DEFAULT_HOST, DEFAULT_PORT, NODE_NAME, FoxgloveBridge
 
     argv = list(sys.argv if argv is None else argv)

@@ -8,7 +8,7 @@ show it from TF.  One job per module:
                                    written with ``yourdfpy``; what it maps and what it cannot
 :mod:`tutorial.urdf.kinematics`    a URDF's joints as transforms, as ``robot_state_publisher``
                                    computes them: fixed ones once, moving ones from a JointState
-:mod:`tutorial.bag.tf`     ``rtt-bag record --tf``: ``/tf``, ``/tf_static`` and
+:mod:`tutorial.bag.record_tf`     ``rtt-bag record --tf``: ``/tf``, ``/tf_static`` and
                                    ``/robot_description`` computed while recording
 :mod:`tutorial.urdf.mujoco_load`   a URDF (a robot description received over ROS) as a MuJoCo model
 =================================  ===============================================================

@@ -1,7 +1,7 @@
 """What a live view still owes the browser, and when it may send it: coalescing and flow control.
 
 A run draws a frame whenever its model moves (up to the frame rate of
-:mod:`tutorial.app.frames`); a browser draws at most one frame per
+:mod:`tutorial.app.frame_clock`); a browser draws at most one frame per
 animation frame of its own, and less on a slow machine or a slow link.
 :class:`FrameFlow` sits between the two:
 

@@ -6,9 +6,9 @@ import time
 
 import pytest
 
-import tutorial.app.frames as frames_module
+import tutorial.app.frame_clock as frames_module
 from tutorial.app.app import App
-from tutorial.app.frames import FRAME_RATE
+from tutorial.app.frame_clock import FRAME_RATE
 from tutorial.core.project import load_project
 
 from conftest import MODEL
@@ -139,7 +139,7 @@ def test_complete_bursts_back_to_back_are_drawn_at_most_frame_rate_times_a_secon
 @pytest.mark.unit
 def test_the_frame_rate_comes_from_the_environment_or_a_clear_error():
     """A class's server sets RTT_FRAME_RATE (course/jupyterhub_config.py); a learner's machine keeps 60."""
-    from tutorial.app.frames import frame_rate
+    from tutorial.app.frame_clock import frame_rate
 
     assert frame_rate(None) == 60.0 and frame_rate(" ") == 60.0
     assert frame_rate("20") == 20.0 and frame_rate("1") == 1.0 and frame_rate("240") == 240.0
@@ -155,7 +155,7 @@ def test_a_class_server_s_frame_rate_paces_the_views(tmp_path):
     import sys
 
     code = (
-        "from tutorial.app.frames import FRAME_RATE, FramePacer\n"
+        "from tutorial.app.frame_clock import FRAME_RATE, FramePacer\n"
         "p = FramePacer(); n = 0; now = 0.0\n"  # one second of the frame clock, each frame drawn when due
         "while True:\n"
         "    now = p.next_frame_due(True, [])\n"

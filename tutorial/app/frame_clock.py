@@ -76,7 +76,8 @@ class FramePacer:
         of changes is still drawn.  Never before the frame clock allows
         (``1/FRAME_RATE`` s per frame on average, see :meth:`drawn`).  A frame
         drawn at a fixed 60 Hz, whatever came, showed a state that arrived
-        just after a frame 16.7 ms late (the book's Benchmarks page).
+        just after a frame a whole frame late (``benchmarks/RESULTS.md``,
+        *What closed the gaps*).
         """
         cap = self.last_frame + 1.0 / FRAME_RATE
         if simulating:
