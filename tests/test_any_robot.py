@@ -127,25 +127,43 @@ def test_a_mesh_that_cannot_be_found_or_read_leaves_out_only_its_visual(tmp_path
     truncated = tmp_path / "cut.stl"
     truncated.write_bytes((ROBOTS / "so_arm_description" / "meshes" / "so100" / "Base.stl").read_bytes()[:300])
     good = ROBOTS / "so_arm_description" / "meshes" / "so100" / "Base.stl"
+    foreign = tmp_path / "picture.stl"  # a file of the wrong format under a mesh's name
+    foreign.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)
+    foreign_dae = tmp_path / "picture.dae"
+    foreign_dae.write_bytes(foreign.read_bytes())
+    # a real description's other tags: ros2_control and Gazebo's are for other programs, not for drawing
     urdf = f"""<robot name="r">
   <link name="a"><visual><geometry><mesh filename="package://nowhere/meshes/a.stl"/></geometry></visual></link>
   <link name="b"><visual><geometry><mesh filename="file://{broken}"/></geometry></visual></link>
   <link name="c"><visual><geometry><mesh filename="file://{truncated}"/></geometry></visual></link>
   <link name="d"><visual><geometry><mesh filename="file://{good}"/></geometry></visual></link>
+  <link name="e"><visual><geometry><mesh filename="file://{foreign}"/></geometry></visual></link>
+  <link name="f"><visual><geometry><mesh filename="file://{foreign_dae}"/></geometry></visual></link>
   <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
   <joint name="bc" type="fixed"><parent link="b"/><child link="c"/></joint>
   <joint name="cd" type="fixed"><parent link="c"/><child link="d"/></joint>
+  <joint name="de" type="fixed"><parent link="d"/><child link="e"/></joint>
+  <joint name="ef" type="fixed"><parent link="e"/><child link="f"/></joint>
+  <ros2_control name="r" type="system">
+    <hardware><plugin>mock_components/GenericSystem</plugin></hardware>
+    <joint name="de"><command_interface name="position"/></joint>
+  </ros2_control>
+  <gazebo reference="d"><material>Gazebo/Grey</material><mu1>0.2</mu1></gazebo>
+  <gazebo><plugin name="control" filename="libgz_ros2_control-system.so"/></gazebo>
 </robot>"""
     text, left_out = mujoco_text(urdf, environ={"AMENT_PREFIX_PATH": str(tmp_path / "ros")})
-    assert len(left_out) == 3 and all("\n" not in line for line in left_out)
+    assert len(left_out) == 5 and all("\n" not in line for line in left_out), left_out
     assert left_out[0].startswith("link a: visual left out: package://nowhere/meshes/a.stl: not found (looked in ")
     assert str(tmp_path / "ros" / "share" / "nowhere") in left_out[0]
     assert left_out[1].startswith("link b: visual left out:") and "broken.dae" in left_out[1]
     assert left_out[2].startswith("link c: visual left out:") and "cut.stl" in left_out[2]
+    assert left_out[3].startswith("link e: visual left out:") and "picture.stl" in left_out[3]
+    assert left_out[4].startswith("link f: visual left out:") and "picture.dae" in left_out[4]
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(text)
     assert model.nmesh == 1 and model.ngeom == 1  # link d still drawn
+    assert "ros2_control" not in text and "gazebo" not in text.lower() and "plugin" not in text
 
 
 def test_package_uris_are_found_as_ros_finds_them(tmp_path):

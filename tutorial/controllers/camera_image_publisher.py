@@ -291,9 +291,10 @@ class RttCameraImagePublisher(SimpleController):
         """Encode and publish the picture on ``.../compressed``, if anyone subscribes.
 
         As image_transport does, nothing is encoded for nobody.  The
-        encoding runs on this thread, never the simulation's.  Only subscribed topics cross a link (DDS sends to
-        matched readers only), so a remote viewer of the compressed topic
-        never pulls the 230 kB raw pictures.
+        encoding runs on this thread, never the simulation's.  Only
+        subscribed topics cross a link (DDS sends to matched readers
+        only), so a remote viewer of the compressed topic never pulls the
+        230 kB raw pictures.
         """
         if self.compressed_publisher.get_subscription_count() == 0:
             return
