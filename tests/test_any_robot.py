@@ -6,7 +6,8 @@ SO-100 arm (STL), each published on ``/<name>/robot_description`` with its
 ``package://`` URIs as shipped, ``AMENT_PREFIX_PATH`` naming the package's
 prefix, and a sine JointState on ``/<name>/joint_state``.  The monitor must
 draw every visual, end on the publisher's final positions, and put every
-link where ``yourdfpy``'s forward kinematics puts it.
+link where ``yourdfpy``'s forward kinematics puts it.  A fourth, Unitree's
+Go2, floats: its root link follows ``/Go2/odom``.
 """
 
 from __future__ import annotations
@@ -238,3 +239,118 @@ def test_the_panda_is_drawn_with_its_collada_meshes(ros, node, tmp_path, monkeyp
         finally:
             app.close()
     assert counts["meshes"] > 1000 and counts["no meshes"] < 500, counts
+
+
+def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, monkeypatch):
+    """Unitree's Go2 (Collada visuals, a floating base): the root link follows /Go2/odom, refused poses are counted.
+
+    Each link must land where the odometry's pose times ``yourdfpy``'s forward
+    kinematics puts it; a pose with a NaN, another child frame or a zero
+    quaternion must leave the robot where it was.
+    """
+    import mujoco
+    import yourdfpy
+    from nav_msgs.msg import Odometry
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import String
+
+    from tutorial.app.app import App
+    from tutorial.core.project import load_project
+    from tutorial.interfaces.joint_state import joint_state_qos
+
+    monkeypatch.setenv("AMENT_PREFIX_PATH", str(PREFIX))
+    monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))
+    path = ROBOTS / "go2_description" / "urdf" / "go2.urdf"
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
+    node.create_publisher(String, "/Go2/robot_description", latched).publish(String(data=path.read_text()))
+    states = node.create_publisher(JointState, "/Go2/joint_state", joint_state_qos())
+    odometry = node.create_publisher(Odometry, "/Go2/odom", joint_state_qos())
+    (tmp_path / "go2.yaml").write_text(
+        "name: go2\nmodels:\n  - name: Go2\n    description: /Go2/robot_description\n    odometry: /Go2/odom\n"
+        "    controllers:\n      - name: RttJointStateMonitor\n"
+        "        class: tutorial.controllers.joint_state_subscriber:RttJointStateMonitor\n"
+    )
+    robot = yourdfpy.URDF.load(str(path), load_meshes=False, build_collision_scene_graph=False)
+    moving = list(robot.actuated_joint_names)
+    records = []
+    app = App(load_project(tmp_path / "go2.yaml"), node_name="monitor_go2", headless=True, output=records.append)
+    try:
+        app.open()
+        assert [r for r in records if r.get("event") == "warning"] == []
+        body, base = app.bodies["Go2"], app.controller("Go2/floating_base")
+        assert base.root_link == robot.base_link == "base"
+        app.loop.run_until(lambda: odometry.get_subscription_count() > 0, timeout=10)
+
+        def pose(x, y, z, q, child="base"):
+            msg = Odometry()
+            msg.header.frame_id, msg.child_frame_id = "odom", child
+            p, o = msg.pose.pose.position, msg.pose.pose.orientation
+            p.x, p.y, p.z = x, y, z
+            o.w, o.x, o.y, o.z = q
+            return msg
+
+        def handled():
+            return base.applied + sum(base.rejected.values())
+
+        yaw, roll = 0.7, 0.1  # a turn and a lean: w x y z of Rz(yaw) Rx(roll)
+        q = (
+            math.cos(yaw / 2) * math.cos(roll / 2),
+            math.cos(yaw / 2) * math.sin(roll / 2),
+            math.sin(yaw / 2) * math.sin(roll / 2),
+            math.sin(yaw / 2) * math.cos(roll / 2),
+        )
+        good = (1.5, -0.5, 0.3)
+        for msg in (
+            pose(*good, q=tuple(1.004 * c for c in q)),  # a little off unit: renormalised
+            pose(float("nan"), 0.0, 0.3, q),
+            pose(9.0, 9.0, 9.0, q, child="odom_base"),
+            pose(9.0, 9.0, 9.0, (0.0, 0.0, 0.0, 0.0)),
+            pose(9.0, 9.0, 9.0, (2.0, 0.0, 0.0, 0.0)),
+        ):
+            before = handled()
+            odometry.publish(msg)
+            app.loop.run_until(lambda before=before: handled() > before, timeout=10)
+        assert base.applied == 1
+        assert base.rejected == {"not_finite": 1, "wrong_frame": 1, "not_a_unit_quaternion": 2}
+        warned = [r["message"] for r in records if r.get("event") == "warning"]
+        assert len(warned) == 3 and "'odom_base'" in warned[1], warned  # once per reason, naming the frame
+
+        final = {}  # inside each joint's limits (yourdfpy would clamp a position outside them)
+        for j, n in enumerate(moving):
+            limit = robot.joint_map[n].limit
+            final[n] = limit.lower + (limit.upper - limit.lower) * (0.5 + 0.4 * math.sin(j + 1.0))
+        states.publish(JointState(name=moving, position=list(final.values())))
+        app.loop.run_until(lambda: all(abs(body.joint(n).q - final[n]) <= 1e-9 for n in moving), timeout=30)
+
+        root = np.eye(4)
+        rotation = np.zeros(9)
+        mujoco.mju_quat2Mat(rotation, np.array(q) / np.linalg.norm(q))
+        root[:3, :3], root[:3, 3] = rotation.reshape(3, 3), good
+        robot.update_cfg(final)
+        for link in robot.robot.links:
+            b = mujoco.mj_name2id(app.model, mujoco.mjtObj.mjOBJ_BODY, f"Go2/{link.name}")
+            assert b >= 0, f"no body for link {link.name}"
+            expected = root @ robot.get_transform(link.name, robot.base_link)
+            assert np.abs(app.data.xpos[b] - expected[:3, 3]).max() <= 1e-6, link.name
+            assert np.abs(app.data.xmat[b].reshape(3, 3) - expected[:3, :3]).max() <= 1e-6, link.name
+        summary = base.summary()
+        assert summary["position"] == list(good) and summary["applied"] == 1
+        assert np.allclose(summary["orientation_wxyz"], q, atol=1e-9)  # renormalised, w first
+    finally:
+        app.close()
+
+
+def test_odometry_needs_a_root_free_of_the_world(tmp_path):
+    """A root already floating keeps its free joint; one on a hinge cannot take a pose, and says so."""
+    from tutorial.core.world import ModelEntry, ModelError, build_world
+
+    floating = "<mujoco><worldbody><body name='base'><freejoint/><geom size='.1'/></body></worldbody></mujoco>"
+    hinged = "<mujoco><worldbody><body name='base'><joint type='hinge'/><geom size='.1'/></body></worldbody></mujoco>"
+    welded = "<mujoco><worldbody><body name='base'><geom size='.1'/></body></worldbody></mujoco>"
+    for text, joints in ((floating, 1), (welded, 1)):
+        model = build_world([ModelEntry("R", None, text=text, odometry="/R/odom")])
+        assert model.njnt == joints and model.jnt_type[0] == 0  # one free joint, whichever way it came
+    assert build_world([ModelEntry("R", None, text=welded)]).njnt == 0  # without odometry: welded, as it was
+    with pytest.raises(ModelError, match="its root link base moves on 1 other joint"):
+        build_world([ModelEntry("R", None, text=hinged, odometry="/R/odom")])

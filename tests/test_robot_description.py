@@ -41,6 +41,17 @@ models:
             "simulator:\n  time_step: 0.001",
             "models[0].description: a simulated model needs a model file",
         ),
+        (
+            "    description: /Tank/robot_description\n    odometry: Tank/odom",
+            "",
+            "models[0].odometry: expected a topic",
+        ),
+        ("    description: /Tank/robot_description\n    odometry: [1]", "", "models[0].odometry: expected a topic"),
+        (
+            f"    file: {PROJECT.parent / 'model' / 'tank.xml'}\n    odometry: /Tank/odom",
+            "simulator:\n  time_step: 0.001",
+            "models[0].odometry: a simulated model's root moves by its physics",
+        ),
     ],
 )
 def test_a_project_names_a_description_topic_or_says_what_is_wrong(tmp_path, model, simulator, says):
@@ -96,7 +107,8 @@ def test_a_viewer_with_no_description_to_read_says_so(ros, tmp_path):
 
 def test_the_step3_monitor_draws_the_published_description(procs):
     """rtt-run step3_description.yaml beside a Step 2 simulation: the monitor takes its model from
-    /Tank/robot_description, says so, and mirrors the simulation's final joint state by name."""
+    /Tank/robot_description, says so, mirrors the simulation's final joint state by name, and stands where
+    /Tank/odom puts it."""
     sim = procs(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json"))
     view = procs(
         module_command(
@@ -115,13 +127,18 @@ def test_the_step3_monitor_draws_the_published_description(procs):
     view.wait_for_line(lambda line: '"event": "first_state"' in line, timeout=30)
     sim.p.send_signal(signal.SIGINT)
     assert sim.wait(30) == 0, sim.err
-    final = sim.summary()["bodies"]["Tank"]["joint_positions"]
+    final = sim.summary()["bodies"]["Tank"]
     view.wait_for_line(lambda line: '"event": "stale"' in line, timeout=30)  # silent since the sim ended
     view.p.send_signal(signal.SIGINT)
     assert view.wait(30) == 0, view.err
     shown = view.summary()["controllers"]["RttJointStateMonitor"]
     assert shown["rejected"] == {}
-    assert shown["last_positions"] == pytest.approx(final, abs=1e-9)
+    assert shown["last_positions"] == pytest.approx(final["joint_positions"], abs=1e-9)
+    # the root link follows /Tank/odom: the tank stands where the simulation left it
+    assert view.summary()["controllers"]["Tank/floating_base"]["rejected"] == {}
+    where = view.summary()["bodies"]["Tank"]
+    assert where["root_position"] == pytest.approx(final["root_position"], abs=1e-6)
+    assert where["root_yaw"] == pytest.approx(final["root_yaw"], abs=1e-6)
 
 
 @pytest.mark.unit

@@ -142,6 +142,10 @@ class App:
         for entry in self.project.models:
             for c in entry.controllers:
                 self._configure_instance(entry.name, c.name, c.cls(), self._ros_parameters(c))
+            if entry.odometry is not None:  # its root link placed where the robot's odometry says
+                from tutorial.app.floating_base import FloatingBase
+
+                self._configure_instance(entry.name, f"{entry.name}/floating_base", FloatingBase(entry.odometry), {})
         self.node_fqn = self.node.get_fully_qualified_name()
         if self.spin is not None:
             self.spin.start()

@@ -21,7 +21,10 @@ loads its models and configures their controllers (Step 3's viewer).  Such a
 viewer project may name a robot-description topic instead of a model file
 (``description: /Tank/robot_description``): the model is then the URDF the
 simulation publishes there (:mod:`tutorial.interfaces.robot_description`),
-received when the project is opened.
+received when the project is opened.  A model of a viewer project may also
+name an odometry topic (``odometry: /Go2/odom``): its root link then floats,
+placed where the robot's ``nav_msgs/Odometry`` says
+(:mod:`tutorial.app.floating_base`).
 
 Every mistake raises one :class:`ProjectError` naming the file and the key,
 e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``,
@@ -270,7 +273,15 @@ def load_project(path: str | Path) -> Project:
         r.mapping(
             m,
             key,
-            {"name": True, "file": False, "description": False, "position": False, "yaw": False, "controllers": False},
+            {
+                "name": True,
+                "file": False,
+                "description": False,
+                "odometry": False,
+                "position": False,
+                "yaw": False,
+                "controllers": False,
+            },
         )
         mname = r.name(m["name"], f"{key}.name")
         if mname in seen:
@@ -298,12 +309,16 @@ def load_project(path: str | Path) -> Project:
                 raise r.fail(f"{key}.file", f"not a usable path: {_brief(m['file'])} ({exc})") from None
             if not found:
                 raise r.fail(f"{key}.file", f"no such model file: {mfile}")
+        odometry = m.get("odometry")
+        if odometry is not None and (not isinstance(odometry, str) or not TOPIC_PATTERN.match(odometry)):
+            raise r.fail(f"{key}.odometry", f"expected a topic name like /{mname}/odom, got {_brief(odometry)}")
         entry = ModelEntry(
             name=mname,
             file=mfile,
             position=r.vector(m.get("position", [0, 0, 0]), f"{key}.position", 3),
             yaw=r.number(m.get("yaw", 0.0), f"{key}.yaw"),
             description=description,
+            odometry=odometry,
         )
         controllers = m.get("controllers", [])
         if not isinstance(controllers, list):
@@ -338,6 +353,12 @@ def load_project(path: str | Path) -> Project:
                     f"models[{i}].description",
                     "a simulated model needs a model file (physics: masses, contacts, actuators); "
                     "a robot-description topic is for a viewer project (no simulator)",
+                )
+            if m.odometry is not None:
+                raise r.fail(
+                    f"models[{i}].odometry",
+                    "a simulated model's root moves by its physics; an odometry topic to follow is for a viewer "
+                    "project (no simulator)",
                 )
     return Project(path=path, name=name, models=models, simulator=simulator)
 

@@ -70,6 +70,9 @@ class ModelEntry:
             of a file (a viewer project); whoever receives it sets ``text``.
         text: the model as text (MJCF, or URDF prepared by
             :func:`tutorial.urdf.mujoco_load.mujoco_text`), used instead of ``file``.
+        odometry: an odometry topic a viewer places the model's root link by
+            (:mod:`tutorial.app.floating_base`); the root then gets a free
+            joint if it has none, so it can be placed anywhere.
     """
 
     name: str
@@ -79,6 +82,7 @@ class ModelEntry:
     controllers: list = field(default_factory=list)
     description: str | None = None
     text: str | None = None
+    odometry: str | None = None
 
 
 def build_world(
@@ -145,8 +149,38 @@ def build_world(
 
 
 def _load(entry: ModelEntry) -> mujoco.MjSpec:
-    """The model parsed (its file, or its text), its unnamed elements named; :class:`ModelError` if MuJoCo cannot
-    read it, or a description-only entry's text has not been received."""
+    """The model parsed (its file, or its text), its unnamed elements named, its root floating if it follows
+    odometry; :class:`ModelError` if MuJoCo cannot read it, or a description-only entry's text has not been
+    received."""
+    child = _parse(entry)
+    if entry.odometry is not None:
+        _float_root(child, entry)
+    return child
+
+
+def _float_root(spec: mujoco.MjSpec, entry: ModelEntry) -> None:
+    """Give the model's root link a free joint, if it has none, so odometry can place it (in place).
+
+    A URDF's root link is welded to the world when MuJoCo reads it; a model
+    file's root may already float (the tank's has a free joint).  A root that
+    moves on other joints (a hinge to the world) cannot take a pose.
+    """
+    root = spec.worldbody.first_body()
+    if root is None:
+        raise ModelError(f"model {entry.name}: follows {entry.odometry}, but has no link to place", entry)
+    joints = list(root.joints)
+    if any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in joints):
+        return
+    if joints:
+        raise ModelError(
+            f"model {entry.name}: follows {entry.odometry}, but its root link {root.name} moves on "
+            f"{len(joints)} other joint(s): an odometry pose needs a root free of the world",
+            entry,
+        )
+    root.add_freejoint(name="floating_base")
+
+
+def _parse(entry: ModelEntry) -> mujoco.MjSpec:
     if entry.text is not None:
         try:
             child = mujoco.MjSpec.from_string(entry.text)

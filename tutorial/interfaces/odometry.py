@@ -21,7 +21,8 @@ Frames and units (REP 103, REP 105):
   y left, z up for the tank);
 * covariances: all 0 (exact: the simulation knows its state).
 
-Topic :func:`odometry_topic`; QoS :func:`odometry_qos`.
+Topic :func:`odometry_topic`; QoS :func:`odometry_qos`.  A viewer reads the
+root link's pose from a received message with :func:`read_root_pose`.
 """
 
 from __future__ import annotations
@@ -115,3 +116,39 @@ def fill_odometry(msg, stamp: tuple[int, int], child_frame: str, motion) -> None
     v, a = msg.twist.twist.linear, msg.twist.twist.angular
     v.x, v.y, v.z = (float(c) for c in linear)
     a.x, a.y, a.z = (float(c) for c in angular)
+
+
+REJECTIONS = ("wrong_frame", "not_finite", "not_a_unit_quaternion")
+QUATERNION_TOLERANCE = 0.01  # how far |q| may be from 1 before a pose is refused, not renormalised
+
+
+def read_root_pose(msg, root_link: str) -> tuple[np.ndarray, np.ndarray] | str:
+    """The root link's pose a received ``nav_msgs/Odometry`` gives, or why it gives none.
+
+    Received data is never trusted: a viewer places the robot only by a pose
+    that is one.
+
+    Args:
+        msg: the message (any object with its fields).
+        root_link: the name of the model's root link (``CHASSIS``, ``base``).
+
+    Returns:
+        ``(position (3,) m, quaternion (4,) w x y z of norm 1)``, the pose of
+        the root link in the odometry's frame; or one of :data:`REJECTIONS`:
+        ``wrong_frame`` (``child_frame_id`` names another frame than the root
+        link; an empty one is taken as the root link), ``not_finite`` (a NaN
+        or an infinity in the pose), ``not_a_unit_quaternion`` (its norm is
+        more than :data:`QUATERNION_TOLERANCE` from 1; a pose a little off
+        is renormalised).  The twist is not read.  Any thread.
+    """
+    if msg.child_frame_id not in ("", root_link):
+        return "wrong_frame"
+    p, o = msg.pose.pose.position, msg.pose.pose.orientation
+    position = np.array([p.x, p.y, p.z], dtype=float)
+    quat = np.array([o.w, o.x, o.y, o.z], dtype=float)  # MuJoCo's order: w first
+    if not (np.isfinite(position).all() and np.isfinite(quat).all()):
+        return "not_finite"
+    norm = float(np.linalg.norm(quat))
+    if abs(norm - 1.0) > QUATERNION_TOLERANCE:
+        return "not_a_unit_quaternion"
+    return position, quat / norm
