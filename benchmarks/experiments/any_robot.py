@@ -1,6 +1,6 @@
 """A real robot's description to its first drawn frame: the Panda (Collada meshes), cold and cached.
 
-    python -m benchmarks.experiments.any_robot [--repeats 3]
+    python -m benchmarks.experiments.any_robot [--repeats 3]   (each repeat a fresh process)
 
 A publisher keeps the Franka Panda's description (``example-robot-data``,
 ``package://`` URIs as shipped) on ``/Panda/robot_description``; a monitor
@@ -8,7 +8,8 @@ A publisher keeps the Franka Panda's description (``example-robot-data``,
 runs it) opens on it and draws its first frame.  The figure is from the
 description's arrival to the end of that frame: the meshes found, the
 Collada files converted to STL (cold: an empty cache) or read from the
-cache (warm), the MuJoCo model compiled, and the scene sent to meshcat.
+cache (warm), the MuJoCo model compiled, and the scene sent to meshcat;
+beside it, the same from the App's start (node, discovery, reception).
 """
 
 from __future__ import annotations
@@ -27,28 +28,53 @@ PREFIX = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix"
 PANDA = PREFIX / "share" / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
 
 
-def first_frame_s(project: Path) -> float:
-    """Seconds from the App's start (the description is already kept for it) to its first frame drawn."""
+def first_frame_s(project: Path) -> tuple[float, float]:
+    """``(seconds from the description's arrival, seconds from the App's start)`` to its first frame drawn.
+
+    The description is already kept for the monitor (transient local): from
+    the App's start, the time also holds the node's creation and its
+    discovery of the publisher.  The arrival is when
+    ``receive_robot_description`` returns the URDF it received.
+    """
+    import tutorial.interfaces.robot_description as descriptions
     from tutorial.app.app import App
     from tutorial.core.project import load_project
 
+    arrived = []
+    receive = descriptions.receive_robot_description
+
+    def timed(*args, **kwargs):
+        urdf = receive(*args, **kwargs)
+        arrived.append(time.perf_counter())
+        return urdf
+
     records = []
+    descriptions.receive_robot_description = timed  # the App imports it when it opens: it finds this one
     t0 = time.perf_counter()
     app = App(load_project(project), node_name="any_robot_monitor", output=records.append)
     try:
         app.open()
         app._draw()  # the first frame: the scene as built, drawn once
-        return time.perf_counter() - t0
+        t1 = time.perf_counter()
+        return t1 - arrived[0], t1 - t0
     finally:
+        descriptions.receive_robot_description = receive
         app.close()
 
 
-def measure(repeats: int = 3) -> dict:
+def one_process(cache: Path) -> dict:
+    """One monitor's first frame, cold then warm, in this process: ``{"cold": (arrival, start), "warm": ...}``.
+
+    Cold is the first in a fresh process with an empty ``cache``: it also
+    imports the mesh readers (trimesh, pycollada), as a learner's first view
+    does.  Warm is the next, with the conversions cached.
+    """
     import rclpy
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from std_msgs.msg import String
 
     os.environ["AMENT_PREFIX_PATH"] = str(PREFIX)
+    os.environ["RTT_MESH_CACHE"] = str(cache)
     rclpy.init()
     node = rclpy.create_node("any_robot_description")
     latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
@@ -56,31 +82,65 @@ def measure(repeats: int = 3) -> dict:
     from tutorial.ros.spin import SpinThread
 
     spin = SpinThread(node).start()  # serves the kept description
-    cold, warm = [], []
-    with tempfile.TemporaryDirectory() as d:
-        project = Path(d) / "panda.yaml"
+    try:
+        project = cache.parent / "panda.yaml"
         project.write_text("name: panda\nmodels:\n  - name: Panda\n    description: /Panda/robot_description\n")
+        return {"cold": first_frame_s(project), "warm": first_frame_s(project)}
+    finally:
+        spin.stop()
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def measure(repeats: int = 3) -> dict:
+    """``repeats`` times: :func:`one_process` in a fresh process, then again in another with its cache full.
+
+    Returns each figure's runs (s, from the description's arrival) and
+    medians: ``cold``, ``warm`` (the same process's second monitor) and
+    ``restart`` (a new process whose conversions are cached: a monitor
+    started again); ``*_from_start_median_s`` from the App's start.
+    """
+    import subprocess
+
+    def child(cache: Path) -> dict:
+        done = subprocess.run(
+            [sys.executable, "-m", "benchmarks.experiments.any_robot", "--one", str(cache)],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+        if done.returncode != 0:
+            raise RuntimeError(f"a run failed: {done.stderr[-2000:]}")
+        return json.loads(done.stdout.strip().splitlines()[-1])
+
+    # cold: a fresh process, an empty cache; warm: the same process again; restart: a fresh process, the cache full
+    runs: dict[str, list] = {"cold": [], "warm": [], "restart": []}
+    with tempfile.TemporaryDirectory() as d:
         for i in range(repeats):
-            os.environ["RTT_MESH_CACHE"] = str(Path(d) / f"cache{i}")
-            cold.append(first_frame_s(project))  # an empty cache: every Collada file converted
-            warm.append(first_frame_s(project))  # the same cache again
-    spin.stop()
-    node.destroy_node()
-    rclpy.try_shutdown()
-    return {
-        "cold_s": [round(x, 3) for x in cold],
-        "warm_s": [round(x, 3) for x in warm],
-        "cold_median_s": round(statistics.median(cold), 3),
-        "warm_median_s": round(statistics.median(warm), 3),
-    }
+            cache = Path(d) / f"run{i}" / "meshes"
+            cache.parent.mkdir()
+            first = child(cache)
+            runs["cold"].append(first["cold"])
+            runs["warm"].append(first["warm"])
+            runs["restart"].append(child(cache)["cold"])
+    out = {}
+    for case, pairs in runs.items():
+        out[f"{case}_s"] = [round(a, 3) for a, _ in pairs]
+        out[f"{case}_median_s"] = round(statistics.median(a for a, _ in pairs), 3)
+        out[f"{case}_from_start_median_s"] = round(statistics.median(b for _, b in pairs), 3)
+    return out
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--one", type=Path, help=argparse.SUPPRESS)  # a child process: one run, into this cache
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    os.environ.setdefault("ROS_DOMAIN_ID", str(60 + os.getpid() % 40))
+    os.environ.setdefault("ROS_DOMAIN_ID", str(60 + os.getpid() % 40))  # the children inherit it
+    if args.one is not None:
+        print(json.dumps(one_process(args.one)))
+        return 0
     print(json.dumps(measure(args.repeats), indent=1))
     return 0
 
