@@ -199,9 +199,17 @@ def plot_learners(r: dict, path: Path) -> Path:
     ax.set_title("real-time factor")
     ax.legend(fontsize=8)
     ax = axes[0, 1]
-    ax.plot(ns, [d["age_ms_p99_max"] for d in data], "o-", label="p99, worst learner")
-    ax.plot(ns, [d["age_ms_pooled"]["p50"] for d in data], "s--", label="p50, all learners")
-    ax.axhline(LEARNERS_TARGETS[1].limit * data[0]["age_ms_p99_max"], color="grey", ls=":", lw=1)
+    unknown = float("nan")  # a class where a learner was shown no state in the window: no point
+    worst = [unknown if d["age_ms_p99_max"] is None else d["age_ms_p99_max"] for d in data]
+    ax.plot(ns, worst, "o-", label="p99, worst learner")
+    ax.plot(
+        ns,
+        [unknown if d["age_ms_pooled"]["p50"] is None else d["age_ms_pooled"]["p50"] for d in data],
+        "s--",
+        label="p50, all learners",
+    )
+    if data[0]["age_ms_p99_max"] is not None:
+        ax.axhline(LEARNERS_TARGETS[1].limit * data[0]["age_ms_p99_max"], color="grey", ls=":", lw=1)
     ax.set_yscale("log")
     ax.set_title("viewer: state age when applied, ms")
     ax.legend(fontsize=8)

@@ -340,6 +340,9 @@ async def _measure(hub, learners, seconds: float, warmup: float, directory: Path
         window = (min(p["window"][0] for p in per), max(p["window"][1] for p in per))
     first_state_s = [round((p["applied"][0][2] - started_ns) / 1e9, 1) for p in per]
     ages = np.concatenate([f["ages_ms"] for f in figures])
+    # A learner whose viewer applied no state inside the window has no age: the worst learner's is then
+    # unknown (None, and its target fails as "n/a"), and how many that happened to is counted.
+    ages_p99 = [f["age_ms_p99"] for f in figures]
     return {
         "learners": n,
         "window_s": round((window[1] - window[0]) / 1e9, 1),
@@ -347,8 +350,9 @@ async def _measure(hub, learners, seconds: float, warmup: float, directory: Path
         "first_state_s": first_state_s,  # from every learner's run cell having returned to each viewer's first state
         "real_time_factor": [f["real_time_factor"] for f in figures],
         "real_time_factor_min": min(f["real_time_factor"] for f in figures),
-        "age_ms_p99": [f["age_ms_p99"] for f in figures],
-        "age_ms_p99_max": max(f["age_ms_p99"] for f in figures),
+        "age_ms_p99": ages_p99,
+        "age_ms_p99_max": None if None in ages_p99 else max(ages_p99),
+        "learners_with_no_state_in_window": sum(a is None for a in ages_p99),
         "age_ms_pooled": pct(ages),
         "frames_per_s": [f["frames_per_s"] for f in figures],
         "frames_per_s_min": min(f["frames_per_s"] for f in figures),
@@ -411,7 +415,12 @@ def learners_per_server(counts, seconds: float, warmup: float, frame_rate: float
         print(
             f"{n:3d} learners, frame rate {frame_rate or 'the hub default'}: "
             f"real-time factor min {r['real_time_factor_min']:.3f}, "
-            f"age p99 max {r['age_ms_p99_max']:.1f} ms, frames/s min {r['frames_per_s_min']:.1f}, "
+            + (
+                f"age p99 max {r['age_ms_p99_max']:.1f} ms, "
+                if r["age_ms_p99_max"] is not None
+                else f"{r['learners_with_no_state_in_window']} learner(s) shown no state in the window, "
+            )
+            + f"frames/s min {r['frames_per_s_min']:.1f}, "
             f"{r['memory_mb_per_learner_mean']:.0f} MB/learner, {r['cores_busy']:.2f} cores busy "
             f"(client {r['client_cores']:.2f})",
             flush=True,

@@ -52,6 +52,11 @@ from tutorial.core.world import ModelEntry
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 # An absolute ROS 2 topic name: /part/part, each part letters, digits and _, not starting with a digit.
 TOPIC_PATTERN = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
+# A model's keys -> whether each is required.
+MODEL_KEYS = {
+    "name": True,
+    **dict.fromkeys(("file", "description", "odometry", "position", "yaw", "controllers"), False),
+}
 MAX_PROJECT_BYTES = 1_000_000  # a project file is a page of YAML; a bigger "project" is the wrong file
 
 
@@ -270,19 +275,7 @@ def load_project(path: str | Path) -> Project:
     seen: set[str] = set()
     for i, m in enumerate(models_doc):
         key = f"models[{i}]"
-        r.mapping(
-            m,
-            key,
-            {
-                "name": True,
-                "file": False,
-                "description": False,
-                "odometry": False,
-                "position": False,
-                "yaw": False,
-                "controllers": False,
-            },
-        )
+        r.mapping(m, key, MODEL_KEYS)
         mname = r.name(m["name"], f"{key}.name")
         if mname in seen:
             raise r.fail(f"{key}.name", f"{mname!r} is used twice; model names must be unique")
@@ -355,11 +348,8 @@ def load_project(path: str | Path) -> Project:
                     "a robot-description topic is for a viewer project (no simulator)",
                 )
             if m.odometry is not None:
-                raise r.fail(
-                    f"models[{i}].odometry",
-                    "a simulated model's root moves by its physics; an odometry topic to follow is for a viewer "
-                    "project (no simulator)",
-                )
+                why = "a simulated model's root moves by its physics; an odometry topic is for a viewer project"
+                raise r.fail(f"models[{i}].odometry", why)
     return Project(path=path, name=name, models=models, simulator=simulator)
 
 
