@@ -49,9 +49,11 @@ test: $(VENV)/.installed lint course/node_modules/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests notebooks -m "not slow" --durations=15 --nbval --nbval-sanitize-with notebooks/nbval_sanitize.cfg
 
-# The hub's slow test: two learners as two Unix users of this machine (root; Debian's python3), each with their
-# own robots (make test runs the hub with two learners under one user, and with a network namespace each).
+# The hub's slow tests: two learners as two Unix users of this machine (root; Debian's python3), each with their
+# own robots; and two learners in one ROS domain, each in a network namespace of their own (containers, pods).
+# make test runs the hub with two learners under one user, each in their own domain.
 test-hub: $(VENV)/.installed course/node_modules/.installed
+	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_hub.py -m slow -q
 
 # Grading every assignment's fake submissions (make test grades notebook 01's): several minutes.

@@ -254,8 +254,8 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
     """Unitree's Go2 (Collada visuals, a floating base): the root link follows /Go2/odom, refused poses are counted.
 
     Each link must land where the odometry's pose times ``yourdfpy``'s forward
-    kinematics puts it; a pose with a NaN, another child frame or a zero
-    quaternion must leave the robot where it was.
+    kinematics puts it; a pose with a NaN, another child frame, a zero
+    quaternion or 2,000 km away must leave the robot where it was.
     """
     import mujoco
     import yourdfpy
@@ -316,14 +316,15 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
             pose(9.0, 9.0, 9.0, q, child="odom_base"),
             pose(9.0, 9.0, 9.0, (0.0, 0.0, 0.0, 0.0)),
             pose(9.0, 9.0, 9.0, (2.0, 0.0, 0.0, 0.0)),
+            pose(2e6, 0.0, 0.3, q),  # 2,000 km away
         ):
             before = handled()
             odometry.publish(msg)
             app.loop.run_until(lambda before=before: handled() > before, timeout=10)
         assert base.applied == 1
-        assert base.rejected == {"not_finite": 1, "wrong_frame": 1, "not_a_unit_quaternion": 2}
+        assert base.rejected == {"not_finite": 1, "wrong_frame": 1, "not_a_unit_quaternion": 2, "too_far": 1}
         warned = [r["message"] for r in records if r.get("event") == "warning"]
-        assert len(warned) == 3 and "'odom_base'" in warned[1], warned  # once per reason, naming the frame
+        assert len(warned) == 4 and "'odom_base'" in warned[1], warned  # once per reason, naming the frame
 
         final = {}  # inside each joint's limits (yourdfpy would clamp a position outside them)
         for j, n in enumerate(moving):

@@ -4,8 +4,8 @@ Every subscription in the library is listed in :data:`FUZZED` with the test
 that feeds it generated messages of its type (NaN, infinities, huge and
 empty arrays, names of any text, absurd image sizes): Step 1's ``/joy``,
 Step 3's joint-state monitor (live and late-joiner paths), Step 5's IMU
-viewer, ``rtt-image``'s receiver (raw and compressed), ``rtt-plot``'s history
-and a viewer's robot description.  Each
+viewer, ``rtt-image``'s receiver (raw and compressed), ``rtt-plot``'s history,
+a viewer's robot description and its floating base's odometry.  Each
 property checks that the callback does not raise, that a bad message is
 rejected and counted (never applied in part where a whole is needed), and
 that what is shown stays finite.  :func:`test_every_subscription_in_the_library_is_fuzzed`
@@ -42,6 +42,7 @@ FUZZED = {
     "Image": "test_rtt_image_receiver_takes_any_image",
     "CompressedImage": "test_rtt_image_receiver_takes_any_compressed_image",
     "String": "test_a_viewer_takes_any_robot_description",
+    "Odometry": "test_a_floating_base_takes_any_odometry",
 }
 
 
@@ -264,6 +265,55 @@ def test_step5_viewer_takes_any_imu(imu_viewer, msg):
     assert s["received"] == before["received"] + 1 and handled == 1  # shown, or rejected and counted
     for arrow in (controller.accel_arrow, controller.gyro_arrow):
         assert np.isfinite(arrow.vector).all() and np.isfinite(arrow.origin).all()
+
+
+# ------------------------------------------------------------ a viewer's floating base: /<body>/odom
+def odometries():
+    from nav_msgs.msg import Odometry
+
+    def build(p, q, child, s):
+        msg = Odometry()
+        msg.pose.pose.position.x, msg.pose.pose.position.y, msg.pose.pose.position.z = p
+        o = msg.pose.pose.orientation
+        o.w, o.x, o.y, o.z = q
+        msg.child_frame_id = child
+        return stamp(msg, *s)
+
+    position = st.tuples(*[FLOAT64 | st.floats(-100, 100) | st.sampled_from([2e6, -1e300])] * 3)
+    near_unit = st.tuples(*[st.floats(-1, 1)] * 4).map(lambda q: tuple(c / (math.hypot(*q) or 1.0) for c in q))
+    rotation = near_unit | st.tuples(*[FLOAT64] * 4)
+    child = st.sampled_from(["", "CHASSIS"]) | TEXT
+    return st.builds(build, position, rotation, child, st.tuples(INT32, UINT32))
+
+
+@pytest.fixture(scope="module")
+def floating_base():
+    from tutorial.app.floating_base import FloatingBase
+
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml", odometry="/Tank/odom")])
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    controller = FloatingBase("/Tank/odom")
+    body = Body(model, data, "Tank")
+    assert controller.configure(ControllerConfig(name="F", body=body, node=FakeNode(), output=lambda r: None))
+    return controller
+
+
+@examples(60)
+@given(msg=odometries())
+def test_a_floating_base_takes_any_odometry(floating_base, msg):
+    controller = floating_base
+    before = controller.summary()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        controller.on_odometry(msg)  # the subscription callback (call_later runs the update at once here)
+    s = controller.summary()
+    handled = s["applied"] + sum(s["rejected"].values()) - before["applied"] - sum(before["rejected"].values())
+    assert handled == 1  # placed, or refused and counted
+    if s["applied"] == before["applied"]:  # refused: the robot stays where it was
+        assert s["position"] == before["position"] and s["orientation_wxyz"] == before["orientation_wxyz"]
+    assert np.isfinite(controller.body.data.xpos).all() and np.isfinite(controller.body.data.xquat).all()
+    assert abs(np.linalg.norm(s["orientation_wxyz"]) - 1.0) < 1e-6
 
 
 # ------------------------------------------------------------ rtt-image: /<body>/camera/image

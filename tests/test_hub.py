@@ -224,6 +224,7 @@ def test_a_learner_who_changed_their_domain_is_warned():
     assert "gave you ROS domain 12" in assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12"})
 
 
+@pytest.mark.slow  # make test-hub: make test keeps the hub's one real case (two learners, their own domains)
 @pytest.mark.network
 def test_with_a_network_namespace_each_learners_may_share_a_domain(procs, net):  # noqa: F811 - the fixture
     """Containers or pods: each learner's server in a network namespace of its own, the same ROS domain.

@@ -27,6 +27,8 @@ root link's pose from a received message with :func:`read_root_pose`.
 
 from __future__ import annotations
 
+import math
+
 import mujoco
 import numpy as np
 
@@ -118,8 +120,9 @@ def fill_odometry(msg, stamp: tuple[int, int], child_frame: str, motion) -> None
     a.x, a.y, a.z = (float(c) for c in angular)
 
 
-REJECTIONS = ("wrong_frame", "not_finite", "not_a_unit_quaternion")
+REJECTIONS = ("wrong_frame", "not_finite", "too_far", "not_a_unit_quaternion")
 QUATERNION_TOLERANCE = 0.01  # how far |q| may be from 1 before a pose is refused, not renormalised
+POSITION_LIMIT = 1e6  # m: a root farther from the frame's origin than 1,000 km is no robot's pose
 
 
 def read_root_pose(msg, root_link: str) -> tuple[np.ndarray, np.ndarray] | str:
@@ -137,9 +140,10 @@ def read_root_pose(msg, root_link: str) -> tuple[np.ndarray, np.ndarray] | str:
         the root link in the odometry's frame; or one of :data:`REJECTIONS`:
         ``wrong_frame`` (``child_frame_id`` names another frame than the root
         link; an empty one is taken as the root link), ``not_finite`` (a NaN
-        or an infinity in the pose), ``not_a_unit_quaternion`` (its norm is
-        more than :data:`QUATERNION_TOLERANCE` from 1; a pose a little off
-        is renormalised).  The twist is not read.  Any thread.
+        or an infinity in the pose), ``too_far`` (a coordinate beyond
+        :data:`POSITION_LIMIT`), ``not_a_unit_quaternion`` (its norm is more
+        than :data:`QUATERNION_TOLERANCE` from 1; a pose a little off is
+        renormalised).  The twist is not read.  Any thread.
     """
     if msg.child_frame_id not in ("", root_link):
         return "wrong_frame"
@@ -148,7 +152,9 @@ def read_root_pose(msg, root_link: str) -> tuple[np.ndarray, np.ndarray] | str:
     quat = np.array([o.w, o.x, o.y, o.z], dtype=float)  # MuJoCo's order: w first
     if not (np.isfinite(position).all() and np.isfinite(quat).all()):
         return "not_finite"
-    norm = float(np.linalg.norm(quat))
+    if np.abs(position).max() > POSITION_LIMIT:
+        return "too_far"
+    norm = math.hypot(*quat)  # no overflow on a huge quaternion: inf, refused below
     if abs(norm - 1.0) > QUATERNION_TOLERANCE:
         return "not_a_unit_quaternion"
     return position, quat / norm
