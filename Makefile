@@ -9,7 +9,7 @@
 #       make mutate (mutation testing of the lessons and the library's core: about 25 minutes),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
-#       make test-hub (the hub with learners as Unix users: slow), make test-robots (every third-party robot in Chromium),
+#       make test-hub (the hub with learners as Unix users: slow), make test-robots (the UR5, SO-100 and Go2 in Chromium),
 #       make assignments (the class's nbgrader assignments from the notebooks, into course/),
 #       make grade (collect, autograde, feedback and course/grades.csv), make test-grade (every assignment graded),
 #       make export (write the controllers from the notebooks that build them),
@@ -81,13 +81,13 @@ mutate: $(VENV)/.installed
 test-fast: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m unit -q
 
-# Every notebook's Run All in JupyterLab, as a learner runs it (tests/test_jupyterlab.py; make test runs the
-# setup check and the two notebooks a learner works in with the mouse, and nbval runs every notebook).
-# Every third-party robot's picture in Chromium (make test draws the Panda's): about 20 s.
+# The UR5's, SO-100's and Go2's pictures in Chromium (make test draws the Panda's): about 20 s.
 test-robots: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_any_robot.py -m slow -q
 
+# Every notebook's Run All in JupyterLab, as a learner runs it (tests/test_jupyterlab.py; make test runs the
+# setup check and the two notebooks a learner works in with the mouse, and nbval runs every notebook).
 test-lab: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
 	RTT_LAB_ALL=1 $(PY) -m pytest tests/test_jupyterlab.py -q

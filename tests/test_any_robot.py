@@ -210,7 +210,7 @@ PICTURED = {**CASES, "Go2": "go2_description/urdf/go2.urdf"}
 @pytest.mark.browser
 @pytest.mark.parametrize(
     "name", [n if n == "Panda" else pytest.param(n, marks=pytest.mark.slow) for n in PICTURED]
-)  # make test draws the Panda; make test-robots every robot
+)  # make test draws the Panda; make test-robots the other three
 def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, name):
     """In Chromium: the robot's meshes are on the page; with its meshes unfound, only meshcat's background is."""
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -253,6 +253,8 @@ def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, na
 def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, monkeypatch):
     """Unitree's Go2 (Collada visuals, a floating base): the root link follows /Go2/odom, refused poses are counted.
 
+    Started after the robot's last pose, the viewer shows it (a late joiner).
+
     Each link must land where the odometry's pose times ``yourdfpy``'s forward
     kinematics puts it; a pose with a NaN, another child frame, a zero
     quaternion or 2,000 km away must leave the robot where it was.
@@ -282,6 +284,16 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
     )
     robot = yourdfpy.URDF.load(str(path), load_meshes=False, build_collision_scene_graph=False)
     moving = list(robot.actuated_joint_names)
+
+    def pose(x, y, z, q, child="base"):
+        msg = Odometry()
+        msg.header.frame_id, msg.child_frame_id = "odom", child
+        p, o = msg.pose.pose.position, msg.pose.pose.orientation
+        p.x, p.y, p.z = x, y, z
+        o.w, o.x, o.y, o.z = q
+        return msg
+
+    odometry.publish(pose(-2.0, 1.0, 0.25, (1.0, 0.0, 0.0, 0.0)))  # kept (transient local) for a viewer to come
     records = []
     app = App(load_project(tmp_path / "go2.yaml"), node_name="monitor_go2", headless=True, output=records.append)
     try:
@@ -289,15 +301,9 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
         assert [r for r in records if r.get("event") == "warning"] == []
         body, base = app.bodies["Go2"], app.controller("Go2/floating_base")
         assert base.root_link == robot.base_link == "base"
+        app.loop.run_until(lambda: base.applied == 1, timeout=10)  # the late joiner stands where the robot was
+        assert base.summary()["position"] == [-2.0, 1.0, 0.25] and base.late_subscription is None
         app.loop.run_until(lambda: odometry.get_subscription_count() > 0, timeout=10)
-
-        def pose(x, y, z, q, child="base"):
-            msg = Odometry()
-            msg.header.frame_id, msg.child_frame_id = "odom", child
-            p, o = msg.pose.pose.position, msg.pose.pose.orientation
-            p.x, p.y, p.z = x, y, z
-            o.w, o.x, o.y, o.z = q
-            return msg
 
         def handled():
             return base.applied + sum(base.rejected.values())
@@ -321,7 +327,7 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
             before = handled()
             odometry.publish(msg)
             app.loop.run_until(lambda before=before: handled() > before, timeout=10)
-        assert base.applied == 1
+        assert base.applied == 2
         assert base.rejected == {"not_finite": 1, "wrong_frame": 1, "not_a_unit_quaternion": 2, "too_far": 1}
         warned = [r["message"] for r in records if r.get("event") == "warning"]
         assert len(warned) == 4 and "'odom_base'" in warned[1], warned  # once per reason, naming the frame
@@ -345,14 +351,16 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
             assert np.abs(app.data.xpos[b] - expected[:3, 3]).max() <= 1e-6, link.name
             assert np.abs(app.data.xmat[b].reshape(3, 3) - expected[:3, :3]).max() <= 1e-6, link.name
         summary = base.summary()
-        assert summary["position"] == list(good) and summary["applied"] == 1
+        assert summary["position"] == list(good) and summary["applied"] == 2
         assert np.allclose(summary["orientation_wxyz"], q, atol=1e-9)  # renormalised, w first
     finally:
         app.close()
 
 
 def test_odometry_needs_a_root_free_of_the_world(tmp_path):
-    """A root already floating keeps its free joint; one on a hinge cannot take a pose, and says so."""
+    """A root already floating keeps its free joint; one on a hinge, or two roots, cannot take a pose, and say so."""
+    import mujoco
+
     from tutorial.core.world import ModelEntry, ModelError, build_world
 
     floating = "<mujoco><worldbody><body name='base'><freejoint/><geom size='.1'/></body></worldbody></mujoco>"
@@ -364,3 +372,12 @@ def test_odometry_needs_a_root_free_of_the_world(tmp_path):
     assert build_world([ModelEntry("R", None, text=welded)]).njnt == 0  # without odometry: welded, as it was
     with pytest.raises(ModelError, match="its root link base moves on 1 other joint"):
         build_world([ModelEntry("R", None, text=hinged, odometry="/R/odom")])
+    two = "<mujoco><worldbody><body name='a'><geom size='.1'/></body>"
+    two += "<body name='b'><geom size='.1'/></body></worldbody></mujoco>"
+    with pytest.raises(ModelError, match=r"has 2 top-level bodies \(a, b\): odometry places one root link"):
+        build_world([ModelEntry("R", None, text=two, odometry="/R/odom")])
+    named = "<mujoco><worldbody><body name='base'><geom size='.1'/><body name='c'><joint name='floating_base'/>"
+    named += "<geom size='.1'/></body></body></worldbody></mujoco>"
+    model = build_world([ModelEntry("R", None, text=named, odometry="/R/odom")])  # the name is taken: another
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(model.njnt)]
+    assert names == ["R/floating_base_1", "R/floating_base"] and model.jnt_type[0] == 0

@@ -39,8 +39,11 @@ class FloatingBase(SimpleController):
     (:func:`tutorial.interfaces.joint_state.joint_state_viewer_qos`): it
     matches reliable publishers whether they keep their last message or not,
     and the final pose arrives.  A best-effort publisher (sensor-data QoS)
-    does not match; a viewer started next to a paused robot shows the root
-    where the model puts it until the next message.
+    does not match.  As the Step 3 monitor does for joint states, a second,
+    transient-local subscription takes the newest pose a publisher kept
+    from before the viewer started (a paused or finished simulation's): it
+    is shown if no live pose has come, then dropped.  Poses are applied in
+    the order they arrive; their stamps are not compared.
 
     Args:
         topic: the odometry topic, e.g. ``/Go2/odom``.
@@ -54,6 +57,7 @@ class FloatingBase(SimpleController):
         from nav_msgs.msg import Odometry
 
         from tutorial.interfaces.joint_state import joint_state_viewer_qos
+        from tutorial.interfaces.odometry import odometry_qos
 
         self.config = config
         self.body = body = config.body
@@ -71,9 +75,14 @@ class FloatingBase(SimpleController):
         self.subscription = config.node.create_subscription(
             Odometry, self.topic, self.on_odometry, joint_state_viewer_qos()
         )
+        # Transient local: matches transient-local publishers only, which hand it the pose they kept.
+        self.late_subscription = config.node.create_subscription(
+            Odometry, self.topic, self.on_late_pose, odometry_qos()
+        )
         return True
 
     def unconfigure(self) -> None:
+        self.drop_late_subscription()
         self.config.node.destroy_subscription(self.subscription)
 
     # ---- spin thread --------------------------------------------------------
@@ -81,7 +90,21 @@ class FloatingBase(SimpleController):
         """Subscription callback (spin thread): hand the message over, touch nothing."""
         self.config.call_later(self.update_root_pose, msg)
 
+    def on_late_pose(self, msg) -> None:
+        self.config.call_later(self.show_late_pose, msg)
+
     # ---- main thread ------------------------------------------------------
+    def show_late_pose(self, msg) -> None:
+        """The newest pose from before the viewer started: applied if no live pose came, then no more."""
+        if self.applied == 0 and self.late_subscription is not None:
+            self.update_root_pose(msg)
+        self.drop_late_subscription()
+
+    def drop_late_subscription(self) -> None:
+        if getattr(self, "late_subscription", None) is not None:
+            self.config.node.destroy_subscription(self.late_subscription)
+            self.late_subscription = None
+
     def update_root_pose(self, msg) -> None:
         """Place the root link by one message, or count why not (main thread)."""
         pose = read_root_pose(msg, self.root_link)
@@ -109,6 +132,8 @@ class FloatingBase(SimpleController):
         self.body.data.qpos[a + 3 : a + 7] = quat
         self.body.notify_kinematic_state_change()
         self.applied += 1
+        if self.late_subscription is not None:
+            self.drop_late_subscription()  # live poses flow: no more need for it
 
     def summary(self) -> dict:
         a = self.qpos_adr

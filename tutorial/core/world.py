@@ -168,6 +168,13 @@ def _float_root(spec: mujoco.MjSpec, entry: ModelEntry) -> None:
     root = spec.worldbody.first_body()
     if root is None:
         raise ModelError(f"model {entry.name}: follows {entry.odometry}, but has no link to place", entry)
+    tops = [b for b in spec.bodies if b.parent is not None and b.parent.name == spec.worldbody.name]
+    if len(tops) > 1:  # one pose places one root: the others would stay behind
+        raise ModelError(
+            f"model {entry.name}: follows {entry.odometry}, but has {len(tops)} top-level bodies "
+            f"({', '.join(b.name or '?' for b in tops)}): odometry places one root link",
+            entry,
+        )
     joints = list(root.joints)
     if any(j.type == mujoco.mjtJoint.mjJNT_FREE for j in joints):
         return
@@ -177,7 +184,11 @@ def _float_root(spec: mujoco.MjSpec, entry: ModelEntry) -> None:
             f"{len(joints)} other joint(s): an odometry pose needs a root free of the world",
             entry,
         )
-    root.add_freejoint(name="floating_base")
+    taken = {j.name for j in spec.joints}
+    name = next(
+        n for n in ("floating_base", *(f"floating_base_{i}" for i in range(1, len(taken) + 2))) if n not in taken
+    )
+    root.add_freejoint(name=name)
 
 
 def _parse(entry: ModelEntry) -> mujoco.MjSpec:
