@@ -82,8 +82,8 @@ def stamp(msg, sec, nanosec):
     return msg
 
 
-def world(*files):
-    model = build_world([ModelEntry(name, MODEL / f) for name, f in files])
+def world(*files, odometry=None):
+    model = build_world([ModelEntry(name, MODEL / f, odometry=odometry) for name, f in files])
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     return model, data
@@ -290,9 +290,7 @@ def odometries():
 def floating_base():
     from tutorial.app.floating_base import FloatingBase
 
-    model = build_world([ModelEntry("Tank", MODEL / "tank.xml", odometry="/Tank/odom")])
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
+    model, data = world(("Tank", "tank.xml"), odometry="/Tank/odom")
     controller = FloatingBase("/Tank/odom")
     body = Body(model, data, "Tank")
     assert controller.configure(ControllerConfig(name="F", body=body, node=FakeNode(), output=lambda r: None))

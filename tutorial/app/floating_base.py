@@ -29,7 +29,7 @@ from collections import Counter
 import mujoco
 
 from tutorial.core.controller import ControllerConfig, SimpleController
-from tutorial.interfaces.odometry import read_root_pose
+from tutorial.interfaces.odometry import RootMotion, read_root_pose
 
 
 class FloatingBase(SimpleController):
@@ -63,13 +63,13 @@ class FloatingBase(SimpleController):
         self.body = body = config.body
         model = body.model
         self.root_link = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body.root_id).removeprefix(body.prefix)
-        first = int(model.body_jntadr[body.root_id]) if model.body_jntnum[body.root_id] else -1
-        if first < 0 or model.jnt_type[first] != mujoco.mjtJoint.mjJNT_FREE:
+        # Where the root's free joint keeps its pose in qpos: the odometry publisher's RootMotion reads it there.
+        self.qpos_adr = RootMotion(model, body.root_id).free_qpos
+        if self.qpos_adr is None:
             config.log.error(
                 "%s: the root link %s of %s has no free joint to place", self.topic, self.root_link, body.name
             )
             return False
-        self.qpos_adr = int(model.jnt_qposadr[first])
         self.applied = 0
         self.rejected: Counter = Counter()
         self.subscription = config.node.create_subscription(
@@ -132,8 +132,7 @@ class FloatingBase(SimpleController):
         self.body.data.qpos[a + 3 : a + 7] = quat
         self.body.notify_kinematic_state_change()
         self.applied += 1
-        if self.late_subscription is not None:
-            self.drop_late_subscription()  # live poses flow: no more need for it
+        self.drop_late_subscription()  # a pose is shown: the kept one is no longer needed
 
     def summary(self) -> dict:
         a = self.qpos_adr
