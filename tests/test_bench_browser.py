@@ -13,7 +13,7 @@ import zlib
 
 import pytest
 
-from benchmarks.experiments.browser import _match, analyse_bare, analyse_tutorial, bare_commands
+from benchmarks.experiments.browser import _match, analyse_bare, analyse_tutorial, bare_commands, since_frame_ms
 
 MS = 1_000_000  # ns
 
@@ -62,6 +62,20 @@ def test_stages_add_up_whatever_the_page_clock(offset_ns):
         ("publish_to_drawn", 15.0),
     ):
         assert out[key]["p50"] == pytest.approx(ms, abs=1e-3), key
+
+
+def test_where_each_measured_send_lands_in_the_page_frame():
+    # frames every 16 ms from 1000 ms; the two measured states are sent at 1004 and 1024 ms
+    out = analyse_tutorial(_run(0), warmup=0.0)
+    assert out["send_phase_ms"]["p50"] == pytest.approx(6.0, abs=1e-3)
+    assert out["send_phase_ms"]["max"] == pytest.approx(8.0, abs=1e-3)
+
+
+def test_a_send_before_the_first_frame_has_no_place_in_a_frame():
+    rafs = [10.0, 26.0, 42.0]  # page ms; the page's clock 2 ms ahead of the monotonic one
+    out = since_frame_ms([5 * MS, 9 * MS, 30 * MS], rafs, offset_ns=2 * MS)
+    assert out["n"] == 2  # 5 ms is before the first frame (8 ms monotonic)
+    assert out["p50"] == pytest.approx((1.0 + 6.0) / 2, abs=1e-3)
 
 
 def test_a_state_sent_twice_counts_once():

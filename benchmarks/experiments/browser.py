@@ -44,6 +44,20 @@ transform, at the moments it sent them), in meshcat's own protocol (one
 tutorial code on its path, only zmq and meshcat's own server and page (bound
 to 127.0.0.1).  Its figure is send -> drawn.  The page's frames per second are its ``requestAnimationFrame``
 callbacks per second.
+
+**Every point of the page's frame, on both sides.**  A page draws at its
+animation frames, so a message waits for the next one: anywhere from 0 to
+16.7 ms, by where in the frame it lands.  Headless Chromium's frames come
+at exactly 60 a second from this machine's clock, the viewer's too, so at
+60 frames a second the viewer's sends would land at one point of the page's
+frame for a whole run: one draw of chance per run (the 1 kHz case's bare
+page had its p99 at 33.6 ms in one run and 6.9 ms in the next, 2026-11-25),
+where a real display's refresh and the machine's clock drift apart.  So the
+viewer here draws at most :data:`VIEW_FRAME_RATE` frames a second: its
+sends slide through every point of the page's frame once a second, in its
+run and in the replay of its tape alike.  Both sides report where their
+sends landed (``send_phase_ms``: send -> the page's animation frame before
+it), which shows it.
 """
 
 from __future__ import annotations
@@ -88,6 +102,9 @@ CASES = {  # name: (kind, size, publisher rate Hz)
 # tank at 50 Hz: 60 frames/s and send -> page p50 1 to 3 ms up to 480 x 360; 57 frames/s and 20 ms at
 # 640 x 480; 25 to 39 frames/s and 34 to 41 ms at 800 x 600.  A browser with a GPU does not pay it.
 VIEWPORT = {"width": 480, "height": 380}
+# The viewer's frame rate here (RTT_FRAME_RATE): a beat of 1 s against the page's 60 frames a second, so
+# each run sees every point of the page's frame (the module's docstring says why).
+VIEW_FRAME_RATE = 59.0
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
     "--no-sandbox",
@@ -263,6 +280,7 @@ def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True,
         + ["--record-meshcat", str(tape)]
         + ([] if batch else ["--meshcat-no-batch"]),
         view_probe,
+        {"RTT_FRAME_RATE": str(VIEW_FRAME_RATE)},
     )
     procs = [viewer]
     page = None
@@ -367,6 +385,15 @@ def bare_run(tape: list, lead_s: float = 1.0, batch: bool = False) -> tuple[dict
     return samples, sent
 
 
+def since_frame_ms(sends_ns: list, rafs_ms: list, offset_ns: int) -> dict:
+    """Percentiles of each send (monotonic ns) -> the page's animation frame before it (page ms; ``offset_ns``:
+    :meth:`Page.clock_offset_ns`), ms; a send before the first frame is left out."""
+    frames = np.sort(np.asarray(rafs_ms, dtype=float)) * 1e6 - offset_ns
+    sends = np.asarray(sends_ns, dtype=float)
+    i = np.searchsorted(frames, sends, side="right") - 1
+    return pct((sends - frames[np.clip(i, 0, None)])[i >= 0], 1e-6)
+
+
 def _match(msgs: list, crcs: list[int]) -> list[tuple[int, int]]:
     """``(page message index, sent index)`` pairs: each page message to the next sent one of the same CRC."""
     pairs, j = [], 0
@@ -423,13 +450,14 @@ def analyse_tutorial(run: dict, warmup: float) -> dict:
     to_mono = lambda page_ms: page_ms * 1e6 - offset_ns  # noqa: E731 - one line of arithmetic
     start_ns = min(c[0] for c in transforms) + int(warmup * 1e9)
     stages = {k: [] for k in (*(key for key, _ in STAGES), "publish_to_drawn")}
-    seen = set()
+    seen, sends = set(), []
     for i, k in _match(page["msgs"], crcs):
         sent_ns = transforms[k][0]
         received = to_mono(page["msgs"][i][0])
         drawn = _first_after(renders, page["msgs"][i][0])
         if not (start_ns <= sent_ns <= end_ns) or drawn is None:
             continue
+        sends.append(sent_ns)
         drawn = to_mono(drawn)
         for body, stamp in tape_states(transforms[k]):  # a frame sent as one message shows several states
             if (body, stamp) in seen or stamp is None:
@@ -451,6 +479,7 @@ def analyse_tutorial(run: dict, warmup: float) -> dict:
                 stages[key].append(value)
     out = {k: pct(v, 1e-6) for k, v in stages.items()}
     out.update(_page_rates(page, start_ns, end_ns, offset_ns), states_drawn=len(seen))
+    out["send_phase_ms"] = since_frame_ms(sends, page["rafs"], offset_ns)
     return out
 
 
@@ -460,7 +489,7 @@ def analyse_bare(samples: dict, sent: list, warmup: float) -> dict:
     renders = np.array(sorted(samples["renders"]))
     crcs = [c for _, c in sent]
     start_ns = sent[0][0] + int(warmup * 1e9)
-    to_page, to_drawn = [], []
+    to_page, to_drawn, sends = [], [], []
     for i, k in _match(samples["msgs"], crcs):
         t_sent = sent[k][0]
         if t_sent < start_ns:
@@ -471,8 +500,10 @@ def analyse_bare(samples: dict, sent: list, warmup: float) -> dict:
             continue
         to_page.append(received - t_sent)
         to_drawn.append(drawn * 1e6 - offset_ns - t_sent)
+        sends.append(t_sent)
     out = {"sent_to_page": pct(to_page, 1e-6), "sent_to_drawn": pct(to_drawn, 1e-6)}
     out.update(_page_rates(samples, start_ns, sent[-1][0], offset_ns))
+    out["send_phase_ms"] = since_frame_ms(sends, samples["rafs"], offset_ns)
     return out
 
 

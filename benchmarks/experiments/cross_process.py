@@ -184,7 +184,13 @@ def pool_pipeline(runs: list[dict], rate: float) -> dict:
         "real_time_factor": round(min(rtf), 4) if rtf else None,
         "real_time_factors": [round(x, 4) for x in rtf],
         "latency_samples_ms": sorted(round(x * 1e-6, 4) for r in runs for x in r["latency"]),
+        "round_p50_ms": _round_p50s(runs),
     }
+
+
+def _round_p50s(runs: list[dict]) -> list[float | None]:
+    """Each run's own latency p50, ms, in the order run (the spread from round to round)."""
+    return [round(statistics.median(r["latency"]) * 1e-6, 4) if r["latency"] else None for r in runs]
 
 
 def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, executor: str = "single") -> dict:
@@ -222,6 +228,7 @@ def pool_bare(runs: list[dict], rate: float) -> dict:
         "received": sum(r["received"] for r in runs),
         "cpu_cores": round(statistics.mean(r["cpu_cores"] for r in runs), 3),
         "latency_samples_ms": sorted(round(x * 1e-6, 4) for x in latency),
+        "round_p50_ms": _round_p50s(runs),
     }
 
 
