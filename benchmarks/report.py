@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 
@@ -17,22 +18,63 @@ def targets_markdown(r: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _number(text: str) -> tuple[float, str] | None:
+    """The leading number of a row's figure and what follows it ("1.38x" -> (1.38, "x"), "0.94 s" -> (0.94, " s"),
+    "49,751 steps/s" -> (49751.0, " steps/s")); None when it has none ("yes")."""
+    m = re.match(r"\s*([-+]?[\d,]*\.?\d+)(.*)$", text or "")
+    if m is None:
+        return None
+    return float(m.group(1).replace(",", "")), m.group(2)
+
+
+def spread(values: list[str]) -> str:
+    """The lowest and highest of the same figure over runs, written as the rows write them ("1.06\u20131.16x");
+    the text itself when the runs agree, every run's text when a figure is not a number or the units differ.
+
+    Raises:
+        ValueError: no figures.
+    """
+    if not values:
+        raise ValueError("no figures to spread")
+    numbers = [_number(v) for v in values]
+    if any(n is None for n in numbers) or len({unit for _, unit in numbers}) != 1:
+        return values[0] if len(set(values)) == 1 else " / ".join(values)
+    lo, hi = min(values, key=lambda v: _number(v)[0]), max(values, key=lambda v: _number(v)[0])
+    unit = numbers[0][1]
+    return lo if lo == hi else f"{lo[: len(lo) - len(unit)].strip()}\u2013{hi.strip()}"
+
+
 def runs_table(paths: list[str]) -> str:
     """The targets of several saved runs (``latest.json`` files) as one Markdown table.
 
-    The measured figure, baseline and ratio are the last run's; the last
-    column gives every run's ratio (or figure) and verdict, in order.
+    The measured figure, baseline and ratio are the last run's; then the
+    spread over the runs (the lowest and highest ratio, or figure where a
+    target has no ratio), how many runs met the target, and every run's
+    ratio (or figure) and verdict, in order.
+
+    Raises:
+        ValueError: the runs do not hold the same targets in the same order.
     """
     runs = [json.loads(Path(p).read_text()) for p in paths]
     last = runs[-1]
+    names = [t["target"] for t in last["targets"]]
+    for path, r in zip(paths, runs):
+        if [t["target"] for t in r["targets"]] != names:
+            raise ValueError(f"{path} holds other targets than {paths[-1]}: runs of different suites")
     numbers = ", ".join(str(i + 1) for i in range(len(runs)))
-    lines = [f"| target | measured | baseline, same run | ratio | runs {numbers} |", "|---|---|---|---|---|"]
+    lines = [
+        f"| target | measured | baseline, same run | ratio | spread | met | runs {numbers} |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for i, t in enumerate(last["targets"]):
-        each = []
-        for r in runs:
-            u = r["targets"][i]
-            each.append(f"{u['ratio'] or u['measured']} {'pass' if u['pass'] else '**FAIL**'}")
-        lines.append(f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | {'; '.join(each)} |")
+        rows = [r["targets"][i] for r in runs]
+        shown = [u["ratio"] or u["measured"] for u in rows]
+        each = "; ".join(f"{v} {'pass' if u['pass'] else '**FAIL**'}" for v, u in zip(shown, rows))
+        met = sum(u["pass"] for u in rows)
+        lines.append(
+            f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | {spread(shown)} | "
+            f"{met} of {len(rows)} | {each} |"
+        )
     return "\n".join(lines) + "\n"
 
 

@@ -64,11 +64,17 @@ def test_stages_add_up_whatever_the_page_clock(offset_ns):
         assert out[key]["p50"] == pytest.approx(ms, abs=1e-3), key
 
 
-def test_where_each_measured_send_lands_in_the_page_frame():
+@pytest.mark.parametrize("offset_ns", [0, 1_763_000_000_000 * MS])
+def test_where_each_measured_send_lands_in_the_page_frame(offset_ns):
     # frames every 16 ms from 1000 ms; the two measured states are sent at 1004 and 1024 ms
-    out = analyse_tutorial(_run(0), warmup=0.0)
+    out = analyse_tutorial(_run(offset_ns), warmup=0.0)
     assert out["send_phase_ms"]["p50"] == pytest.approx(6.0, abs=1e-3)
     assert out["send_phase_ms"]["max"] == pytest.approx(8.0, abs=1e-3)
+
+
+def test_a_send_on_a_frame_lands_at_its_start_and_without_frames_nowhere():
+    assert since_frame_ms([26 * MS], [10.0, 26.0, 42.0], offset_ns=0)["max"] == 0.0
+    assert since_frame_ms([26 * MS], [], offset_ns=0)["n"] == 0
 
 
 def test_a_send_before_the_first_frame_has_no_place_in_a_frame():
@@ -91,6 +97,10 @@ def test_bare_page_send_to_drawn():
     out = analyse_bare(run["page"], sent, warmup=0.0)
     assert out["sent_to_page"]["p50"] == pytest.approx(8.0, abs=1e-3)
     assert out["sent_to_drawn"]["p50"] == pytest.approx(11.0, abs=1e-3)
+    # sent at 1004, 1024 and 1044 ms against frames every 16 ms from 1000 ms (the page's clock 5 ms ahead)
+    assert out["send_phase_ms"]["n"] == 3
+    assert out["send_phase_ms"]["p50"] == pytest.approx(8.0, abs=1e-3)
+    assert out["send_phase_ms"]["max"] == pytest.approx(12.0, abs=1e-3)
 
 
 def _batched(run: dict) -> dict:

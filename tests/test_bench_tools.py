@@ -8,6 +8,7 @@ import pytest
 
 from benchmarks import publish
 from benchmarks.experiments.late_join import summary
+from benchmarks.report import runs_table, spread
 from benchmarks.targets import LATE_JOIN_TARGETS
 
 pytestmark = pytest.mark.unit
@@ -75,3 +76,70 @@ def test_learners_targets_and_plot(tmp_path):
     assert [t.row({}) for t in LEARNERS_TARGETS if t.needs is None or {}.get(t.needs)] == []  # not run: left out
     path = plot_learners(run, tmp_path / "bench_learners.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    "values, written",
+    [
+        (["1.38x", "1.92x", "1.06x"], "1.06\u20131.92x"),
+        (["49,751 steps/s", "59,524 steps/s"], "49,751\u201359,524 steps/s"),
+        (["0.94 s", "0.94 s"], "0.94 s"),
+        (["yes", "yes"], "yes"),
+        (["yes", "no"], "yes / no"),
+        (["n/a", "1.2x"], "n/a / 1.2x"),
+        (["10.2 ms", "9.5 ms"], "9.5\u201310.2 ms"),  # by number, not by text
+        (["950 steps/s", "1,200 steps/s"], "950\u20131,200 steps/s"),
+        (["0.9 s", "900 ms"], "0.9 s / 900 ms"),  # units differ: not one spread
+    ],
+)
+def test_the_spread_of_a_figure_over_runs(values, written):
+    assert spread(values) == written
+
+
+def _saved_run(path, ratios_and_verdicts):
+    targets = [
+        {"target": f"t{i}", "measured": "1 ms", "baseline": "", "ratio": ratio, "pass": ok}
+        for i, (ratio, ok) in enumerate(ratios_and_verdicts)
+    ]
+    path.write_text(json.dumps({"targets": targets}))
+    return str(path)
+
+
+def test_runs_table_counts_the_runs_that_met_each_target(tmp_path):
+    a = _saved_run(tmp_path / "a.json", [("1.1x", True), ("2.0x", False)])
+    b = _saved_run(tmp_path / "b.json", [("1.3x", True), ("1.4x", True)])
+    rows = runs_table([a, b]).splitlines()[2:]
+    assert rows[0].split(" | ")[4:6] == ["1.1\u20131.3x", "2 of 2"]
+    assert rows[1].split(" | ")[4:6] == ["1.4\u20132.0x", "1 of 2"]
+
+
+def test_runs_table_refuses_runs_of_different_suites(tmp_path):
+    a = _saved_run(tmp_path / "a.json", [("1.1x", True)])
+    b = _saved_run(tmp_path / "b.json", [("1.1x", True), ("1.4x", True)])
+    with pytest.raises(ValueError, match="other targets"):
+        runs_table([a, b])
+
+
+def test_no_figures_have_no_spread():
+    with pytest.raises(ValueError, match="no figures"):
+        spread([])
+
+
+def test_each_round_keeps_its_own_p50():
+    from benchmarks.experiments.cross_process import _round_p50s
+
+    assert _round_p50s([{"latency": [100_000, 300_000, 200_000]}, {"latency": []}, {"latency": [150_000]}]) == [
+        0.2,
+        None,
+        0.15,
+    ]
+
+
+def test_a_slid_tape_keeps_its_scene_and_stretches_the_rest():
+    from benchmarks.experiments.widget import slid
+
+    tape = [[5, "set_object", "/a", "00", None, None], [1000, "set_transform", "/b", "01", "Tank", 0]]
+    tape += [[3000, "set_transform", "/b", "02", "Tank", 1], [11000, "set_transform", "/b", "03", "Tank", 2]]
+    out = slid(tape, 1.5)
+    assert [c[0] for c in out] == [5, 1000, 4000, 16000]
+    assert [c[1:] for c in out] == [c[1:] for c in tape]

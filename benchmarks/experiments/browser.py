@@ -45,19 +45,22 @@ tutorial code on its path, only zmq and meshcat's own server and page (bound
 to 127.0.0.1).  Its figure is send -> drawn.  The page's frames per second are its ``requestAnimationFrame``
 callbacks per second.
 
-**Every point of the page's frame, on both sides.**  A page draws at its
-animation frames, so a message waits for the next one: anywhere from 0 to
-16.7 ms, by where in the frame it lands.  Headless Chromium's frames come
-at exactly 60 a second from this machine's clock, the viewer's too, so at
-60 frames a second the viewer's sends would land at one point of the page's
-frame for a whole run: one draw of chance per run (the 1 kHz case's bare
-page had its p99 at 33.6 ms in one run and 6.9 ms in the next, 2026-11-25),
-where a real display's refresh and the machine's clock drift apart.  So the
-viewer here draws at most :data:`VIEW_FRAME_RATE` frames a second: its
-sends slide through every point of the page's frame once a second, in its
-run and in the replay of its tape alike.  Both sides report where their
-sends landed (``send_phase_ms``: send -> the page's animation frame before
-it), which shows it.
+**Every point of the page's frame, on both sides, at 1 kHz.**  A page
+draws at its animation frames, so a message waits for the next one:
+anywhere from 0 to 16.7 ms, by where in the frame it lands.  Headless
+Chromium's frames come 60 a second, and at 1 kHz the viewer draws at its
+own 60 a second: its sends then landed at one point of the page's frame for
+a whole run (send -> the frame before it, measured at 60: p50 6.5 ms and
+p90 7.0 ms in one run, 13.4 and 13.6 ms in another), a draw of chance per
+run (the bare page's p99 was 33.6 ms in one run and 6.9 ms in the next,
+2026-11-25).  So the viewer here draws at most :data:`VIEW_FRAME_RATE`
+frames a second: its sends slide through every point of the page's frame
+once a second, in its run and in the replay of its tape alike.  Both sides
+report where their sends landed (``send_phase_ms``: send -> the page's
+animation frame before it, not capped at a frame: a stalled page shows
+more).  At 50 Hz the cap never acts: a state every 20 ms lands on five
+points of the frame 3.3 ms apart, one draw of chance per run for where the
+five sit, which moves a p99 by at most 3.3 ms.
 """
 
 from __future__ import annotations
@@ -387,8 +390,10 @@ def bare_run(tape: list, lead_s: float = 1.0, batch: bool = False) -> tuple[dict
 
 def since_frame_ms(sends_ns: list, rafs_ms: list, offset_ns: int) -> dict:
     """Percentiles of each send (monotonic ns) -> the page's animation frame before it (page ms; ``offset_ns``:
-    :meth:`Page.clock_offset_ns`), ms; a send before the first frame is left out."""
+    :meth:`Page.clock_offset_ns`), ms; a send before the first frame is left out, and with no frame, every one."""
     frames = np.sort(np.asarray(rafs_ms, dtype=float)) * 1e6 - offset_ns
+    if frames.size == 0:
+        return pct([])
     sends = np.asarray(sends_ns, dtype=float)
     i = np.searchsorted(frames, sends, side="right") - 1
     return pct((sends - frames[np.clip(i, 0, None)])[i >= 0], 1e-6)
