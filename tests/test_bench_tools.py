@@ -133,13 +133,3 @@ def test_each_round_keeps_its_own_p50():
         None,
         0.15,
     ]
-
-
-def test_a_slid_tape_keeps_its_scene_and_stretches_the_rest():
-    from benchmarks.experiments.widget import slid
-
-    tape = [[5, "set_object", "/a", "00", None, None], [1000, "set_transform", "/b", "01", "Tank", 0]]
-    tape += [[3000, "set_transform", "/b", "02", "Tank", 1], [11000, "set_transform", "/b", "03", "Tank", 2]]
-    out = slid(tape, 1.5)
-    assert [c[0] for c in out] == [5, 1000, 4000, 16000]
-    assert [c[1:] for c in out] == [c[1:] for c in tape]

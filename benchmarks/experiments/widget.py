@@ -19,14 +19,12 @@ timed to the pixel:
   state that a newer one replaced before it went out is not counted, as a
   state the page never drew is not.
 
-The tape comes from a viewer capped at ``browser.VIEW_FRAME_RATE`` (59)
-frames a second, which changes nothing at these cases' 50 Hz.  Both
-replays run the tape :data:`REPLAY_SLIDE` times slower than it was taped: a
-state every 20 ms against the page's 16.7 ms frames lands on five points of
-the frame, and where those five sit is one draw of chance per page (two
-pages, two draws: a ratio moved by up to a fifth from it); slowed by 0.1 %,
-the sends slide 6 ms over the measured 6 s, so both pages see every point.
-Both sides report where the states they count landed (``send_phase_ms``,
+The tape comes from ``browser.tutorial_run``, whose publisher runs
+``browser.SLIDE`` times slower than its case (49.9 Hz for 50 Hz), so its
+states slide through every point of a page's 60 Hz frame, in each replay
+alike (at exactly 50 Hz they land on five points, placed by chance per
+page: two pages, two draws, a ratio moved by up to a fifth).  Both sides
+report where the states they count landed (``send_phase_ms``,
 ``browser.since_frame_ms``).
 
 ``--remote`` also runs the browser on a second host with a 5 Mbit/s link
@@ -61,7 +59,6 @@ from benchmarks.stats import pct
 
 ROOT = Path(__file__).resolve().parents[2]
 WIDGET_CASES = ("tank_50Hz", "tanks_8")
-REPLAY_SLIDE = 1.001  # both replays run the tape this much slower (the module's docstring says why)
 
 REPLAY_CELL = """\
 import json, os, threading, time
@@ -111,14 +108,6 @@ IFRAME_RAFS = """() => {
   w.requestAnimationFrame(tick);
   return true;
 }"""
-
-
-def slid(tape: list, slower: float) -> list:
-    """The tape with every moment from its first transform on ``slower`` times as far from that one (the
-    scene's commands before it unchanged): the same commands, sent that much more slowly."""
-    first = next(i for i, c in enumerate(tape) if c[4] is not None)
-    base = tape[first][0]
-    return tape[:first] + [[base + round((c[0] - base) * slower), *c[1:]] for c in tape[first:]]
 
 
 def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
@@ -200,7 +189,7 @@ def widget_vs_page(cases: list[str], seconds: float, warmup: float) -> dict:
     out = {}
     for case in cases:
         with tempfile.TemporaryDirectory() as d:
-            tape = slid(tutorial_run(case, seconds, Path(d))["tape"], REPLAY_SLIDE)
+            tape = tutorial_run(case, seconds, Path(d))["tape"]
             samples, sent = bare_run(tape, batch=True)
             page = analyse_bare(samples, sent, warmup)
             widget = analyse_widget(widget_run(tape, Path(d)), warmup)
