@@ -13,7 +13,14 @@ import zlib
 
 import pytest
 
-from benchmarks.experiments.browser import _match, analyse_bare, analyse_tutorial, bare_commands, since_frame_ms
+from benchmarks.experiments.browser import (
+    _match,
+    analyse_bare,
+    analyse_tutorial,
+    bare_commands,
+    publisher_rate_parameter,
+    since_frame_ms,
+)
 
 MS = 1_000_000  # ns
 
@@ -178,3 +185,10 @@ def test_page_cost_reads_only_the_page_main_threads_slices_of_a_trace():
     assert got["waiting for the GPU process (ReadPixels)"] == {"n": 2, "mean_ms": 7.5}
     assert got["animation-frame callbacks (meshcat's render)"] == {"n": 0, "mean_ms": None}
     assert main_thread_ms({}) == {label: {"n": 0, "mean_ms": None} for label in SLICES}
+
+
+def test_a_cases_publisher_rate_is_a_ros_double_and_slides_below_the_view_rate():
+    # 1 kHz as "1000" is an integer parameter, which rtt-run refuses for a double: the run would not start
+    assert publisher_rate_parameter(1000.0) == "RttJointStatePublisher.rate:=1000.0"
+    slid = float(publisher_rate_parameter(50.0).split(":=")[1])
+    assert 49.8 < slid < 50.0  # every 25th state one 1 ms step later: the states slide through the page's frame

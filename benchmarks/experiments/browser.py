@@ -275,6 +275,14 @@ def _wait(proc: subprocess.Popen, timeout: float) -> None:
         raise RuntimeError(f"{proc.args} exited {proc.returncode}: {proc.stderr.read()[-2000:]}")
 
 
+def publisher_rate_parameter(rate: float) -> str:
+    """The ``-p`` argument that sets a case's publisher rate (Hz) for its run: :data:`SLIDE` times slower
+    below :data:`VIEW_FRAME_RATE`, and always written as a ROS double (``1000.0``, never ``1000``: the
+    parameter is declared a double, and an integer is refused)."""
+    rate = float(rate if rate > VIEW_FRAME_RATE else rate / SLIDE)
+    return f"RttJointStatePublisher.rate:={rate!r}"
+
+
 def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True, query: str = "") -> dict:
     """One case through the tutorial: simulation, viewer, its page; the raw records of each.
 
@@ -283,7 +291,6 @@ def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True,
     triangle counts, :mod:`tutorial.view.meshcat_page`).
     """
     kind, size, rate = CASES[case]
-    rate = rate if rate > VIEW_FRAME_RATE else rate / SLIDE
     sim_project, view_project = (tanks_projects if kind == "tanks" else arm_projects)(size, directory)
     sim_probe, view_probe, tape = directory / "sim.json", directory / "view.json", directory / "tape.json"
     viewer = start(
@@ -300,7 +307,7 @@ def tutorial_run(case: str, seconds: float, directory: Path, batch: bool = True,
         page = Page(url + query)
         sim = start(
             py("tutorial.tools.rtt_run", str(sim_project), "--headless", "--duration", str(seconds), "--json")
-            + ["--ros-args", "-p", f"RttJointStatePublisher.rate:={rate:.6g}"],
+            + ["--ros-args", "-p", publisher_rate_parameter(rate)],
             sim_probe,
         )
         procs.append(sim)
