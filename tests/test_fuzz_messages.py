@@ -89,6 +89,13 @@ def world(*files, odometry=None):
     return model, data
 
 
+def configured(controller, name, model, data, output=lambda record: None) -> Body:
+    """``controller`` configured on the tank of ``model`` with a fake node; returns that body."""
+    body = Body(model, data, "Tank")
+    assert controller.configure(ControllerConfig(name=name, body=body, node=FakeNode(), output=output))
+    return body
+
+
 # ------------------------------------------------------------ Step 1: /joy
 def joys():
     from sensor_msgs.msg import Joy
@@ -105,8 +112,7 @@ def tank_controller():
 
     model, data = world(("Room", "room.xml"), ("Tank", "tank.xml"))
     controller = RttTankController()
-    body = Body(model, data, "Tank")
-    assert controller.configure(ControllerConfig(name="C", body=body, node=FakeNode(), output=lambda r: None))
+    body = configured(controller, "C", model, data)
     assert controller.initialize(ControllerIO(body=body, time_step=model.opt.timestep, node=None, data=data))
     return controller, model, data
 
@@ -160,8 +166,7 @@ def monitor():
     model, data = world(("Tank", "tank.xml"))
     records = []
     controller = RttJointStateMonitor()
-    body = Body(model, data, "Tank")
-    assert controller.configure(ControllerConfig(name="M", body=body, node=FakeNode(), output=records.append))
+    body = configured(controller, "M", model, data, records.append)
     return controller, body, records
 
 
@@ -245,8 +250,7 @@ def imu_viewer():
 
     model, data = world(("Tank", "tank.xml"))
     controller = RttImuStateSubscriber()
-    body = Body(model, data, "Tank")
-    assert controller.configure(ControllerConfig(name="I", body=body, node=FakeNode(), output=lambda r: None))
+    configured(controller, "I", model, data)
     return controller
 
 
@@ -292,8 +296,7 @@ def floating_base():
 
     model, data = world(("Tank", "tank.xml"), odometry="/Tank/odom")
     controller = FloatingBase("/Tank/odom")
-    body = Body(model, data, "Tank")
-    assert controller.configure(ControllerConfig(name="F", body=body, node=FakeNode(), output=lambda r: None))
+    configured(controller, "F", model, data)
     return controller
 
 
