@@ -233,7 +233,14 @@ def print_report(r: dict) -> None:
 
         print("\n== across hosts (two network namespaces; benchmarks.experiments.network)")
         print_table(r["network"])
+    print_targets(r)
+
+
+def print_targets(r: dict) -> None:
+    """Print a run's targets, one line each, and the experiments that failed, if any."""
     print("\n== targets")
+    for key, why in r.get("failed", {}).items():
+        print(f"  [FAIL] the {key} experiment failed; its targets read n/a. Its last words: {why.splitlines()[-1]}")
     for t in r["targets"]:
         figure = (
             t["measured"]

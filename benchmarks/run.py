@@ -56,6 +56,7 @@ import random
 import sys
 import tempfile
 import time
+import traceback
 from pathlib import Path
 
 from benchmarks.experiments.any_robot import measure as description_first_frame
@@ -74,8 +75,37 @@ from benchmarks.experiments.widget import remote as widget_remote
 from benchmarks.machine import probe as machine_probe
 from benchmarks.paths import BOOK_STATIC, RESULTS, ROOT
 from benchmarks.plots import plot_browser, plot_latency, plot_learners, plot_scale
-from benchmarks.report import print_report, runs_table, targets_markdown
-from benchmarks.targets import targets
+from benchmarks.report import print_report, print_targets, runs_table, targets_markdown
+from benchmarks.targets import partial, targets
+
+
+class Experiments:
+    """Runs a run's experiments one after the other into its results; one that fails does not end the run.
+
+    A full run is half an hour: an experiment that raises (a browser or a
+    hub that did not start in time) is noted in ``r["failed"]`` (the
+    traceback) and the run goes on, so the other figures are written; the
+    failed experiment's targets read n/a, a fail
+    (:func:`benchmarks.targets.targets`).  Ctrl-C still stops the run.
+    """
+
+    def __init__(self, r: dict):
+        self.r = r
+
+    def __call__(self, key: str, experiment, merge: bool = False) -> bool:
+        """Run ``experiment()`` into ``r[key]`` (``merge``: its keys into ``r``); False when it failed."""
+        try:
+            result = experiment()
+        except Exception:  # noqa: BLE001 - kept in the results and printed; the run goes on
+            why = traceback.format_exc()
+            self.r.setdefault("failed", {})[key] = why
+            print(f"\n{key}: the experiment FAILED, the run goes on without it:\n{why}", file=sys.stderr, flush=True)
+            return False
+        if merge:
+            self.r.update(result)
+        else:
+            self.r[key] = result
+        return True
 
 
 def _commit() -> str:
@@ -136,37 +166,45 @@ def main(argv=None) -> int:
         "commit": _commit(),
         "seconds_per_run": seconds,
         "rounds": rounds,
+        "quick": args.quick,  # a smoke test: its targets of sizes it did not run read n/a
         "load_average_at_start": [round(x, 2) for x in os.getloadavg()],
         "machine_at_start": machine_probe(),
     }
     pairs, other_pairs = (8, 8) if args.quick else (SPEED_PAIRS, SPEED_PAIRS_OTHER)
     rates = {"publisher_50Hz": 50.0, "publisher_every_step": 0.0}
-    r["simulation_speed"] = {
-        "tank": simulation_speed("project/step2.yaml", rates, pairs, 1000),
-        "arm24": simulation_speed("benchmarks/projects/arm_sim.yaml", rates, other_pairs, 1000),
-    }
-    r["realtime"] = realtime_mode("project/step2.yaml", 2.0 if args.quick else 5.0)
-    rclpy.try_shutdown()
-    r.update(latency_rounds(rounds, seconds, warmup))
-    r["scene_update"] = {
-        "tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
-        "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200),
-    }
-    r["startup"] = startup(1 if args.quick else 3)
-    r["any_robot"] = description_first_frame(1 if args.quick else 3)  # not a target: the Benchmarks page reports it
-    a = r["any_robot"]
-    print(
-        f"the Panda from its description, first frame after its arrival: cold {a['cold_median_s']} s, "
-        f"started again (cached) {a['restart_median_s']} s, second monitor {a['warm_median_s']} s",
-        flush=True,
+    measure = Experiments(r)
+    measure(
+        "simulation_speed",
+        lambda: {
+            "tank": simulation_speed("project/step2.yaml", rates, pairs, 1000),
+            "arm24": simulation_speed("benchmarks/projects/arm_sim.yaml", rates, other_pairs, 1000),
+        },
     )
-    r["late_join"] = late_join(4 if args.quick else 20, 4 if args.quick else 8, 5.0 if args.quick else 20.0)
-    with tempfile.TemporaryDirectory() as d:
-        r["scale"] = scale_curves(
-            seconds, warmup, 1 if args.quick else args.scale_rounds, 8 if args.quick else 20, Path(d)
+    measure("realtime", lambda: realtime_mode("project/step2.yaml", 2.0 if args.quick else 5.0))
+    rclpy.try_shutdown()
+    measure("pipeline", lambda: latency_rounds(rounds, seconds, warmup), merge=True)  # pipeline, bare, ...
+    measure(
+        "scene_update",
+        lambda: {
+            "tank": scene_update_cost("model/tank.xml", 30 if args.quick else 200),
+            "arm24": scene_update_cost("model/arm24.xml", 30 if args.quick else 200),
+        },
+    )
+    measure("startup", lambda: startup(1 if args.quick else 3))
+    if measure("any_robot", lambda: description_first_frame(1 if args.quick else 3)):  # not a target
+        a = r["any_robot"]
+        print(
+            f"the Panda from its description, first frame after its arrival: cold {a['cold_median_s']} s, "
+            f"started again (cached) {a['restart_median_s']} s, second monitor {a['warm_median_s']} s",
+            flush=True,
         )
-    r["browser"] = pixel_latency(list(BROWSER_CASES), seconds, warmup)
-    r["widget"] = widget_vs_page(list(WIDGET_CASES), seconds, warmup)
+    late = (4, 4, 5.0) if args.quick else (20, 8, 20.0)  # starts, idle participants, idle seconds
+    measure("late_join", lambda: late_join(*late))
+    with tempfile.TemporaryDirectory() as d:
+        scale_rounds = 1 if args.quick else args.scale_rounds
+        measure("scale", lambda: scale_curves(seconds, warmup, scale_rounds, 8 if args.quick else 20, Path(d)))
+    measure("browser", lambda: pixel_latency(list(BROWSER_CASES), seconds, warmup))
+    measure("widget", lambda: widget_vs_page(list(WIDGET_CASES), seconds, warmup))
     from tutorial.network.hosts import why_unavailable
 
     hosts_problem = why_unavailable()
@@ -174,24 +212,38 @@ def main(argv=None) -> int:
         r["network_skipped"] = hosts_problem
         print(f"across hosts: skipped ({hosts_problem})", flush=True)
     else:
-        r["network"] = across_hosts(6.0 if args.quick else 14.0)
-        r["widget_remote"] = widget_remote(5.0)
-    r["learners"] = learners_per_server((1, 2) if args.quick else LEARNERS, 8.0 if args.quick else 20.0, warmup + 1.0)
+        measure("network", lambda: across_hosts(6.0 if args.quick else 14.0))
+        measure("widget_remote", lambda: widget_remote(5.0))
+    learners = (1, 2) if args.quick else LEARNERS
+    measure("learners", lambda: learners_per_server(learners, 8.0 if args.quick else 20.0, warmup + 1.0))
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
     r["machine_at_end"] = machine_probe()
     r["targets"] = targets(r)
-    print_report(r)
-    r["plots"] = [
-        str(plot_scale(r, plots / "bench_scale.png")),
-        str(plot_latency(r, plots / "bench_latency.png")),
-        str(plot_browser(r, plots / "bench_browser.png")),
-        str(plot_learners(r, plots / "bench_learners.png")),
-    ]
+    try:
+        print_report(r)
+    except Exception:  # noqa: BLE001 - re-raised unless this run lacks figures on purpose or after a failure
+        if not partial(r):
+            raise
+        print("\n(the figures stop at the first one this run lacks; all that were measured are in the results)")
+        print_targets(r)
+    r["plots"] = []
+    for plot, name in (
+        (plot_scale, "bench_scale.png"),
+        (plot_latency, "bench_latency.png"),
+        (plot_browser, "bench_browser.png"),
+        (plot_learners, "bench_learners.png"),
+    ):
+        try:
+            r["plots"].append(str(plot(r, plots / name)))
+        except Exception:  # noqa: BLE001 - as above
+            if not partial(r):
+                raise
+            print(f"{name}: not drawn, this run lacks figures it shows", flush=True)
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(r, indent=1))
     (out.parent / "targets.md").write_text(targets_markdown(r))
-    print(f"\nwritten to {out}, {out.parent / 'targets.md'}; plots: {', '.join(r['plots'])}")
+    print(f"\nwritten to {out}, {out.parent / 'targets.md'}; plots: {', '.join(r['plots']) or 'none'}")
     return 0 if all(t["pass"] for t in r["targets"]) else 1
 
 

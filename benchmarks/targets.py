@@ -30,6 +30,12 @@ def read(*keys: str) -> Callable[[dict], object]:
     return lambda r: reduce(operator.getitem, keys, r)
 
 
+def partial(r: dict) -> bool:
+    """Whether run results ``r`` may lack figures: an experiment failed (``r["failed"]``), or the run was
+    ``--quick`` (fewer sizes: no class of 8 learners)."""
+    return bool(r.get("failed") or r.get("quick"))
+
+
 @dataclass(frozen=True)
 class Target:
     """One target: a figure of a run, its limit, and how the two are compared and written.
@@ -74,14 +80,24 @@ class Target:
         return self.fmt(value) if callable(self.fmt) else self.fmt.format(value)
 
     def row(self, r: dict) -> dict:
-        """The table's row for run results ``r``: target, measured, baseline, ratio (text) and pass (bool)."""
-        value = self.figure(r)
-        base = None if self.baseline is None else self.baseline(r)
-        if self.ratio is not None:
-            ratio = self.ratio(r)
-        elif value is None or base is None:
-            ratio = None
-        else:  # the figure to its baseline, or to its bound when that is the limit plus the baseline
+        """The table's row for run results ``r``: target, measured, baseline, ratio (text) and pass (bool).
+
+        In a :func:`partial` run, a target whose figures it lacks reads
+        "n/a": a fail, never left out.
+
+        Raises:
+            KeyError, TypeError: a figure is missing from a full run where no experiment failed.
+        """
+        try:
+            value = self.figure(r)
+            base = None if self.baseline is None else self.baseline(r)
+            ratio = self.ratio(r) if self.ratio is not None else None
+        except (KeyError, TypeError):
+            if not partial(r):
+                raise
+            return {"target": self.label, "measured": "n/a", "baseline": "", "ratio": "", "pass": False}
+        if self.ratio is None and value is not None and base is not None:
+            # the figure to its baseline, or to its bound when that is the limit plus the baseline
             ratio = value / (self.limit + base if self.against == "plus" else base)
         held = ratio if self.against == "ratio" else value
         if base is None and self.against in ("times", "plus"):
@@ -433,5 +449,10 @@ TARGETS = (
 
 
 def targets(r: dict) -> list[dict]:
-    """Each target's row for run results ``r``: its text, the measured figure, the same-run baseline, ratio, pass."""
-    return [t.row(r) for t in TARGETS if t.needs is None or r.get(t.needs)]
+    """Each target's row for run results ``r``: its text, the measured figure, the same-run baseline, ratio, pass.
+
+    A target whose experiment did not run (``needs``: across hosts without
+    root) is left out; one whose experiment failed (``r["failed"]``) is a fail.
+    """
+    failed = r.get("failed", {})
+    return [t.row(r) for t in TARGETS if t.needs is None or r.get(t.needs) or t.needs in failed]

@@ -9,6 +9,7 @@ Every wait has a deadline.  One thread per object.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -20,6 +21,7 @@ import time
 import uuid
 from pathlib import Path
 
+import psutil
 import requests
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -98,7 +100,13 @@ class Hub:
         return self.log_path.read_text(errors="replace")
 
     def close(self) -> None:
-        """Stop the hub, its proxy and every learner's server (the whole session)."""
+        """Stop the hub, its proxy, every learner's server and every kernel those started."""
+        # The kernels run in sessions of their own, out of reach of the hub's group: noted now,
+        # while they are still the servers' children, and stopped by their ids at the end.
+        # (psutil.Process checks the start time too, so a reused id is never hit.)
+        descendants: list[psutil.Process] = []
+        with contextlib.suppress(psutil.Error):
+            descendants = psutil.Process(self.proc.pid).children(recursive=True)
         if self.proc.poll() is None:
             os.killpg(self.proc.pid, signal.SIGTERM)
             try:
@@ -110,6 +118,11 @@ class Hub:
             os.killpg(self.proc.pid, signal.SIGKILL)  # a learner's server or kernel left in the session
         except ProcessLookupError:
             pass
+        left = [p for p in descendants if p.is_running()]
+        for p in left:
+            with contextlib.suppress(psutil.Error):
+                p.kill()
+        psutil.wait_procs(left, timeout=10)
         self._log.close()
 
 

@@ -133,3 +133,50 @@ def test_each_round_keeps_its_own_p50():
         None,
         0.15,
     ]
+
+
+def test_cross_process_ab_refuses_an_unknown_variant(capsys):
+    from benchmarks.experiments.cross_process import main
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["--variants", "bare,pipline"])
+    assert exit_.value.code == 2 and "unknown variants ['pipline']" in capsys.readouterr().err
+
+
+def test_an_experiment_that_fails_does_not_end_the_run(capsys):
+    """A full run is half an hour: one experiment's error is kept, the others' figures are not lost."""
+    from benchmarks.run import Experiments
+
+    r: dict = {}
+    measure = Experiments(r)
+
+    def hub_did_not_start():
+        raise TimeoutError("the hub did not answer")
+
+    assert measure("learners", hub_did_not_start) is False
+    assert measure("startup", lambda: {"median_s": 0.9}) is True
+    assert measure("pipeline", lambda: {"pipeline": {"a": 1}, "bare": {"a": 2}}, merge=True) is True
+    assert r["startup"] == {"median_s": 0.9} and r["pipeline"] == {"a": 1} and r["bare"] == {"a": 2}
+    assert "learners" not in r and "TimeoutError: the hub did not answer" in r["failed"]["learners"]
+    assert "learners: the experiment FAILED" in capsys.readouterr().err
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):  # Ctrl-C still stops the run
+        measure("scale", interrupted)
+
+
+def test_a_failed_experiments_targets_read_n_a_and_fail():
+    from benchmarks.targets import LEARNERS_TARGETS, TARGETS, targets
+
+    run = {"failed": {"learners": "Traceback ...\nTimeoutError"}}
+    rows = targets(run)
+    learners = [t.label for t in LEARNERS_TARGETS]
+    assert [row["target"] for row in rows if row["target"] in learners] == learners  # failed: in the table
+    assert all(row["measured"] == "n/a" and not row["pass"] for row in rows)  # nothing else was measured either
+    assert {row["target"] for row in rows} == {t.label for t in TARGETS if t.needs in (None, "learners")}
+    with pytest.raises(KeyError):  # no experiment failed: a missing figure is a bug, not an n/a
+        targets({})
+    quick = targets({"quick": True})  # a smoke test's run lacks sizes on purpose: n/a, fails
+    assert quick and all(row["measured"] == "n/a" and not row["pass"] for row in quick)

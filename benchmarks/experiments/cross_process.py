@@ -193,15 +193,22 @@ def _round_p50s(runs: list[dict]) -> list[float | None]:
     return [round(statistics.median(r["latency"]) * 1e-6, 4) if r["latency"] else None for r in runs]
 
 
-def bare_pair_run(rate: float, seconds: float, warmup: float, joints: int, executor: str = "single") -> dict:
+def bare_pair_run(
+    rate: float, seconds: float, warmup: float, joints: int, executor: str = "single", hand_off: bool = False
+) -> dict:
     """One run of the bare rclpy pair at the same rate, same message and QoS: raw samples.
 
     ``executor`` is the subscriber's: ``single`` (rclpy's default, the
     baseline) or ``events`` (the EventsExecutor, for comparison).
+    ``hand_off``: the subscriber notes each arrival on its main thread after
+    the tutorial's hand-off (``benchmarks.bare_pair --hand-off``), not a baseline.
     """
     with tempfile.TemporaryDirectory() as d:
         probe = Path(d) / "bare.json"
-        sub = start(py("benchmarks.bare_pair", "sub", "--duration", str(seconds + 8.0), "--executor", executor), probe)
+        sub_cmd = py("benchmarks.bare_pair", "sub", "--duration", str(seconds + 8.0), "--executor", executor)
+        if hand_off:
+            sub_cmd.append("--hand-off")
+        sub = start(sub_cmd, probe)
         time.sleep(1.0)  # not synchronisation: the subscriber starts first so it misses nothing
         pub = start(
             py("benchmarks.bare_pair", "pub", "--rate", str(rate), "--duration", str(seconds), "--joints", str(joints))
@@ -259,3 +266,59 @@ def latency_rounds(rounds: int, seconds: float, warmup: float) -> dict:
             out["bare_events_executor"][key] = pool_bare(events_runs, rate)
             out["pipeline_events_executor"][key] = pool_pipeline(pipe_events_runs, rate)
     return out
+
+
+VARIANTS = ("bare", "bare_hand_off", "pipeline", "pipeline_headless")
+
+
+def main(argv=None) -> int:
+    """An A/B at 1 kHz, not part of ``make bench``: the variants alternate, round after round.
+
+    ``bare`` is the targets' baseline, ``bare_hand_off`` the same pair with
+    the tutorial's hop to the main thread, ``pipeline`` the simulation and
+    the Step 3 viewer (``pipeline_headless``: its view not drawn).  Prints
+    each round's latency p50 and p99 and, at the end, the pooled figures.
+    Run it alone on the machine.
+    """
+    import argparse
+    import os
+
+    from tutorial.ros import env as ros_env
+
+    p = argparse.ArgumentParser(description=main.__doc__.splitlines()[0])
+    p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--seconds", type=float, default=8.0)
+    p.add_argument("--variants", default="bare,bare_hand_off,pipeline", help=f"comma-separated: {', '.join(VARIANTS)}")
+    args = p.parse_args(argv)
+    variants = args.variants.split(",")
+    unknown = sorted(set(variants) - set(VARIANTS))
+    if unknown:
+        p.error(f"unknown variants {unknown}: use {', '.join(VARIANTS)}")
+    ros_env.use_localhost_by_default()
+    if "ROS_DOMAIN_ID" not in os.environ:
+        p.error("set ROS_DOMAIN_ID to a domain of your own (this A/B publishes at 1 kHz)")
+    _, sim_project, view_project, rate, joints = next(r for r in LATENCY_RUNS if r[0] == "tank_1kHz")
+    samples: dict[str, list[list[int]]] = {v: [] for v in variants}
+    for i in range(args.rounds):
+        for v in variants:
+            if v.startswith("bare"):
+                run = bare_pair_run(rate, args.seconds, 1.0, joints, hand_off=v == "bare_hand_off")
+                more = ""
+            else:
+                headless = v.endswith("headless")
+                run = pipeline_run(sim_project, view_project, rate, args.seconds, 1.0, headless_view=headless)
+                s2c, c2a = pct(run["step_to_callback"], 1e-6), pct(run["callback_to_applied"], 1e-6)
+                more = f"  step -> callback p50 {s2c['p50']:.3f}, callback -> applied p50 {c2a['p50']:.3f}"
+            samples[v].append(run["latency"])
+            lat = pct(run["latency"], 1e-6)
+            figures = f"p50 {lat['p50']:.3f} ms  p99 {lat['p99']:.3f} ms  n {lat['n']}"
+            print(f"round {i + 1} {v:18s} {figures}{more}", flush=True)
+    for v in variants:
+        lat = pct([x for r in samples[v] for x in r], 1e-6)
+        rounds = ", ".join(f"{pct(r, 1e-6)['p50']:.3f}" for r in samples[v])
+        print(f"pooled  {v:18s} p50 {lat['p50']:.3f} ms  p99 {lat['p99']:.3f} ms  (rounds' p50: {rounds})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
