@@ -2,22 +2,36 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
 import pytest
 
-from benchmarks.experiments.cross_process import bare_pair_run
 from benchmarks.paths import ROOT
+from benchmarks.procs import finish, py, start
 
 pytestmark = pytest.mark.cross_process
 
 
-def test_bare_pair_with_the_hand_off_notes_every_state_on_its_main_thread():
+def test_bare_pair_with_the_hand_off_notes_every_state_on_its_main_thread(tmp_path):
     """The A/B's ``bare_hand_off`` variant: the states arrive through the SpinThread and the hand-off."""
-    run = bare_pair_run(rate=200.0, seconds=2.0, warmup=0.2, joints=2, hand_off=True)
-    assert run["received"] >= 200, run["received"]  # about 400 sent; discovery may eat the first ones
-    assert len(run["latency"]) > 0 and min(run["latency"]) > 0  # noted after the stamp, on this host's clock
+    probe = tmp_path / "bare.json"
+    sub, pub = start(py("benchmarks.bare_pair", "sub", "--duration", "4", "--hand-off"), probe), None
+    try:
+        pub = start(py("benchmarks.bare_pair", "pub", "--rate", "200.0", "--duration", "2.5"))
+        finish(pub, 30)
+        finish(sub, 30)
+    finally:
+        for proc in (sub, pub):
+            if proc is not None and proc.poll() is None:
+                proc.kill()
+                proc.wait(10)
+    received = json.loads(probe.read_text())["received"]
+    assert len(received) >= 200, len(received)  # 500 sent; discovery may eat the first ones
+    assert all(noted > stamp for stamp, noted in received)  # noted after the stamp, on this host's clock
+    stamps = [stamp for stamp, _ in received]
+    assert stamps == sorted(set(stamps))  # in order, none twice (the hand-off may drop a state, never repeat one)
 
 
 def test_bare_pair_refuses_the_hand_off_where_it_means_nothing():
