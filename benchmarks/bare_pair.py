@@ -58,15 +58,15 @@ def main() -> int:
     ros_env.use_localhost_by_default()
     rclpy.init()
     node = rclpy.create_node(f"bare_{args.role}")
+    spin = executor = None  # with --hand-off the node's SpinThread makes its own executor
     if args.executor == "events":
         from rclpy.experimental import EventsExecutor
 
         executor = EventsExecutor()
-    else:
+    elif not args.hand_off:
         executor = SingleThreadedExecutor()
-    if not args.hand_off:  # with --hand-off the node's SpinThread makes its own executor
+    if executor is not None:
         executor.add_node(node)
-    spin = None
     log: list[tuple[int, int]] = []
     if args.role == "pub":
         pub = node.create_publisher(JointState, TOPIC, joint_state_qos())
@@ -104,10 +104,11 @@ def main() -> int:
     try:
         if spin is not None:
             spin.start()
-            while time.monotonic() < end:
-                loop.run_once(0.05)
         while time.monotonic() < end:
-            executor.spin_once(timeout_sec=0.05)
+            if spin is not None:
+                loop.run_once(0.05)
+            else:
+                executor.spin_once(timeout_sec=0.05)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

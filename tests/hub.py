@@ -24,6 +24,8 @@ from pathlib import Path
 import psutil
 import requests
 
+from tests.jupyterlab import stop_left
+
 ROOT = Path(__file__).resolve().parent.parent
 PASSWORD = "tanktutorial-test"
 
@@ -103,7 +105,6 @@ class Hub:
         """Stop the hub, its proxy, every learner's server and every kernel those started."""
         # The kernels run in sessions of their own, out of reach of the hub's group: noted now,
         # while they are still the servers' children, and stopped by their ids at the end.
-        # (psutil.Process checks the start time too, so a reused id is never hit.)
         descendants: list[psutil.Process] = []
         with contextlib.suppress(psutil.Error):
             descendants = psutil.Process(self.proc.pid).children(recursive=True)
@@ -118,11 +119,7 @@ class Hub:
             os.killpg(self.proc.pid, signal.SIGKILL)  # a learner's server or kernel left in the session
         except ProcessLookupError:
             pass
-        left = [p for p in descendants if p.is_running()]
-        for p in left:
-            with contextlib.suppress(psutil.Error):
-                p.kill()
-        psutil.wait_procs(left, timeout=10)
+        stop_left(descendants)
         self._log.close()
 
 

@@ -172,16 +172,7 @@ class JupyterLab:
                 os.killpg(self.proc.pid, signal.SIGKILL)
                 self.proc.wait(10)
         # The kernels run in sessions of their own: whatever outlived the server is stopped by its id.
-        # (psutil.Process checks the start time too, so a reused id is never hit.)
-        left = [p for p in self._descendants.values() if p.is_running()]
-        for p in left:
-            with contextlib.suppress(psutil.Error):
-                p.terminate()
-        _, alive = psutil.wait_procs(left, timeout=5)
-        for p in alive:
-            with contextlib.suppress(psutil.Error):
-                p.kill()
-        psutil.wait_procs(alive, timeout=5)
+        stop_left(self._descendants.values())
         shutil.rmtree(self._tmp, ignore_errors=True)
 
     def __enter__(self) -> JupyterLab:
@@ -189,6 +180,24 @@ class JupyterLab:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def stop_left(processes) -> None:
+    """Stop those of ``processes`` (``psutil.Process``) still running: SIGTERM, then SIGKILL after 5 s.
+
+    For processes that outlive the process group they were started in (a
+    kernel runs in a session of its own).  ``psutil.Process`` checks the
+    start time too, so an id the system has reused is never hit.
+    """
+    left = [p for p in processes if p.is_running()]
+    for p in left:
+        with contextlib.suppress(psutil.Error):
+            p.terminate()
+    _, alive = psutil.wait_procs(left, timeout=5)
+    for p in alive:
+        with contextlib.suppress(psutil.Error):
+            p.kill()
+    psutil.wait_procs(alive, timeout=5)
 
 
 @contextlib.contextmanager

@@ -298,7 +298,7 @@ def main(argv=None) -> int:
     if "ROS_DOMAIN_ID" not in os.environ:
         p.error("set ROS_DOMAIN_ID to a domain of your own (this A/B publishes at 1 kHz)")
     _, sim_project, view_project, rate, joints = next(r for r in LATENCY_RUNS if r[0] == "tank_1kHz")
-    samples: dict[str, list[list[int]]] = {v: [] for v in variants}
+    runs: dict[str, list[dict]] = {v: [] for v in variants}
     for i in range(args.rounds):
         for v in variants:
             if v.startswith("bare"):
@@ -309,13 +309,13 @@ def main(argv=None) -> int:
                 run = pipeline_run(sim_project, view_project, rate, args.seconds, 1.0, headless_view=headless)
                 s2c, c2a = pct(run["step_to_callback"], 1e-6), pct(run["callback_to_applied"], 1e-6)
                 more = f"  step -> callback p50 {s2c['p50']:.3f}, callback -> applied p50 {c2a['p50']:.3f}"
-            samples[v].append(run["latency"])
+            runs[v].append(run)
             lat = pct(run["latency"], 1e-6)
             figures = f"p50 {lat['p50']:.3f} ms  p99 {lat['p99']:.3f} ms  n {lat['n']}"
             print(f"round {i + 1} {v:18s} {figures}{more}", flush=True)
     for v in variants:
-        lat = pct([x for r in samples[v] for x in r], 1e-6)
-        rounds = ", ".join(f"{pct(r, 1e-6)['p50']:.3f}" for r in samples[v])
+        lat = pct([x for r in runs[v] for x in r["latency"]], 1e-6)
+        rounds = ", ".join(f"{p50:.3f}" for p50 in _round_p50s(runs[v]))
         print(f"pooled  {v:18s} p50 {lat['p50']:.3f} ms  p99 {lat['p99']:.3f} ms  (rounds' p50: {rounds})")
     return 0
 
