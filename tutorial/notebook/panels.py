@@ -18,6 +18,7 @@ accepts from any thread).
 from __future__ import annotations
 
 import html
+import threading
 
 
 class Panel:
@@ -39,6 +40,11 @@ class Panel:
         self.line = w.HTML()
         self.controls: list = []
         self.closed = False
+        # Two threads write the status line: the kernel thread (close(), a panel's first refresh) and a run's
+        # owner thread (each new status).  Each write reads the state it shows under this lock, so the write
+        # that lands last shows the newest state: without it, a refresh that read "starting" could land after
+        # the owner's "running" and the line would say "starting" for good.
+        self._lock = threading.Lock()
 
     def say(self, text: str, warning: bool = False) -> None:
         """Set the status line (kernel thread, or any thread that owns no widget lock)."""
@@ -58,12 +64,13 @@ class Panel:
 
     def close(self, why: str = "closed by reset(): run this cell again to use it") -> None:
         """Disable the controls and say why (kernel thread)."""
-        if self.closed:
-            return
-        self.closed = True
-        for c in self.controls:
-            c.disabled = True
-        self.say(why)
+        with self._lock:
+            if self.closed:
+                return
+            self.closed = True
+            for c in self.controls:
+                c.disabled = True
+            self.say(why)
 
 
 class RunControls(Panel):
@@ -83,7 +90,6 @@ class RunControls(Panel):
         self.stop.on_click(lambda _: run.stop())
         self.controls = [self.start, self.stop]
         self.widget = w.HBox([self.start, self.stop, self.line])
-        self.refresh()
 
     def _start(self) -> None:
         try:
@@ -92,12 +98,13 @@ class RunControls(Panel):
             self.say(str(exc), warning=True)
 
     def refresh(self) -> None:
-        """Show the run's status; Start is enabled only when it is not running."""
-        if self.closed:
-            return
-        status = self.run.status
-        # From the status, not from the thread: the owner thread reports "finished" while it is still alive.
-        active = status in ("starting", "running")
-        self.start.disabled = active
-        self.stop.disabled = not active
-        self.say(f"/{self.run.node_name}: {status}", warning=status.startswith("failed"))
+        """Show the run's status; Start is enabled only when it is not running (any thread)."""
+        with self._lock:
+            if self.closed:
+                return
+            status = self.run.status
+            # From the status, not from the thread: the owner thread reports "finished" while it is still alive.
+            active = status in ("starting", "running")
+            self.start.disabled = active
+            self.stop.disabled = not active
+            self.say(f"/{self.run.node_name}: {status}", warning=status.startswith("failed"))

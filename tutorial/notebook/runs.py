@@ -361,7 +361,10 @@ class BackgroundApp:
         from tutorial.notebook.panels import RunControls
 
         panel = RunControls(self)
+        # Listed first, then drawn: a status the owner thread sets from here on reaches the panel, and
+        # one it set before is what refresh() reads (the panel's lock orders the two writes).
         self._panels.append(panel)
+        panel.refresh()
         return panel
 
     def stop(self, timeout: float = 10.0) -> dict | None:
