@@ -134,6 +134,7 @@ def nodes(procs):
     started.close()
 
 
+@pytest.mark.more  # make test: the recorder killed; a viewer says stale in test_bag_replay
 def test_simulation_killed_the_viewer_says_stale_and_recovers_with_a_new_one(nodes):
     view = nodes.viewer()
     sim = nodes.simulation()
@@ -154,6 +155,7 @@ def test_simulation_killed_the_viewer_says_stale_and_recovers_with_a_new_one(nod
     assert nodes.stop(view) == 0, view.err
 
 
+@pytest.mark.more  # make test: a monitor joining a running publisher, test_step3_cross_process
 def test_viewer_killed_and_restarted_mirrors_again(nodes):
     sim = nodes.simulation()
     first = nodes.viewer()
@@ -193,6 +195,7 @@ def test_two_publishers_on_the_topic_are_warned_about(nodes):
     assert wait_until(lambda: publishers_seen(view) == 1, timeout=30), view.out
 
 
+@pytest.mark.more  # make test: the safe stop across a partition, test_network
 def test_joy_killed_mid_drive_the_tank_stops(nodes, node):
     """SIGKILL ``rtt-joy`` while the demo drives forward at 0.8 m/s: after the
     joy timeout (0.5 s of simulated time) the tank's root moves less than 0.1 m."""

@@ -4,7 +4,8 @@
 teacher's ``course/`` is never touched); the fake submissions start from
 the release, as a learner's would:
 
-- the stubs as released: 0 points;
+- the stubs as released: 0 points (``make test-grade``; ``make test`` has
+  them only with the checks edited, below);
 - the worked solutions pasted in: full points;
 - each wrong answer of tests/test_exercises.py ``MISTAKES`` (the solution
   with one mistake): it loses exactly its own exercise's points, no other;
@@ -93,20 +94,22 @@ def exercises_of(name: str) -> list[str]:
 def submissions(course: Path, name: str, every_mistake: bool = True) -> dict[str, tuple[dict, dict[str, float]]]:
     """The fake submissions of ``name``: each one's notebook and the points each exercise must get.
 
-    ``every_mistake``: every wrong answer of ``MISTAKES``; else the first one only.
+    ``every_mistake``: every wrong answer of ``MISTAKES``, and the stubs alone; else the first wrong answer only.
     """
     solved = solution_of(course, name)
     numbers = exercises_of(name)
     full = {n: float(assignments.POINTS[n]) for n in numbers}
     zero = dict.fromkeys(numbers, 0.0)
     out = {
-        "stubs": (submission(course, name, {}), zero),
         "solutions": (submission(course, name, solved), full),
+        # the stubs with every check edited to pass: 0 only if nbgrader put the checks back and the stubs fail them
         "check-edited": (
             submission(course, name, {}, {f"check_{n.replace('.', '_')}": "pass  # always passes" for n in numbers}),
             zero,
         ),
     }
+    if every_mistake:  # the stubs alone as well (make test-grade); make test's check-edited already holds them to 0
+        out["stubs"] = (submission(course, name, {}), zero)
     first = numbers[0]
     gid = f"exercise_{first.replace('.', '_')}"
     # the answer never returns: every function and method it defines starts with an endless loop

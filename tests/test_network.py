@@ -153,6 +153,7 @@ def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa:
     assert summary["controllers"]["RttTankController"]["joy_received"] > 10  # the operator's Joy crossed the link
 
 
+@pytest.mark.more  # make test: notebook 08's static peers (nbval)
 def test_no_multicast_static_peers_find_the_robot(procs, net):  # noqa: F811 - the fixture
     robot, operator = net["robot"], net["operator"]
     robot.block_multicast()
@@ -171,6 +172,7 @@ def test_no_multicast_static_peers_find_the_robot(procs, net):  # noqa: F811 - t
     assert wait_until(lambda: publishers_seen(view) == 1, timeout=10), view.out
 
 
+@pytest.mark.more  # make test: notebook 08's static peers, the other way without multicast
 def test_no_multicast_discovery_server(procs, net):  # noqa: F811 - the fixture
     robot, operator = net["robot"], net["operator"]
     robot.block_multicast()
@@ -188,6 +190,7 @@ def test_no_multicast_discovery_server(procs, net):  # noqa: F811 - the fixture
     assert sim.p.poll() is None
 
 
+@pytest.mark.more  # make test: notebook 08's 5 Mbit/s link (nbval)
 def test_on_a_5_mbit_link_the_compressed_camera_and_the_states_arrive(procs, net):  # noqa: F811 - the fixture
     """The issue's case: a thin link, the camera on. The compressed pictures fit, the states stay live."""
     robot, operator = net["robot"], net["operator"]

@@ -174,6 +174,7 @@ def test_a_second_node_with_the_same_name_is_warned_about(procs):
         assert "2 nodes are named /rtt" in json.loads(first)["message"], p.out
 
 
+@pytest.mark.more  # make test: a second node with the same name is warned about
 def test_distinct_names_give_no_warning(procs):
     a = viewer(procs, "project/step3.yaml", "rtt_a", "--duration", "5")
     b = viewer(procs, "project/step3.yaml", "rtt_b", "--duration", "5")
@@ -181,6 +182,7 @@ def test_distinct_names_give_no_warning(procs):
     assert a.records("warning") == [] and b.records("warning") == []
 
 
+@pytest.mark.more  # make test: gymnasium's ant across processes, test_third_party_models
 def test_any_model_publishes_and_shows_its_own_joints(procs):
     view = viewer(procs, "tests/fixtures/crane_view.yaml")
     # 5 s: long enough that the two nodes have found each other well before the final
