@@ -74,7 +74,11 @@ class Panel:
 
 
 class RunControls(Panel):
-    """Start and Stop buttons for a :class:`tutorial.notebook.runs.BackgroundApp`, with its status."""
+    """Start and Stop buttons for a :class:`tutorial.notebook.runs.BackgroundApp`, with its status.
+
+    Made by ``BackgroundApp.controls()``, which lists the panel with the run and then calls
+    :meth:`refresh`, so the line shows every status from then on.
+    """
 
     def __init__(self, run):
         import ipywidgets as w
