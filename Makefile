@@ -9,7 +9,7 @@
 #       make mutate (mutation testing of the lessons and the library's core: about 25 minutes),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
-#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about a minute),
+#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 40 s),
 #       make test-hub (the hub with learners as Unix users: slow), make test-robots (the UR5, SO-100 and Go2 in Chromium),
 #       make assignments (the class's nbgrader assignments from the notebooks, into course/),
 #       make grade (collect, autograde, feedback and course/grades.csv), make test-grade (every assignment graded),
@@ -81,7 +81,7 @@ mutate: $(VENV)/.installed
 	$(PY) scripts/mutation_report.py
 
 # The cases make test leaves out to stay under 10 minutes, each of a kind make test keeps one real case of
-# (marked "more": more faults, more network set-ups, more step 3 cases): about a minute.
+# (marked "more": two more faults, two more network set-ups, one more robot across processes): about 40 s.
 test-more: $(VENV)/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m more -q

@@ -134,7 +134,9 @@ def nodes(procs):
     started.close()
 
 
-@pytest.mark.more  # make test: the recorder killed; a viewer says stale in test_bag_replay
+# make test keeps the recorder killed; a stale viewer only at the end of a playback (test_bag_replay) and the
+# stale timer alone (test_step3_monitor), not after a kill
+@pytest.mark.more
 def test_simulation_killed_the_viewer_says_stale_and_recovers_with_a_new_one(nodes):
     view = nodes.viewer()
     sim = nodes.simulation()
@@ -195,7 +197,6 @@ def test_two_publishers_on_the_topic_are_warned_about(nodes):
     assert wait_until(lambda: publishers_seen(view) == 1, timeout=30), view.out
 
 
-@pytest.mark.more  # make test: the safe stop across a partition, test_network
 def test_joy_killed_mid_drive_the_tank_stops(nodes, node):
     """SIGKILL ``rtt-joy`` while the demo drives forward at 0.8 m/s: after the
     joy timeout (0.5 s of simulated time) the tank's root moves less than 0.1 m."""

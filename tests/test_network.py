@@ -172,7 +172,6 @@ def test_no_multicast_static_peers_find_the_robot(procs, net):  # noqa: F811 - t
     assert wait_until(lambda: publishers_seen(view) == 1, timeout=10), view.out
 
 
-@pytest.mark.more  # make test: notebook 08's static peers, the other way without multicast
 def test_no_multicast_discovery_server(procs, net):  # noqa: F811 - the fixture
     robot, operator = net["robot"], net["operator"]
     robot.block_multicast()

@@ -174,7 +174,6 @@ def test_a_second_node_with_the_same_name_is_warned_about(procs):
         assert "2 nodes are named /rtt" in json.loads(first)["message"], p.out
 
 
-@pytest.mark.more  # make test: a second node with the same name is warned about
 def test_distinct_names_give_no_warning(procs):
     a = viewer(procs, "project/step3.yaml", "rtt_a", "--duration", "5")
     b = viewer(procs, "project/step3.yaml", "rtt_b", "--duration", "5")

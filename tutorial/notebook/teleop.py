@@ -95,10 +95,13 @@ class TeleopPanel(Panel):
         listeners = self.publisher.get_subscription_count()
         if listeners != self._listeners:
             self._listeners = listeners
-            if listeners:
-                self.say(f"publishing {joy.TOPIC} at {joy.AUTOREPEAT:.0f} Hz to {listeners} subscriber(s)")
-            else:
-                self.say(f"nothing subscribes to {joy.TOPIC}: start the simulation to drive", warning=True)
+            with self._lock:  # the panel's lock (Panel): close() on the kernel thread may have said why meanwhile
+                if self.closed:
+                    return
+                if listeners:
+                    self.say(f"publishing {joy.TOPIC} at {joy.AUTOREPEAT:.0f} Hz to {listeners} subscriber(s)")
+                else:
+                    self.say(f"nothing subscribes to {joy.TOPIC}: start the simulation to drive", warning=True)
 
     def release(self) -> None:
         """All sticks back to the centre (kernel thread)."""
