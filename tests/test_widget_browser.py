@@ -6,7 +6,8 @@ meshcat's script when asked, the scene after the view's hello, frames.  So
 each message a view can be sent is tried exactly, and fast:
 
 - the scene and a frame draw (the box moves on the canvas);
-- every frame is answered with ``drawn``, and only after it was drawn;
+- every frame is answered with ``drawn``, and only after it was drawn: two
+  frames drawn together in one answer, a lone frame on its own;
 - a message it cannot take (a command that is not msgpack, an unknown
   command type, a buffer over the limit, a ``set_transforms`` to a path the
   scene does not have, a non-finite matrix) is named in the console, that
@@ -138,6 +139,25 @@ def test_scene_and_frames_draw_and_each_is_answered(view):
     moved = red_x(page)
     assert abs(moved - at_start) > 20, f"the box did not move: {at_start:.0f} -> {moved:.0f} px"
     assert not errors, errors
+
+
+def test_two_frames_drawn_together_are_answered_once_and_a_lone_frame_on_its_own(view):
+    page, errors = view
+    frame(page, [pack_batch([move(0.5)])])  # whatever was owed before is answered
+    page.wait_for_timeout(200)  # two animation frames at 60 Hz and more: no answer left owed
+    before = page.evaluate("window.sent.length")
+    page.evaluate(  # two frames in one task: drawn in the same animation frame
+        "([a, b]) => { for (const m of [a, b]) window.deliver({type: 'frame'}, "
+        "[new DataView(Uint8Array.from(atob(m), (c) => c.charCodeAt(0)).buffer)]); }",
+        b64([pack_batch([move(1.0)]), pack_batch([move(1.5)])]),
+    )
+    page.wait_for_function(f"window.sent.length > {before}", timeout=10_000)
+    page.wait_for_timeout(200)  # a second answer, were there one, would have come by now
+    answers = [m for m in page.evaluate("window.sent")[before:] if m["type"] == "drawn"]
+    assert answers == [{"type": "drawn", "frames": 2}], answers
+    stats = frame(page, [pack_batch([move(0.0)])])  # a lone frame: answered on its own
+    assert page.evaluate("window.sent")[-1] == {"type": "drawn", "frames": 1}
+    assert stats["dropped"] == 0 and not errors, errors
 
 
 @pytest.mark.parametrize(

@@ -105,6 +105,31 @@ def test_at_most_window_frames_in_flight_and_each_answer_lets_one_more_go():
     assert burst == WINDOW
 
 
+def test_an_answer_for_two_frames_lets_two_go_and_a_bad_count_counts_as_one(widget):
+    """A view answers two drawn frames at once ({"type": "drawn", "frames": 2}); its count is never trusted."""
+    vis = widget.visualizer()
+    vis["box"].set_object(g.Box([0.1, 0.2, 0.3]))
+    widget._on_message(widget, {"type": "hello", "id": "v1"}, [])
+    x = 0.0
+
+    def fill() -> int:  # new poses until the window is full: the frames sent
+        nonlocal x
+        before = len(widget.sent)
+        for _ in range(WINDOW + 2):
+            x += 1.0
+            vis["box"].set_transform(pose(x))
+        return len(widget.sent) - before
+
+    assert fill() == WINDOW - 1  # the scene is the window's first frame
+    widget._on_message(widget, {"type": "drawn", "frames": 2}, [])  # the newest pending pose goes at once
+    assert fill() == 1, "an answer for two frames let fewer than two go"
+    for bad in (0, -5, "2", 2.5, True, None, [2]):
+        widget._on_message(widget, {"type": "drawn", "frames": bad}, [])
+        assert fill() == 0, f"frames={bad!r} let more than one go"  # it counted one, sent with the answer
+    widget._on_message(widget, {"type": "drawn", "frames": 10**9}, [])
+    assert fill() == WINDOW - 1, "answers added up past the window"  # one went with the answer itself
+
+
 def test_a_frame_of_several_transforms_is_one_set_transforms_and_other_commands_keep_their_order():
     f = FrameFlow()
     opened(f)
@@ -199,8 +224,11 @@ def test_the_widget_answers_its_views(widget):
     widget._on_message(widget, {"type": "hello", "id": "v1"}, [])
     content, buffers = widget.sent[-1]
     assert content == {"type": "scene", "to": "v1"} and [c["type"] for c in unpack(buffers)] == ["set_object"]
-    vis["box"].set_transform(pose(1.0))  # the window has one frame left
+    vis["box"].set_transform(pose(1.0))  # the scene is in flight: the window has WINDOW - 1 frames left
     assert widget.sent[-1][0] == {"type": "frame", "n": 1}
+    for k in range(WINDOW - 2):
+        vis["box"].set_transform(pose(1.5 + k))
+    assert widget.sent[-1][0] == {"type": "frame", "n": WINDOW - 1}
     n = len(widget.sent)
     vis["box"].set_transform(pose(2.0))
     vis["box"].set_transform(pose(3.0))

@@ -1,6 +1,6 @@
 """Live 3D views over the notebook's own connection: a meshcat scene as a Jupyter widget.
 
 ``widget``  :class:`MeshcatWidget` (an anywidget whose view is meshcat's own page) and its meshcat window
-``flow``    :class:`FrameFlow`: coalescing, one frame in flight, the scene kept for views that open later
+``flow``    :class:`FrameFlow`: coalescing, a window of frames in flight, the scene kept for views that open later
 ``widget.js`` the browser's side
 """

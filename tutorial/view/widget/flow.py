@@ -12,13 +12,15 @@ animation frame of its own, and less on a slow machine or a slow link.
   than one command per path and property however long the browser is
   away, and what goes out is always the newest state, never a queue of
   old ones.
-- **it sends only what the browser can draw.**  A view answers each frame
-  with ``drawn`` once it has drawn it (its next animation frame).  The flow
-  keeps at most :data:`WINDOW` frames in flight: one being drawn, and the
-  next on its way, so the answer's trip back to the kernel does not halve
-  the frame rate.  A slow browser or link therefore gets fewer frames, each
-  the newest state; a tab that closed, or hid, gets nothing more until a
-  view says ``hello`` again.
+- **it sends only what the browser can draw.**  A view answers the frames
+  it has drawn with ``drawn`` (two at a time, or a lone one two animation
+  frames later: each message to the kernel costs it a busy and an idle
+  status on its connection).  The flow keeps at most :data:`WINDOW` frames
+  in flight: two drawn and not answered yet, and the next on its way, so
+  the answer's trip back to the kernel does not cut the frame rate.  A
+  slow browser or link therefore gets fewer frames, each the newest
+  state; a tab that closed, or hid, gets nothing more until a view says
+  ``hello`` again.
 - **it keeps the scene** (meshcat's server's tree,
   ``meshcat.servers.tree``) so that a view that opens later (a page reload,
   a second tab) is sent the whole current scene at once: :meth:`scene`.
@@ -43,7 +45,7 @@ import umsgpack
 
 from tutorial.view.meshcat_batch import pack_batch
 
-WINDOW = 2  # frames sent and not yet answered, at most
+WINDOW = 3  # frames sent and not yet answered, at most (a view answers two frames at a time)
 BUSY_RATE = 10.0  # frames/s sent while the kernel runs a cell (no answers can arrive then)
 BUSY_UNANSWERED = 600  # frames sent in a row with no answer, while busy, before the flow stops (a minute)
 KINDS = ("set_transform", "set_object", "set_property", "delete", "set_animation")
@@ -171,10 +173,10 @@ class FrameFlow:
         self.frames_sent += 1
         return out
 
-    def drawn(self) -> None:
-        """A view has drawn a frame it was sent: one more may go."""
+    def drawn(self, frames: int = 1) -> None:
+        """A view has drawn ``frames`` frames it was sent (at least 1): as many more may go, up to the window."""
         self.answers += 1
-        self._credit = min(self._credit + 1, WINDOW)
+        self._credit = min(self._credit + max(1, frames), WINDOW)
         self._unanswered = 0
 
     def scene(self, now: float) -> list[bytes]:

@@ -3,9 +3,12 @@
 // Each view is an <iframe srcdoc> holding meshcat's own page: meshcat's viewer script (sent once per
 // browser page by the kernel, gzip-compressed) and the project's page script (PAGE_SCRIPT: set_transforms,
 // lighter drawing without a GPU).  The kernel sends meshcat's own commands, packed with msgpack, as the
-// buffers of one widget message a frame.  The view answers each frame with "drawn" once the frame after
-// it has been drawn, which is what lets the kernel send the next: a slow browser gets fewer frames, never
-// a queue.  A view that opens (a page reload, a second tab) says "hello" and is sent the whole scene.
+// buffers of one widget message a frame.  The view answers the frames it has drawn with "drawn" (how
+// many), which is what lets the kernel send the next: a slow browser gets fewer frames, never a queue.
+// It answers two frames at a time, or a lone frame two animation frames after it was drawn: the kernel
+// publishes a busy and an idle status for every message it is sent, so an answer per frame would double
+// the traffic on the kernel's connection and slow the frames themselves (the Benchmarks page, "Live views
+// in the notebook").  A view that opens (a page reload, a second tab) says "hello" and is sent the whole scene.
 //
 // A message the view cannot take (not a meshcat command, a buffer over the limit, a set_transforms to a
 // path the scene does not have, a number that is not finite) is named in the console, and that frame is
@@ -196,17 +199,28 @@ function render({ model, el }) {
   // A benchmark's probe (benchmarks/experiments/widget.py sets window.rttProbe to an array): for each
   // frame, [its number, when it arrived, when it was drawn], on this page's clock, ms.
   const now = () => performance.timeOrigin + performance.now();
+  let owed = 0;  // frames drawn and not answered yet: at most one, for at most two animation frames
+  const settle = () => {
+    try {
+      if (!gone && owed > 0) model.send({ type: "drawn", frames: owed });
+    } catch (error) {
+      // cut off its kernel (restarted): nothing to answer; the comm_live_update watch says so
+    }
+    owed = 0;
+  };
   const answer = (n) => {
     const probe = Array.isArray(window.rttProbe) && n !== undefined ? [n, now(), null] : null;
     if (probe) window.rttProbe.push(probe);
     // Once the frame after this message has been drawn: meshcat draws in its animation frame, which it
     // asked for before this one, so it runs first.
-    frame.contentWindow.requestAnimationFrame(() => {
+    const view = frame.contentWindow;
+    view.requestAnimationFrame(() => {
       if (probe) probe[2] = now();
-      try {
-        if (!gone) model.send({ type: "drawn" });
-      } catch (error) {
-        // cut off its kernel (restarted): nothing to answer; the comm_live_update watch says so
+      owed += 1;
+      if (owed >= 2) {
+        settle();
+      } else {  // a lone frame: answered with the next one, or two animation frames from now
+        view.requestAnimationFrame(() => view.requestAnimationFrame(settle));
       }
     });
   };
