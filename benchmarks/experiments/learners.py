@@ -10,8 +10,9 @@ the tank driven by ``rtt-joy --demo``.  The benchmark's step clock and
 viewer probe (``benchmarks/probes.py``) ride along.  A learner's browser is
 on their laptop, so here each learner's views are a client that does not
 draw: it opens the kernel's WebSocket through the hub's proxy, says hello
-to each view as widget.js does, and answers every frame with ``drawn`` at
-once.  Its CPU is this machine's too, and is stated apart.
+to each view as widget.js does, and answers the frames with ``drawn`` as
+widget.js does (two at a time) as they arrive.  Its CPU is this machine's
+too, and is stated apart.
 
 Measured in a window common to every learner (after each has applied its
 first states and a warm-up, until the first simulation ends):
@@ -119,8 +120,9 @@ class ViewClient:
     """One learner's kernel WebSocket, through the hub's proxy: runs cells, and answers its live views.
 
     It acts as widget.js does without drawing: a view's ``hello`` on its
-    comm's opening, then ``drawn`` for each frame as it arrives.  Frames are
-    counted with their arrival times (monotonic ns).  One asyncio task.
+    comm's opening, then ``drawn`` for the frames as they arrive, two at a
+    time, a lone frame two 60 Hz frames later.  Frames are counted with their
+    arrival times (monotonic ns).  One asyncio task.
     """
 
     def __init__(self, url: str, token: str):
@@ -131,6 +133,8 @@ class ViewClient:
         self._waiting: dict[str, asyncio.Future] = {}
         self._out: dict[str, list[str]] = {}
         self._errors: dict[str, str] = {}
+        self._owed: dict[str, int] = {}  # comm id -> frames arrived and not answered yet
+        self._settling: set[asyncio.Task] = set()  # the late answers' tasks, kept until the client closes
         self._ws = None
 
     async def connect(self) -> None:
@@ -179,7 +183,12 @@ class ViewClient:
                 body = content["data"].get("content", {})
                 if body.get("type") == "frame":
                     self.frames.append((time.monotonic_ns(), size))
-                    await self._send(_custom(content["comm_id"], {"type": "drawn"}))
+                    comm = content["comm_id"]
+                    self._owed[comm] = self._owed.get(comm, 0) + 1
+                    if self._owed[comm] >= 2:
+                        await self._settle(comm)
+                    else:
+                        self._settle_later(comm)
                 elif body.get("type") == "scene":
                     self.scenes += 1
             elif parent in self._out and kind == "stream":
@@ -190,6 +199,16 @@ class ViewClient:
                 future = self._waiting.pop(parent)
                 if not future.done():
                     future.set_result(None)
+
+    def _settle_later(self, comm: str) -> None:
+        """Answer a lone frame as widget.js does: two animation frames (60 Hz) later, unless a second came."""
+        loop = asyncio.get_running_loop()
+        loop.call_later(2 / 60, lambda: self._settling.add(loop.create_task(self._settle(comm))))
+
+    async def _settle(self, comm: str) -> None:
+        owed, self._owed[comm] = self._owed.get(comm, 0), 0
+        if owed:
+            await self._send(_custom(comm, {"type": "drawn", "frames": owed}))
 
     async def close(self) -> None:
         if self._ws is not None:
