@@ -134,7 +134,7 @@ class ViewClient:
         self._out: dict[str, list[str]] = {}
         self._errors: dict[str, str] = {}
         self._owed: dict[str, int] = {}  # comm id -> frames arrived and not answered yet
-        self._settling: set[asyncio.Task] = set()  # the late answers' tasks, kept until the client closes
+        self._settling: set[asyncio.Task] = set()  # the late answers' tasks, each kept until it is done
         self._ws = None
 
     async def connect(self) -> None:
@@ -203,7 +203,13 @@ class ViewClient:
     def _settle_later(self, comm: str) -> None:
         """Answer a lone frame as widget.js does: two animation frames (60 Hz) later, unless a second came."""
         loop = asyncio.get_running_loop()
-        loop.call_later(2 / 60, lambda: self._settling.add(loop.create_task(self._settle(comm))))
+
+        def settle() -> None:
+            task = loop.create_task(self._settle(comm))
+            self._settling.add(task)
+            task.add_done_callback(self._settling.discard)
+
+        loop.call_later(2 / 60, settle)
 
     async def _settle(self, comm: str) -> None:
         owed, self._owed[comm] = self._owed.get(comm, 0), 0

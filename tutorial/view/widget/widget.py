@@ -174,8 +174,9 @@ class MeshcatWidget(anywidget.AnyWidget):
                 self.send({"type": "scene", "to": str(content.get("id", ""))}, self.flow.scene(time.monotonic()))
         elif kind == "drawn":
             frames = content.get("frames", 1)
-            # how many frames the view drew since its last answer; anything else counts as one (never trusted)
-            frames = frames if isinstance(frames, int) and not isinstance(frames, bool) and frames >= 1 else 1
+            # how many frames the view drew since its last answer (never trusted): not an int counts as one,
+            # and the flow takes at least one and at most its window
+            frames = frames if isinstance(frames, int) and not isinstance(frames, bool) else 1
             with self._lock:
                 self.flow.drawn(frames)
                 self._send_frame()
