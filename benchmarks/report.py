@@ -100,7 +100,8 @@ def print_report(r: dict) -> None:
                     f"{label} {s[k]} ({s[label + '_ratio']:.3f}x, 95% CI {lo:.3f}-{hi:.3f}, "
                     f"quartiles {q1:.2f}-{q3:.2f})"
                 )
-        print(f"  {name:5s} " + ", ".join(parts) + f"  [{s['pairs']} interleaved pairs of {s['steps_per_run']} steps]")
+        runs = f"{s['pairs']} interleaved pairs of {s['steps_per_run']} steps"
+        print(f"  {name:5s} " + ", ".join(parts) + f"  [{runs}; {', '.join(s.get('controllers', []))}]")
     rt = r["realtime"]
     print(
         f"  real-time mode (tank, all controllers): real-time factor {rt['real_time_factor']}, "

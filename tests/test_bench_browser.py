@@ -18,6 +18,7 @@ from benchmarks.experiments.browser import (
     analyse_bare,
     analyse_tutorial,
     bare_commands,
+    bare_samples,
     publisher_rate_parameter,
     since_frame_ms,
 )
@@ -192,3 +193,52 @@ def test_a_cases_publisher_rate_is_a_ros_double_and_slides_below_the_view_rate()
     assert publisher_rate_parameter(1000.0) == "RttJointStatePublisher.rate:=1000.0"
     slid = float(publisher_rate_parameter(50.0).split(":=")[1])
     assert 49.8 < slid < 50.0  # every 25th state one 1 ms step later: the states slide through the page's frame
+
+
+def _widget_round(latencies_ms: list[float], fps: float) -> dict:
+    """A made-up round of :func:`benchmarks.experiments.widget.widget_samples`."""
+    ns = [x * MS for x in latencies_ms]
+    return {
+        "handed_to_drawn": ns,
+        "sent_to_page": ns,
+        "page_to_drawn": ns,
+        "send_phase": ns,
+        "frames_per_s": fps,
+        "messages_per_s": 50.0,
+        "states_handed": len(ns),
+        "states_drawn": len(ns),
+        "dropped": 0,
+        "page": {"software": True},
+    }
+
+
+def test_the_widget_figures_pool_every_rounds_samples_and_keep_the_slowest_rate():
+    from benchmarks.experiments.widget import summarise_page, summarise_widget
+
+    rounds = [_widget_round([10.0] * 99 + [40.0], 60.0), _widget_round([10.0] * 100, 55.0)]
+    out = summarise_widget(rounds)
+    assert out["handed_to_drawn"]["n"] == 200
+    assert out["handed_to_drawn"]["max"] == pytest.approx(40.0)
+    # the one slow state of 200 lies past the pooled p99: it is the max, not a percentile
+    assert out["handed_to_drawn"]["p99"] < 11.0
+    assert out["frames_per_s"] == 55.0 and out["frames_per_s_rounds"] == [60.0, 55.0]
+    assert out["states_drawn"] == 200
+
+    run = _run(5 * MS)
+    sent = [(c[0], zlib.crc32(bytes.fromhex(c[3]))) for c in run["tape"]]
+    one = bare_samples(run["page"], sent, warmup=0.0)
+    page = summarise_page([one, one])
+    assert page["sent_to_drawn"]["n"] == 2 * len(one["sent_to_drawn"])
+    assert page["sent_to_drawn"]["p50"] == pytest.approx(analyse_bare(run["page"], sent, 0.0)["sent_to_drawn"]["p50"])
+
+
+def test_the_simulation_speed_target_times_the_controllers_it_names():
+    """Step 1's controller and Step 2's publisher, as the target (and the scale projects) have them: the
+    controller it leaves out of project/step2.yaml is there to leave out, and nothing else is."""
+    from benchmarks.experiments.speed import TARGET_LEAVES_OUT
+    from benchmarks.paths import ROOT
+    from tutorial.core.project import load_project
+
+    names = [c.name for m in load_project(ROOT / "project/step2.yaml").models for c in m.controllers]
+    assert set(TARGET_LEAVES_OUT) <= set(names)
+    assert [n for n in names if n not in TARGET_LEAVES_OUT] == ["RttTankController", "RttJointStatePublisher"]

@@ -403,15 +403,20 @@ def bare_run(tape: list, lead_s: float = 1.0, batch: bool = False) -> tuple[dict
     return samples, sent
 
 
-def since_frame_ms(sends_ns: list, rafs_ms: list, offset_ns: int) -> dict:
-    """Percentiles of each send (monotonic ns) -> the page's animation frame before it (page ms; ``offset_ns``:
-    :meth:`Page.clock_offset_ns`), ms; a send before the first frame is left out, and with no frame, every one."""
+def since_frame(sends_ns: list, rafs_ms: list, offset_ns: int) -> np.ndarray:
+    """Each send (monotonic ns) -> the page's animation frame before it (page ms; ``offset_ns``:
+    :meth:`Page.clock_offset_ns`), ns; a send before the first frame is left out, and with no frame, every one."""
     frames = np.sort(np.asarray(rafs_ms, dtype=float)) * 1e6 - offset_ns
     if frames.size == 0:
-        return pct([])
+        return np.zeros(0)
     sends = np.asarray(sends_ns, dtype=float)
     i = np.searchsorted(frames, sends, side="right") - 1
-    return pct((sends - frames[np.clip(i, 0, None)])[i >= 0], 1e-6)
+    return (sends - frames[np.clip(i, 0, None)])[i >= 0]
+
+
+def since_frame_ms(sends_ns: list, rafs_ms: list, offset_ns: int) -> dict:
+    """Percentiles (ms) of :func:`since_frame`."""
+    return pct(since_frame(sends_ns, rafs_ms, offset_ns), 1e-6)
 
 
 def _match(msgs: list, crcs: list[int]) -> list[tuple[int, int]]:
@@ -503,8 +508,9 @@ def analyse_tutorial(run: dict, warmup: float) -> dict:
     return out
 
 
-def analyse_bare(samples: dict, sent: list, warmup: float) -> dict:
-    """send -> page and send -> drawn (ms) for the bare replay."""
+def bare_samples(samples: dict, sent: list, warmup: float) -> dict:
+    """The bare replay's raw figures: per state, send -> page, send -> drawn and send -> the frame before (ns);
+    and the page's rates (:func:`_page_rates`)."""
     offset_ns = samples["offset_ns"]
     renders = np.array(sorted(samples["renders"]))
     crcs = [c for _, c in sent]
@@ -521,9 +527,20 @@ def analyse_bare(samples: dict, sent: list, warmup: float) -> dict:
         to_page.append(received - t_sent)
         to_drawn.append(drawn * 1e6 - offset_ns - t_sent)
         sends.append(t_sent)
-    out = {"sent_to_page": pct(to_page, 1e-6), "sent_to_drawn": pct(to_drawn, 1e-6)}
-    out.update(_page_rates(samples, start_ns, sent[-1][0], offset_ns))
-    out["send_phase_ms"] = since_frame_ms(sends, samples["rafs"], offset_ns)
+    return {
+        "sent_to_page": to_page,
+        "sent_to_drawn": to_drawn,
+        "send_phase": list(since_frame(sends, samples["rafs"], offset_ns)),
+        "rates": _page_rates(samples, start_ns, sent[-1][0], offset_ns),
+    }
+
+
+def analyse_bare(samples: dict, sent: list, warmup: float) -> dict:
+    """send -> page and send -> drawn (ms) for the bare replay."""
+    raw = bare_samples(samples, sent, warmup)
+    out = {"sent_to_page": pct(raw["sent_to_page"], 1e-6), "sent_to_drawn": pct(raw["sent_to_drawn"], 1e-6)}
+    out.update(raw["rates"])
+    out["send_phase_ms"] = pct(raw["send_phase"], 1e-6)
     return out
 
 

@@ -1,12 +1,13 @@
 """The live view over the notebook's own connection, beside the meshcat page over its own WebSocket, same run.
 
-    python -m benchmarks.experiments.widget [--seconds 8] [--cases tank_50Hz tanks_8] [--remote]
+    python -m benchmarks.experiments.widget [--seconds 8] [--cases tank_50Hz tanks_8] [--rounds 3] [--remote]
 
 For each case, the Step 3 viewer first runs for real (``browser.tutorial_run``:
 simulation, joystick, viewer) and its frames are taped: every command it
 sent to meshcat, at the moment it sent it.  The tape is then replayed, at
-the same moments, two ways, and each time the state handed to the view is
-timed to the pixel:
+the same moments, two ways, ``WIDGET_ROUNDS`` times each and alternating,
+and each time the state handed to the view is timed to the pixel (each
+side's samples pooled over its rounds; each round's p99s kept beside):
 
 - **page**: to the project's meshcat server and its page in Chromium (the
   page every view was before: a WebSocket of its own), the frames exactly
@@ -49,16 +50,17 @@ import numpy as np
 
 from benchmarks.experiments.browser import (
     CASES,
-    analyse_bare,
     bare_run,
+    bare_samples,
     clock_offset_ns,
-    since_frame_ms,
+    since_frame,
     tutorial_run,
 )
 from benchmarks.stats import pct
 
 ROOT = Path(__file__).resolve().parents[2]
 WIDGET_CASES = ("tank_50Hz", "tanks_8")
+WIDGET_ROUNDS = 3  # interleaved replays of one tape to each side per case, pooled (widget_vs_page)
 
 REPLAY_CELL = """\
 import json, os, threading, time
@@ -146,8 +148,9 @@ def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
     return dict(kernel, probe=probe, rafs=rafs, offset_ns=offset_ns, page=stats.get("page"), dropped=stats["dropped"])
 
 
-def analyse_widget(run: dict, warmup: float) -> dict:
-    """handed -> drawn (the kernel's put -> the view's frame after it), and the view's frames/s."""
+def widget_samples(run: dict, warmup: float) -> dict:
+    """One widget replay's raw figures: per state, handed -> drawn, sent -> page, page -> drawn and handed -> the
+    view's frame before (ns); the view's frames/s and messages/s."""
     puts = np.array(run["puts"], dtype=np.int64)
     sent = dict(run["sent"])  # frame number -> monotonic ns sent
     offset = run["offset_ns"]
@@ -171,10 +174,10 @@ def analyse_widget(run: dict, warmup: float) -> dict:
     fps = round(float((len(rafs) - 1) / ((rafs[-1] - rafs[0]) * 1e-9)), 1) if len(rafs) > 1 else None
     frames = [t for _, t in run["sent"] if t >= start_ns]
     return {
-        "send_phase_ms": since_frame_ms([int(t) for t in puts[sorted(counted)]], run["rafs"], offset),
-        "handed_to_drawn": pct(handed_to_drawn, 1e-6),
-        "sent_to_page": pct(sent_to_page, 1e-6),
-        "page_to_drawn": pct(page_to_drawn, 1e-6),
+        "handed_to_drawn": handed_to_drawn,
+        "sent_to_page": sent_to_page,
+        "page_to_drawn": page_to_drawn,
+        "send_phase": list(since_frame([int(t) for t in puts[sorted(counted)]], run["rafs"], offset)),
         "frames_per_s": fps,
         "messages_per_s": round(len(frames) / ((puts[-1] - start_ns) * 1e-9), 1) if frames else None,
         "states_handed": int((puts >= start_ns).sum()),
@@ -184,16 +187,75 @@ def analyse_widget(run: dict, warmup: float) -> dict:
     }
 
 
-def widget_vs_page(cases: list[str], seconds: float, warmup: float) -> dict:
-    """Every case: the taped viewer replayed to the WebSocket page and to the widget, in the same run."""
+def _pooled(rounds: list[dict], latencies: tuple[str, ...]) -> dict:
+    """Percentiles (ms) of each latency over the samples of all ``rounds``; a rate is its slowest round's."""
+
+    def lowest(key):
+        values = [r[key] for r in rounds if r.get(key) is not None]
+        return min(values) if values else None
+
+    out = {k: pct([x for r in rounds for x in r[k]], 1e-6) for k in latencies}
+    out["send_phase_ms"] = pct([x for r in rounds for x in r["send_phase"]], 1e-6)
+    out["frames_per_s"] = lowest("frames_per_s")
+    out["frames_per_s_rounds"] = [r["frames_per_s"] for r in rounds]
+    out["messages_per_s"] = lowest("messages_per_s")
+    return out
+
+
+def summarise_widget(rounds: list[dict]) -> dict:
+    """The widget's figures over the pooled samples of ``rounds`` (:func:`widget_samples`)."""
+    out = _pooled(rounds, ("handed_to_drawn", "sent_to_page", "page_to_drawn"))
+    for k in ("states_handed", "states_drawn", "dropped"):
+        out[k] = sum(r[k] for r in rounds)
+    out["page"] = rounds[0]["page"]
+    return out
+
+
+def summarise_page(rounds: list[dict]) -> dict:
+    """The meshcat page's figures over the pooled samples of ``rounds`` (:func:`browser.bare_samples`)."""
+    flat = [dict(r, **{k: v for k, v in r["rates"].items() if k != "render_js_ms"}) for r in rounds]
+    out = _pooled(flat, ("sent_to_page", "sent_to_drawn"))
+    out["renders_per_s"] = min((r["renders_per_s"] for r in flat if r["renders_per_s"] is not None), default=None)
+    out["page"] = rounds[0]["rates"]["page"]
+    out["render_js_ms_rounds"] = [r["rates"]["render_js_ms"] for r in rounds]
+    return out
+
+
+def widget_vs_page(cases: list[str], seconds: float, warmup: float, rounds: int = WIDGET_ROUNDS) -> dict:
+    """Every case: the taped viewer replayed to the WebSocket page and to the widget, ``rounds`` times each.
+
+    The two replays alternate (page first in even rounds, the widget first
+    in odd ones), so a drift of the machine over the minutes of a case
+    falls on both sides, and each side's samples are pooled over its rounds:
+    a p99 of one replay's 300 states is its third-latest state, and moved
+    by a fifth from one replay to the next here.  Each round's own p99s and
+    their ratio are kept in ``rounds``, to show that spread.
+    """
     out = {}
     for case in cases:
+        pages, widgets, each = [], [], []
         with tempfile.TemporaryDirectory() as d:
             tape = tutorial_run(case, seconds, Path(d))["tape"]
-            samples, sent = bare_run(tape, batch=True)
-            page = analyse_bare(samples, sent, warmup)
-            widget = analyse_widget(widget_run(tape, Path(d)), warmup)
-        out[case] = {"page": page, "widget": widget}
+            for r in range(rounds):
+                order = ("page", "widget") if r % 2 == 0 else ("widget", "page")
+                for side in order:
+                    if side == "page":
+                        pages.append(bare_samples(*bare_run(tape, batch=True), warmup))
+                    else:
+                        widgets.append(widget_samples(widget_run(tape, Path(tempfile.mkdtemp(dir=d))), warmup))
+                page_p99 = pct(pages[-1]["sent_to_drawn"], 1e-6)["p99"]
+                widget_p99 = pct(widgets[-1]["handed_to_drawn"], 1e-6)["p99"]
+                each.append(
+                    {
+                        "first": order[0],
+                        "page_p99_ms": page_p99,
+                        "widget_p99_ms": widget_p99,
+                        "ratio": round(widget_p99 / page_p99, 3) if page_p99 and widget_p99 else None,
+                        "widget_frames_per_s": widgets[-1]["frames_per_s"],
+                    }
+                )
+                print(f"widget {case}, round {r + 1} of {rounds}: {json.dumps(each[-1])}", flush=True)
+        out[case] = {"page": summarise_page(pages), "widget": summarise_widget(widgets), "rounds": each}
         print(f"widget {case}: {json.dumps(out[case])}", flush=True)
     return out
 
@@ -243,11 +305,12 @@ def main(argv=None) -> int:
     p.add_argument("--seconds", type=float, default=8.0, help="simulated seconds per case (default 8)")
     p.add_argument("--warmup", type=float, default=2.0, help="s left out at the start of each run (default 2)")
     p.add_argument("--cases", nargs="+", choices=list(CASES), default=list(WIDGET_CASES))
+    p.add_argument("--rounds", type=int, default=WIDGET_ROUNDS, help=f"replays per side (default {WIDGET_ROUNDS})")
     p.add_argument("--remote", action="store_true", help="also the browser on a second host over 5 Mbit/s (root)")
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
-    r = {"cases": widget_vs_page(args.cases, args.seconds, args.warmup)}
+    r = {"cases": widget_vs_page(args.cases, args.seconds, args.warmup, args.rounds)}
     if args.remote:
         r["remote"] = remote()
     print(json.dumps(r, indent=1))
