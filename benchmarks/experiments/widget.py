@@ -187,18 +187,18 @@ def widget_samples(run: dict, warmup: float) -> dict:
     }
 
 
+def _lowest(rounds: list[dict], key: str):
+    """The lowest ``key`` of the ``rounds`` (a rate: its slowest round's); None when no round has one."""
+    return min((r[key] for r in rounds if r.get(key) is not None), default=None)
+
+
 def _pooled(rounds: list[dict], latencies: tuple[str, ...]) -> dict:
     """Percentiles (ms) of each latency over the samples of all ``rounds``; a rate is its slowest round's."""
-
-    def lowest(key):
-        values = [r[key] for r in rounds if r.get(key) is not None]
-        return min(values) if values else None
-
     out = {k: pct([x for r in rounds for x in r[k]], 1e-6) for k in latencies}
     out["send_phase_ms"] = pct([x for r in rounds for x in r["send_phase"]], 1e-6)
-    out["frames_per_s"] = lowest("frames_per_s")
+    out["frames_per_s"] = _lowest(rounds, "frames_per_s")
     out["frames_per_s_rounds"] = [r["frames_per_s"] for r in rounds]
-    out["messages_per_s"] = lowest("messages_per_s")
+    out["messages_per_s"] = _lowest(rounds, "messages_per_s")
     return out
 
 
@@ -213,9 +213,9 @@ def summarise_widget(rounds: list[dict]) -> dict:
 
 def summarise_page(rounds: list[dict]) -> dict:
     """The meshcat page's figures over the pooled samples of ``rounds`` (:func:`browser.bare_samples`)."""
-    flat = [dict(r, **{k: v for k, v in r["rates"].items() if k != "render_js_ms"}) for r in rounds]
+    flat = [{**r, **r["rates"]} for r in rounds]  # the page's rates beside its samples
     out = _pooled(flat, ("sent_to_page", "sent_to_drawn"))
-    out["renders_per_s"] = min((r["renders_per_s"] for r in flat if r["renders_per_s"] is not None), default=None)
+    out["renders_per_s"] = _lowest(flat, "renders_per_s")
     out["page"] = rounds[0]["rates"]["page"]
     out["render_js_ms_rounds"] = [r["rates"]["render_js_ms"] for r in rounds]
     return out
