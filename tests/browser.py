@@ -59,3 +59,19 @@ def greenish_pixels(image: np.ndarray) -> int:
     """Pixels where green clearly beats blue: the tank's olive paint against meshcat's blue background."""
     r, g, b = image[..., 0], image[..., 1], image[..., 2]
     return int(np.count_nonzero((g > b + 0.06) & (g >= r)))
+
+
+# Count the messages a page's window gets for ``ms`` after one is posted to it (Playwright's page or frame).
+MESSAGES_AFTER_ONE = """(ms) => new Promise((done) => {
+  let n = 0;
+  const count = () => { n += 1; };
+  window.addEventListener("message", count);
+  window.postMessage("one message, as a browser extension or an embedding page may post", "*");
+  setTimeout(() => { window.removeEventListener("message", count); done(n); }, ms);
+})"""
+
+
+def messages_after_one(frame, ms: int = 500) -> int:
+    """How many messages a meshcat page's window gets in ``ms`` after one is posted to it: 1 unless something
+    answers it (meshcat's bundled GIF worker did, endlessly: :data:`tutorial.view.meshcat_page.UNHOOK_SCRIPT`)."""
+    return frame.evaluate(MESSAGES_AFTER_ONE, ms)

@@ -25,7 +25,7 @@ from tutorial.core.world import ModelEntry, build_world
 from tutorial.view import meshcat_page
 from tutorial.view.meshcat_batch import MAX_COMMANDS, MAX_PATH_CHARS, MAX_PATH_PARTS, BadBatch, pack_batch, split_batch
 
-from browser import chromium
+from browser import chromium, messages_after_one
 from conftest import MODEL
 from fuzzing import examples
 
@@ -375,6 +375,7 @@ def test_the_page_leaves_out_multisampling_on_a_software_renderer_unless_asked(s
         assert chosen["software"] is True and chosen["antialias"] is False
         assert page.evaluate(attributes) is False
         assert page.evaluate("document.querySelectorAll('#meshcat-pane canvas').length") == 1  # replaced, not added
+        assert messages_after_one(page) == 1  # meshcat's bundled GIF worker does not answer it
         page.goto(server.web_url + "?antialias=1")
         page.wait_for_function("window.rttPage !== undefined")
         assert page.evaluate("window.rttPage.antialias") is True

@@ -8,7 +8,7 @@ import pytest
 from tutorial.core.world import ModelEntry, build_world
 from tutorial.notebook import replay
 
-from browser import chromium
+from browser import chromium, messages_after_one
 from conftest import MODEL
 
 pytestmark = [
@@ -57,6 +57,7 @@ def test_a_recording_is_lighter_without_a_gpu_and_drawn_only_in_sight():
                 return counts; })()"""
         )
         assert segments and set(segments) == {16}  # meshcat's 50, capped: the tank's turret, wheels, track ends
+        assert messages_after_one(frame) == 1  # meshcat's bundled GIF worker does not answer it
         assert frames_drawn(frame, 0.7) > 5  # in sight, the animation plays (60 a second when it can)
         page.evaluate("window.scrollTo(0, 2000)")
         page.wait_for_timeout(300)  # the observer is told after the page's next frame

@@ -34,6 +34,7 @@ import pytest
 import umsgpack
 from meshcat.commands import SetObject, SetTransform
 
+from tests.browser import messages_after_one
 from tests.jupyterlab import browser
 from tutorial.view.meshcat_batch import pack_batch
 from tutorial.view.meshcat_page import viewer_script_gzip
@@ -251,6 +252,13 @@ def test_cut_off_from_its_kernel_the_view_says_it_is_not_live_and_an_answer_take
     page.evaluate(DELIVER, [{"type": "pong"}, []])
     page.wait_for_timeout(2000)  # past the ping's 1.5 s: the notice would have shown by now
     assert notice.count() == 0
+
+
+def test_a_message_posted_to_the_views_page_starts_nothing(view):
+    page, errors = view
+    errors.clear()
+    assert messages_after_one(page.frames[1]) == 1
+    assert not errors, errors
 
 
 def test_the_module_is_the_widgets_with_its_limits():

@@ -43,7 +43,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from tutorial.view.meshcat_page import LIGHTEN_SCRIPT, viewer_script_gzip
+from tutorial.view.meshcat_page import LIGHTEN_SCRIPT, UNHOOK_SCRIPT, viewer_script_gzip
 
 DECIMALS = 4  # animation values: 0.1 mm, 1e-4 of a unit quaternion
 _UUID = re.compile(r"^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")
@@ -256,7 +256,7 @@ body {{ margin: 0; display: flex; height: 100vh; background: #fff; font: 12px sa
   const script = unpack("{script}");
   const stream = new Blob([script]).stream().pipeThrough(new DecompressionStream("gzip"));
   (0, eval)(await new Response(stream).text());  // meshcat's viewer: defines MeshCat
-  const scenes = {scenes};
+  {unhook}  const scenes = {scenes};
   // Drawn only while in sight: a notebook holds many recordings, each looping its animation, and a
   // browser draws a page's frames (offscreen ones too) as long as it is open.  Out of sight, a
   // viewer's render is skipped and its scene stays marked for the next one.
@@ -300,6 +300,7 @@ def page_html(scenes: Sequence[ViewRecording], labels: Sequence[str] = (), title
     return _PAGE.format(
         title=html.escape(title),
         lighten=LIGHTEN_SCRIPT,  # defines rttLighten (no "</" in it: it cannot end the <script>)
+        unhook=UNHOOK_SCRIPT,
         panes=panes,
         script=_viewer_script_gzip_base64(),
         scenes=json.dumps(encoded, separators=(",", ":")),

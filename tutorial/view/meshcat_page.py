@@ -4,8 +4,9 @@ The page is meshcat's own ``index.html``, as the installed meshcat ships
 it, with :data:`PAGE_SCRIPT` added at the end of its body
 (:func:`with_page_script`).  The script runs right after meshcat's own,
 which has made the ``viewer`` and opened its WebSocket, before the first
-message is handled and before the first frame is drawn.  It does three
-things:
+message is handled and before the first frame is drawn.  It clears a
+message handler that meshcat's script leaves on the page
+(:data:`UNHOOK_SCRIPT`), and does three things:
 
 - **it draws ``set_transforms``**, a frame's transforms in one message
   (:mod:`tutorial.view.meshcat_batch`): each inner command goes to meshcat's
@@ -198,6 +199,17 @@ function rttLighten(viewer, search) {
 }
 """.replace("__COARSE__", json.dumps(COARSE_SEGMENTS))
 
+# meshcat's viewer script bundles gif.js (its animation recorder), and loading the script also runs the code
+# of gif.js's worker on the page itself.  That code sets ``self.onmessage``: it takes any message posted to
+# the page's window as a picture to encode, and posts its result back to the same window, so one message
+# (from a browser extension, an embedding page) starts a loop that keeps the page's thread busy for as long
+# as it is open (gif.js issue 143).  meshcat never uses the window's handler (its recorder's workers are
+# workers of their own), so every page of ours clears it once meshcat's script has run.
+UNHOOK_SCRIPT = (
+    "if (typeof window.onmessage === 'function') window.onmessage = null;  "
+    "// gif.js's worker code on the page (tutorial/view/meshcat_page.py)\n"
+)
+
 PAGE_SCRIPT = (
     LIGHTEN_SCRIPT
     + """// ros-tank-tutorial's additions to meshcat's page (tutorial/view/meshcat_page.py)
@@ -205,7 +217,9 @@ PAGE_SCRIPT = (
   if (typeof viewer === "undefined" || typeof MeshCat === "undefined") {
     return;  // meshcat's script did not run: nothing to add to
   }
-  window.rttPage = rttLighten(viewer, location.search);
+  """
+    + UNHOOK_SCRIPT
+    + """  window.rttPage = rttLighten(viewer, location.search);
   // A frame's transforms in one message: each goes to the viewer's handler, one by one.
   const handleOne = viewer.handle_command.bind(viewer);
   viewer.handle_command = function (cmd) {
