@@ -189,7 +189,7 @@ def plot_learners(r: dict, path: Path) -> Path:
     from benchmarks.targets import LEARNERS_TARGETS
 
     runs = r["learners"]
-    ns = sorted(int(n) for n in runs)
+    ns = sorted(int(n) for n in runs if "failed" not in runs[n])  # a class that failed has no figures to draw
     data = [runs[str(n)] for n in ns]
     fig, axes = plt.subplots(2, 2, figsize=(10, 7), constrained_layout=True)
     ax = axes[0, 0]

@@ -31,9 +31,11 @@ def read(*keys: str) -> Callable[[dict], object]:
 
 
 def partial(r: dict) -> bool:
-    """Whether run results ``r`` may lack figures: an experiment failed (``r["failed"]``), or the run was
-    ``--quick`` (fewer sizes: no class of 8 learners)."""
-    return bool(r.get("failed") or r.get("quick"))
+    """Whether run results ``r`` may lack figures: an experiment failed (``r["failed"]``), a class of
+    learners failed (its entry in ``r["learners"]`` says so), or the run was ``--quick`` (fewer sizes: no
+    class of 8 learners)."""
+    classes = r.get("learners") or {}
+    return bool(r.get("failed") or r.get("quick") or any("failed" in c for c in classes.values()))
 
 
 @dataclass(frozen=True)

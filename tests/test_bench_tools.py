@@ -78,6 +78,38 @@ def test_learners_targets_and_plot(tmp_path):
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_a_class_that_fails_keeps_the_smaller_classes_figures(monkeypatch, tmp_path, capsys):
+    """A class the machine cannot carry (a learner's cell timed out) is kept as failed, the smaller classes'
+    figures stay, no larger class is tried, the targets of the failed size read n/a, and the plot draws the rest."""
+    from benchmarks.experiments import learners
+    from benchmarks.plots import plot_learners
+    from benchmarks.targets import LEARNERS_TARGETS
+
+    tried = []
+
+    def one_class(n, *_args):
+        tried.append(n)
+        if n >= 8:
+            raise TimeoutError("a learner's cell did not finish")
+        return {
+            "real_time_factor": [1.0] * n, "real_time_factor_min": 1.0, "age_ms_p99_max": 3.0 * n,
+            "age_ms_pooled": {"p50": 1.0}, "memory_mb_per_learner_mean": 250.0, "cores_busy": 0.4 * n,
+            "cores_by_role": {"kernels": 0.2 * n}, "learners_with_no_state_in_window": 0, "frames_per_s_min": 38.0,
+            "client_cores": 0.05,
+        }  # fmt: skip
+
+    monkeypatch.setattr(learners, "one_class", one_class)
+    out = learners.learners_per_server((1, 2, 4, 8, 16), 1.0, 0.1)
+    assert tried == [1, 2, 4, 8] and sorted(out) == ["1", "2", "4", "8"]
+    assert out["4"]["age_ms_p99_max"] == 12.0
+    assert out["8"] == {"learners": 8, "failed": "TimeoutError: a learner's cell did not finish"}
+    assert "8 learners: the class failed (TimeoutError" in capsys.readouterr().out
+    run = {"machine": {"cpus": 2}, "when": "now", "learners": out}
+    assert [t.row(run)["measured"] for t in LEARNERS_TARGETS] == ["n/a"] * 3
+    assert not any(t.row(run)["pass"] for t in LEARNERS_TARGETS)
+    assert plot_learners(run, tmp_path / "bench_learners.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 @pytest.mark.parametrize(
     "values, written",
     [

@@ -431,11 +431,22 @@ def _in_window(p: dict, window: tuple[int, int]) -> dict:
 
 
 def learners_per_server(counts, seconds: float, warmup: float, frame_rate: float | None = None) -> dict:
-    """The class sizes in turn; each one's figures."""
+    """The class sizes in turn; each one's figures.
+
+    A class that fails (the machine too loaded for a learner's cell to
+    finish in time, say) is kept as ``{"learners": n, "failed": "..."}``,
+    and no larger class is tried: the smaller classes' figures stay, and the
+    targets that read the failed size read n/a.
+    """
     out = {}
     for n in counts:
-        with tempfile.TemporaryDirectory() as d:
-            out[str(n)] = one_class(n, seconds, warmup, Path(d), frame_rate)
+        try:
+            with tempfile.TemporaryDirectory() as d:
+                out[str(n)] = one_class(n, seconds, warmup, Path(d), frame_rate)
+        except Exception as error:  # noqa: BLE001 - kept as this size's result, with what went wrong
+            out[str(n)] = {"learners": n, "failed": f"{type(error).__name__}: {error}"[:500]}
+            print(f"{n:3d} learners: the class failed ({out[str(n)]['failed']}); no larger class tried", flush=True)
+            break
         r = out[str(n)]
         print(
             f"{n:3d} learners, frame rate {frame_rate or 'the hub default'}: "
@@ -478,7 +489,7 @@ def main(argv=None) -> int:
         out = Path(args.output)
         out.mkdir(parents=True, exist_ok=True)
         (out / "learners.json").write_text(json.dumps(r, indent=1))
-        if "1" in r["learners"]:  # the plot's limits are one learner's figures times the targets'
+        if "failed" not in r["learners"].get("1", {"failed": "not run"}):  # its limits: one learner's figures
             plot_learners(r, out / "bench_learners.png")
     return 0
 
