@@ -256,7 +256,8 @@ body {{ margin: 0; display: flex; height: 100vh; background: #fff; font: 12px sa
   const script = unpack("{script}");
   const stream = new Blob([script]).stream().pipeThrough(new DecompressionStream("gzip"));
   (0, eval)(await new Response(stream).text());  // meshcat's viewer: defines MeshCat
-  {unhook}  const scenes = {scenes};
+  {unhook}
+  const scenes = {scenes};
   // Drawn only while in sight: a notebook holds many recordings, each looping its animation, and a
   // browser draws a page's frames (offscreen ones too) as long as it is open.  Out of sight, a
   // viewer's render is skipped and its scene stays marked for the next one.

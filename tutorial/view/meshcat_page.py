@@ -207,7 +207,7 @@ function rttLighten(viewer, search) {
 # workers of their own), so every page of ours clears it once meshcat's script has run.
 UNHOOK_SCRIPT = (
     "if (typeof window.onmessage === 'function') window.onmessage = null;  "
-    "// gif.js's worker code on the page (tutorial/view/meshcat_page.py)\n"
+    "// gif.js's worker code on the page (tutorial/view/meshcat_page.py)"
 )
 
 PAGE_SCRIPT = (
@@ -219,7 +219,8 @@ PAGE_SCRIPT = (
   }
   """
     + UNHOOK_SCRIPT
-    + """  window.rttPage = rttLighten(viewer, location.search);
+    + """
+  window.rttPage = rttLighten(viewer, location.search);
   // A frame's transforms in one message: each goes to the viewer's handler, one by one.
   const handleOne = viewer.handle_command.bind(viewer);
   viewer.handle_command = function (cmd) {
