@@ -489,7 +489,8 @@ def main(argv=None) -> int:
         out = Path(args.output)
         out.mkdir(parents=True, exist_ok=True)
         (out / "learners.json").write_text(json.dumps(r, indent=1))
-        if "failed" not in r["learners"].get("1", {"failed": "not run"}):  # its limits: one learner's figures
+        alone = r["learners"].get("1")
+        if alone and "failed" not in alone:  # the plot's limits are one learner's figures times the targets'
             plot_learners(r, out / "bench_learners.png")
     return 0
 
