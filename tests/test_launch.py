@@ -98,6 +98,37 @@ def test_a_failing_node_fails_the_launch_and_stops_the_others():
     assert "cannot read the project file" in text
 
 
+def test_a_node_hung_in_its_clean_up_says_where_before_it_is_killed():
+    """A node that ignores SIGINT and SIGTERM (as ours do while they clean up) and never ends: the
+    launcher names it, its threads' stacks are printed (faulthandler, on SIGABRT), and the launch
+    still ends within SHUTDOWN_TIMEOUT s."""
+    import io
+
+    from tutorial.ros.launch import SHUTDOWN_TIMEOUT
+
+    out = io.StringIO()
+    launch = Launch(LaunchDescription([NodeProcess("hung", "tests.fixtures.hanging_node")]), out=out)
+    launch.start()
+    try:
+        assert wait_until(lambda: "[hung] cleaning up" in out.getvalue(), timeout=20), out.getvalue()
+        started = time.monotonic()
+        code = launch.shutdown()
+        elapsed = time.monotonic() - started
+    finally:
+        for p in launch.procs.values():
+            if p.poll() is None:
+                p.kill()
+    text = out.getvalue()
+    assert code == 1, text
+    assert "[launch] hung did not stop within 4.2 s: SIGABRT" in text, text
+    # faulthandler's dump, line by line through the launcher: the function the node hangs in, on its main thread
+    assert "[hung] Current thread" in text or "[hung] Thread" in text, text
+    assert "in clean_up_forever" in text, text
+    assert "[launch] failed: hung (killed by SIGABRT)" in text, text
+    assert elapsed < SHUTDOWN_TIMEOUT + 0.5
+    assert launch.procs["hung"].returncode == -signal.SIGABRT
+
+
 def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
     """``--record FILE.mcap`` adds ``rtt-bag record`` (node ``rtt_bag``); the launch's stop closes the file whole.
 

@@ -4,7 +4,10 @@ It keeps ROS 2 launch's vocabulary: a :class:`LaunchDescription` lists
 :class:`NodeProcess` actions, each started as its own process with its output
 prefixed by the node name.  Stopping follows ``ros2 launch``'s escalation:
 on Ctrl-C or SIGTERM every node gets SIGINT, then SIGTERM, then SIGKILL,
-and the whole shutdown ends within :data:`SHUTDOWN_TIMEOUT` s.  A node marked
+and the whole shutdown ends within :data:`SHUTDOWN_TIMEOUT` s.  One step is
+added before SIGKILL: SIGABRT, which Python's ``faulthandler`` (turned on in
+every node with ``PYTHONFAULTHANDLER``) answers by printing where each of the
+node's threads is, so a node that hangs in its clean-up says where.  A node marked
 ``required`` (ROS 1 launch's ``required="true"``) shuts everything down when
 it exits.  Children also get SIGTERM if the launcher itself dies (Linux's
 parent-death signal), so none is left behind.  Once every child is gone,
@@ -21,6 +24,7 @@ from __future__ import annotations
 import argparse
 import ctypes
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -32,7 +36,8 @@ from tutorial.ros.shm import SHM_DIR, fast_dds_shm_files, is_segment, remove_unu
 
 SHUTDOWN_TIMEOUT = 5.0  # s, from the stop request to the last child gone
 _SIGINT_GRACE = 3.0  # s before SIGINT escalates to SIGTERM
-_SIGTERM_GRACE = 1.5  # s before SIGTERM escalates to SIGKILL
+_SIGTERM_GRACE = 1.2  # s before SIGTERM escalates to SIGABRT
+_SIGABRT_GRACE = 0.3  # s for faulthandler to print the stacks before SIGKILL
 PR_SET_PDEATHSIG = 1
 _LIBRARY_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _SHM_SAMPLE_PERIOD = 1.0  # s between looks at every /dev/shm file the children map
@@ -109,6 +114,7 @@ class Launch:
         # The nodes import this library from wherever the launcher found it (a clone need not be installed).
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [_LIBRARY_ROOT, env.get("PYTHONPATH")]))
         env["PYTHONUNBUFFERED"] = "1"
+        env["PYTHONFAULTHANDLER"] = "1"  # a crash, or the launcher's SIGABRT, prints every thread's stack
         for node in self.description.nodes:
             proc = subprocess.Popen(
                 node.command(),
@@ -147,14 +153,22 @@ class Launch:
         return self.shutdown()
 
     def shutdown(self) -> int:
-        """SIGINT, then SIGTERM, then SIGKILL; every child is gone within SHUTDOWN_TIMEOUT s."""
+        """SIGINT, then SIGTERM, then SIGABRT (stacks), then SIGKILL; every child is gone within SHUTDOWN_TIMEOUT s."""
         self.stopping = True
         self.note_shared_memory()
-        start = time.monotonic()
-        for sig, grace in ((signal.SIGINT, _SIGINT_GRACE), (signal.SIGTERM, _SIGTERM_GRACE), (signal.SIGKILL, None)):
+        start = first = time.monotonic()
+        stages = (
+            (signal.SIGINT, _SIGINT_GRACE),
+            (signal.SIGTERM, _SIGTERM_GRACE),
+            (signal.SIGABRT, _SIGABRT_GRACE),
+            (signal.SIGKILL, None),
+        )
+        for sig, grace in stages:
             alive = [p for p in self.procs.values() if p.poll() is None]
             if not alive:
                 break
+            if sig == signal.SIGABRT:
+                self._say_hung(alive, time.monotonic() - first)
             for p in alive:
                 p.send_signal(sig)
             deadline = start + (grace if grace is not None else SHUTDOWN_TIMEOUT - 0.2)
@@ -181,6 +195,16 @@ class Launch:
             return 1
         self._say("all nodes stopped cleanly")
         return 0
+
+    def _say_hung(self, alive: list[subprocess.Popen], waited: float) -> None:
+        """Name the nodes still running after SIGINT and SIGTERM, and keep SIGABRT from writing a core file."""
+        names = ", ".join(name for name, p in self.procs.items() if p in alive)
+        self._say(f"{names} did not stop within {waited:.1f} s: SIGABRT, so Python prints where its threads are")
+        for p in alive:
+            try:
+                resource.prlimit(p.pid, resource.RLIMIT_CORE, (0, 0))
+            except (OSError, ValueError):
+                pass  # gone meanwhile, or not ours to change: the abort may then write a core file
 
     def note_shared_memory(self, mapped: bool = True) -> None:
         """Add the Fast DDS files in /dev/shm the children use now to :attr:`shm_files` (main thread).
