@@ -212,11 +212,18 @@ class ViewClient:
         loop.call_later(2 / 60, settle)
 
     async def _settle(self, comm: str) -> None:
+        from websockets.exceptions import ConnectionClosed
+
         owed, self._owed[comm] = self._owed.get(comm, 0), 0
         if owed:
-            await self._send(_custom(comm, {"type": "drawn", "frames": owed}))
+            try:
+                await self._send(_custom(comm, {"type": "drawn", "frames": owed}))
+            except ConnectionClosed:
+                pass  # the learner's page closed: a browser's closing page answers nothing either
 
     async def close(self) -> None:
+        for task in list(self._settling):
+            task.cancel()  # answers still due two frames later: the page is closing
         if self._ws is not None:
             await self._ws.close()
             self._reader.cancel()

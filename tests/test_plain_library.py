@@ -1,0 +1,86 @@
+"""A library a teacher can read: short modules, and controllers as plain as ros2/demos.
+
+Two checks, each proved to catch what it claims on a made-up module:
+
+- a module of ``tutorial/`` over :data:`MAX_LINES` lines says in its
+  docstring why it is one job (the words "one job");
+- the controllers the notebooks export (``tutorial/controllers/``, the code a
+  learner writes in notebooks 01 to 06) use no speed tricks: no
+  ``memoryview``, no ``array`` module, no ``bytes``/``bytearray`` buffers.
+  Where a step needs speed, it calls a library function in one line.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.unit
+
+ROOT = Path(__file__).resolve().parent.parent
+MAX_LINES = 400
+TRICK_CALLS = {"memoryview", "bytes", "bytearray"}
+
+
+def long_modules_without_a_reason(package: Path) -> list[str]:
+    """Modules under ``package`` over MAX_LINES lines whose docstring does not say "one job"."""
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        text = path.read_text()
+        if text.count("\n") > MAX_LINES and "one job" not in (ast.get_docstring(ast.parse(text)) or ""):
+            found.append(f"{path.relative_to(package.parent)}: {text.count(chr(10))} lines")
+    return found
+
+
+def speed_tricks(source: str) -> list[str]:
+    """``line: what`` for each speed trick in ``source``: memoryview/bytes/bytearray calls, the array module."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in TRICK_CALLS:
+            found.append(f"{node.lineno}: {node.func.id}(")
+        elif isinstance(node, ast.Import) and any(alias.name == "array" for alias in node.names):
+            found.append(f"{node.lineno}: import array")
+        elif isinstance(node, ast.ImportFrom) and node.module == "array":
+            found.append(f"{node.lineno}: from array import")
+    return found
+
+
+def test_every_long_module_says_why_it_is_one_job():
+    assert long_modules_without_a_reason(ROOT / "tutorial") == []
+
+
+def test_the_length_check_catches_a_long_module_without_a_reason(tmp_path):
+    package = tmp_path / "tutorial"
+    package.mkdir()
+    body = "x = 1\n" * MAX_LINES
+    (package / "long.py").write_text('"""Many jobs."""\n' + body)
+    (package / "long_but_said.py").write_text('"""Long: one job, the file format."""\n' + body)
+    (package / "short.py").write_text('"""Short."""\n' + "x = 1\n" * (MAX_LINES - 1))
+    assert long_modules_without_a_reason(package) == [f"tutorial/long.py: {MAX_LINES + 1} lines"]
+
+
+def test_the_exported_controllers_use_no_speed_tricks():
+    modules = sorted((ROOT / "tutorial" / "controllers").glob("*.py"))
+    assert len(modules) >= 6  # one or more a notebook, 01 to 06
+    found = {m.name: speed_tricks(m.read_text()) for m in modules}
+    assert {name: tricks for name, tricks in found.items() if tricks} == {}
+
+
+@pytest.mark.parametrize(
+    "source, trick",
+    [
+        ("buf = memoryview(data.qpos)\n", "1: memoryview("),
+        ("positions = bytes(8 * n)\n", "1: bytes("),
+        ("scratch = bytearray(64)\n", "1: bytearray("),
+        ("import array\n", "1: import array"),
+        ("from array import array\n", "1: from array import"),
+    ],
+)
+def test_the_trick_check_catches_each_trick(source, trick):
+    assert speed_tricks(source) == [trick]
+
+
+def test_the_trick_check_leaves_numpy_alone():
+    assert speed_tricks("import numpy as np\nhome = np.array([0.0, 0.0, 0.107])\n") == []
