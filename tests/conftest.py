@@ -55,6 +55,25 @@ MODEL = ROOT / "model"
 
 TIERS = ("unit", "ros", "cross_process", "launch", "browser", "notebooks", "network")
 
+_SHM_BEFORE: set[str] = set()  # /dev/shm's names when the session started
+
+
+def pytest_sessionstart(session) -> None:
+    _SHM_BEFORE.update(os.listdir("/dev/shm"))
+
+
+def pytest_sessionfinish(session, exitstatus) -> None:
+    """Remove the Fast DDS files in /dev/shm that this session's killed processes left and nobody uses.
+
+    Several tests kill a node with SIGKILL on purpose (a crash, a recorder
+    killed), and a killed participant leaves its files.  Only files new since
+    the session started are looked at, and only those no live process holds
+    are removed (:func:`tutorial.ros.shm.remove_unused_fast_dds_shm`).
+    """
+    from tutorial.ros.shm import SHM_DIR, remove_unused_fast_dds_shm
+
+    remove_unused_fast_dds_shm(set(os.listdir(SHM_DIR)) - _SHM_BEFORE)
+
 
 def pytest_configure(config):
     for tier in TIERS:
