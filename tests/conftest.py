@@ -55,24 +55,34 @@ MODEL = ROOT / "model"
 
 TIERS = ("unit", "ros", "cross_process", "launch", "browser", "notebooks", "network")
 
-_SHM_BEFORE: set[str] = set()  # /dev/shm's names when the session started
+_SHM_BEFORE: set[str] = set()  # the names in /dev/shm when the session started
+
+
+def _shm_names() -> set[str]:
+    from tutorial.ros.shm import SHM_DIR
+
+    try:
+        return set(os.listdir(SHM_DIR))
+    except FileNotFoundError:  # no /dev/shm: nothing of Fast DDS's to look after
+        return set()
 
 
 def pytest_sessionstart(session) -> None:
-    _SHM_BEFORE.update(os.listdir("/dev/shm"))
+    _SHM_BEFORE.update(_shm_names())
 
 
 def pytest_sessionfinish(session, exitstatus) -> None:
-    """Remove the Fast DDS files in /dev/shm that this session's killed processes left and nobody uses.
+    """Remove the Fast DDS files in /dev/shm that appeared during the session and no live process uses.
 
     Several tests kill a node with SIGKILL on purpose (a crash, a recorder
     killed), and a killed participant leaves its files.  Only files new since
-    the session started are looked at, and only those no live process holds
-    are removed (:func:`tutorial.ros.shm.remove_unused_fast_dds_shm`).
+    the session started are looked at, and of those only the ones whose lock
+    no live process holds are removed (:func:`tutorial.ros.shm.remove_unused_fast_dds_shm`,
+    Fast DDS's own rule): whoever left them, they are nobody's any more.
     """
-    from tutorial.ros.shm import SHM_DIR, remove_unused_fast_dds_shm
+    from tutorial.ros.shm import remove_unused_fast_dds_shm
 
-    remove_unused_fast_dds_shm(set(os.listdir(SHM_DIR)) - _SHM_BEFORE)
+    remove_unused_fast_dds_shm(_shm_names() - _SHM_BEFORE)
 
 
 def pytest_configure(config):

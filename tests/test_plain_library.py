@@ -5,7 +5,7 @@ Two checks, each proved to catch what it claims on a made-up module:
 - a module of ``tutorial/`` over :data:`MAX_LINES` lines says in its
   docstring why it is one job (the words "one job");
 - the controllers the notebooks export (``tutorial/controllers/``, the code a
-  learner writes in notebooks 01 to 06) use no speed tricks: no
+  learner writes in notebooks 01 to 06, and 09's robot-model publisher) use no speed tricks: no
   ``memoryview``, no ``array`` module, no ``bytes``/``bytearray`` buffers.
   Where a step needs speed, it calls a library function in one line.
 """
@@ -29,7 +29,8 @@ def long_modules_without_a_reason(package: Path) -> list[str]:
     found = []
     for path in sorted(package.rglob("*.py")):
         text = path.read_text()
-        if text.count("\n") > MAX_LINES and "one job" not in (ast.get_docstring(ast.parse(text)) or ""):
+        docstring = " ".join((ast.get_docstring(ast.parse(text)) or "").split())  # a line break is a space
+        if text.count("\n") > MAX_LINES and "one job" not in docstring:
             found.append(f"{path.relative_to(package.parent)}: {text.count(chr(10))} lines")
     return found
 
@@ -56,14 +57,14 @@ def test_the_length_check_catches_a_long_module_without_a_reason(tmp_path):
     package.mkdir()
     body = "x = 1\n" * MAX_LINES
     (package / "long.py").write_text('"""Many jobs."""\n' + body)
-    (package / "long_but_said.py").write_text('"""Long: one job, the file format."""\n' + body)
+    (package / "long_but_said.py").write_text('"""Long: one\njob, the file format."""\n' + body)
     (package / "short.py").write_text('"""Short."""\n' + "x = 1\n" * (MAX_LINES - 1))
     assert long_modules_without_a_reason(package) == [f"tutorial/long.py: {MAX_LINES + 1} lines"]
 
 
 def test_the_exported_controllers_use_no_speed_tricks():
-    modules = sorted((ROOT / "tutorial" / "controllers").glob("*.py"))
-    assert len(modules) >= 6  # one or more a notebook, 01 to 06
+    modules = sorted(m for m in (ROOT / "tutorial" / "controllers").glob("*.py") if m.name != "__init__.py")
+    assert len(modules) >= 6  # at least one for each of notebooks 01 to 06
     found = {m.name: speed_tricks(m.read_text()) for m in modules}
     assert {name: tricks for name, tricks in found.items() if tricks} == {}
 

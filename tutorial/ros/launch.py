@@ -39,7 +39,7 @@ _SIGINT_GRACE = 3.0  # s before SIGINT escalates to SIGTERM
 _SIGTERM_GRACE = 1.2  # s before SIGTERM escalates to SIGABRT
 _SIGABRT_GRACE = 0.3  # s for faulthandler to print the stacks before SIGKILL
 PR_SET_PDEATHSIG = 1
-_LIBRARY_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_LIBRARY_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # holds tutorial/
 _SHM_SAMPLE_PERIOD = 1.0  # s between looks at every /dev/shm file the children map
 
 
@@ -97,6 +97,7 @@ class Launch:
         self.stop_requested = False
         self.stopping = False
         self.failed: list[str] = []
+        self.forced: dict[str, signal.Signals] = {}  # node -> the last signal the shutdown had to send past SIGTERM
         self.shm_files: set[str] = set()  # Fast DDS files in /dev/shm the children used (main thread)
         self._next_shm_sample = 0.0
 
@@ -169,8 +170,11 @@ class Launch:
                 break
             if sig == signal.SIGABRT:
                 self._say_hung(alive, time.monotonic() - first)
-            for p in alive:
-                p.send_signal(sig)
+            for name, p in self.procs.items():
+                if p in alive:
+                    p.send_signal(sig)
+                    if sig in (signal.SIGABRT, signal.SIGKILL):
+                        self.forced[name] = sig
             deadline = start + (grace if grace is not None else SHUTDOWN_TIMEOUT - 0.2)
             for p in alive:
                 try:
@@ -186,25 +190,36 @@ class Launch:
             if code not in (0, None) and name not in self.failed and code != -signal.SIGINT:
                 self.failed.append(name)
         if self.failed:
-            self._say(
-                "failed: "
-                + ", ".join(
-                    f"{name} ({_exit_status(self.procs[name].returncode)})" for name in sorted(set(self.failed))
-                )
-            )
+            self._say("failed: " + ", ".join(f"{name} ({self._ended(name)})" for name in sorted(set(self.failed))))
             return 1
         self._say("all nodes stopped cleanly")
         return 0
 
     def _say_hung(self, alive: list[subprocess.Popen], waited: float) -> None:
-        """Name the nodes still running after SIGINT and SIGTERM, and keep SIGABRT from writing a core file."""
+        """Name the nodes still running after SIGINT and SIGTERM, and keep SIGABRT from writing a core file.
+
+        The core-file limit is the kernel's for a core written as a file; a
+        system that pipes cores to a handler (systemd-coredump, apport) may
+        still collect one.
+        """
         names = ", ".join(name for name, p in self.procs.items() if p in alive)
-        self._say(f"{names} did not stop within {waited:.1f} s: SIGABRT, so Python prints where its threads are")
+        self._say(
+            f"{names} did not stop within {waited:.1f} s: sending SIGABRT, "
+            "so Python prints the stack of every thread (below, with the node's prefix)"
+        )
         for p in alive:
             try:
                 resource.prlimit(p.pid, resource.RLIMIT_CORE, (0, 0))
             except (OSError, ValueError):
                 pass  # gone meanwhile, or not ours to change: the abort may then write a core file
+
+    def _ended(self, name: str) -> str:
+        """How node ``name`` ended, for the report: ``exit 1``, ``killed by SIGKILL``, or stopped by the launcher."""
+        code = self.procs[name].returncode
+        forced = self.forced.get(name)
+        if forced is not None and code == -forced:
+            return f"did not stop: the launcher sent {forced.name}"
+        return _exit_status(code)
 
     def note_shared_memory(self, mapped: bool = True) -> None:
         """Add the Fast DDS files in /dev/shm the children use now to :attr:`shm_files` (main thread).

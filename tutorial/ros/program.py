@@ -113,7 +113,8 @@ def ignore_stop_signals() -> None:
     group, and a launcher then sends each of its nodes another one.  Without
     this, that second signal raises ``KeyboardInterrupt`` in the middle of
     ``destroy_node()`` and prints a traceback.  A clean-up that hangs is still
-    ended: a launcher escalates to SIGKILL.
+    ended: the launcher sends SIGABRT, which prints every thread's stack
+    (``PYTHONFAULTHANDLER``), then SIGKILL.
 
     Raises:
         ValueError: called from a thread other than the main thread.
