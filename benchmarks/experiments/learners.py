@@ -135,7 +135,6 @@ class ViewClient:
         self._errors: dict[str, str] = {}
         self._owed: dict[str, int] = {}  # comm id -> frames arrived and not answered yet
         self._settling: set[asyncio.Task] = set()  # the late answers' tasks, each kept until it is done
-        self._timers: set[asyncio.TimerHandle] = set()  # the late answers not yet due
         self._ws = None
 
     async def connect(self) -> None:
@@ -203,16 +202,14 @@ class ViewClient:
 
     def _settle_later(self, comm: str) -> None:
         """Answer a lone frame as widget.js does: two animation frames (60 Hz) later, unless a second came."""
-        loop = asyncio.get_running_loop()
 
-        def settle() -> None:
-            self._timers.discard(timer)
-            task = loop.create_task(self._settle(comm))
-            self._settling.add(task)
-            task.add_done_callback(self._settling.discard)
+        async def settle() -> None:
+            await asyncio.sleep(2 / 60)
+            await self._settle(comm)
 
-        timer = loop.call_later(2 / 60, settle)
-        self._timers.add(timer)
+        task = asyncio.get_running_loop().create_task(settle())
+        self._settling.add(task)
+        task.add_done_callback(self._settling.discard)
 
     async def _settle(self, comm: str) -> None:
         from websockets.exceptions import ConnectionClosed
@@ -225,10 +222,8 @@ class ViewClient:
                 pass  # the learner's page closed: a browser's closing page answers nothing either
 
     async def close(self) -> None:
-        for timer in list(self._timers):
-            timer.cancel()  # answers still due two frames later: the page is closing
         for task in list(self._settling):
-            task.cancel()
+            task.cancel()  # answers still due two frames later: the page is closing
         if self._ws is not None:
             await self._ws.close()
             self._reader.cancel()

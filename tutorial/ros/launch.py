@@ -165,18 +165,17 @@ class Launch:
             (signal.SIGKILL, None),
         )
         for sig, grace in stages:
-            alive = [p for p in self.procs.values() if p.poll() is None]
+            alive = {name: p for name, p in self.procs.items() if p.poll() is None}
             if not alive:
                 break
             if sig == signal.SIGABRT:
                 self._say_hung(alive, time.monotonic() - first)
-            for name, p in self.procs.items():
-                if p in alive:
-                    p.send_signal(sig)
-                    if sig in (signal.SIGABRT, signal.SIGKILL):
-                        self.forced[name] = sig
+            for name, p in alive.items():
+                p.send_signal(sig)
+                if sig in (signal.SIGABRT, signal.SIGKILL):
+                    self.forced[name] = sig
             deadline = start + (grace if grace is not None else SHUTDOWN_TIMEOUT - 0.2)
-            for p in alive:
+            for p in alive.values():
                 try:
                     p.wait(max(0.0, deadline - time.monotonic()) if grace is not None else None)
                 except subprocess.TimeoutExpired:
@@ -195,19 +194,18 @@ class Launch:
         self._say("all nodes stopped cleanly")
         return 0
 
-    def _say_hung(self, alive: list[subprocess.Popen], waited: float) -> None:
+    def _say_hung(self, alive: dict[str, subprocess.Popen], waited: float) -> None:
         """Name the nodes still running after SIGINT and SIGTERM, and keep SIGABRT from writing a core file.
 
         The core-file limit is the kernel's for a core written as a file; a
         system that pipes cores to a handler (systemd-coredump, apport) may
         still collect one.
         """
-        names = ", ".join(name for name, p in self.procs.items() if p in alive)
         self._say(
-            f"{names} did not stop within {waited:.1f} s: sending SIGABRT, "
+            f"{', '.join(alive)} did not stop within {waited:.1f} s: sending SIGABRT, "
             "so Python prints the stack of every thread (below, with the node's prefix)"
         )
-        for p in alive:
+        for p in alive.values():
             try:
                 resource.prlimit(p.pid, resource.RLIMIT_CORE, (0, 0))
             except (OSError, ValueError):
