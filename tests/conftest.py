@@ -58,17 +58,10 @@ TIERS = ("unit", "ros", "cross_process", "launch", "browser", "notebooks", "netw
 _SHM_BEFORE: set[str] = set()  # the names in /dev/shm when the session started
 
 
-def _shm_names() -> set[str]:
-    from tutorial.ros.shm import SHM_DIR
-
-    try:
-        return set(os.listdir(SHM_DIR))
-    except FileNotFoundError:  # no /dev/shm: nothing of Fast DDS's to look after
-        return set()
-
-
 def pytest_sessionstart(session) -> None:
-    _SHM_BEFORE.update(_shm_names())
+    from tutorial.ros.shm import shm_names
+
+    _SHM_BEFORE.update(shm_names())
 
 
 def pytest_sessionfinish(session, exitstatus) -> None:
@@ -79,10 +72,11 @@ def pytest_sessionfinish(session, exitstatus) -> None:
     the session started are looked at, and of those only the ones whose lock
     no live process holds are removed (:func:`tutorial.ros.shm.remove_unused_fast_dds_shm`,
     Fast DDS's own rule): whoever left them, they are nobody's any more.
+    (A session is two hooks, not one block: :func:`tutorial.ros.shm.new_leftovers_removed`'s rule, by hand.)
     """
-    from tutorial.ros.shm import remove_unused_fast_dds_shm
+    from tutorial.ros.shm import remove_unused_fast_dds_shm, shm_names
 
-    remove_unused_fast_dds_shm(_shm_names() - _SHM_BEFORE)
+    remove_unused_fast_dds_shm(shm_names() - _SHM_BEFORE)
 
 
 def pytest_configure(config):

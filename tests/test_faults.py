@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from test_launch import processes_with_marker
 
-from tutorial.ros.shm import SHM_DIR, fast_dds_shm_files, remove_unused_fast_dds_shm
+from tutorial.ros.shm import SHM_DIR, fast_dds_shm_files, new_leftovers_removed, remove_unused_fast_dds_shm
 
 from conftest import ROOT, module_command, publishers_seen, wait_until
 
@@ -369,6 +369,38 @@ def test_shared_memory_clean_up_keeps_what_a_live_owner_locks():
         assert remove_unused_fast_dds_shm({port + "_el"}) == [port, port + "_el", f"sem.{port}_mutex"]
     finally:
         for name in files + [f"sem.{port}_mutex"]:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(os.path.join(SHM_DIR, name))
+
+
+def test_a_run_removes_only_the_unused_leftovers_that_appeared_while_it_ran():
+    """make bench's clean-up (new_leftovers_removed) on stand-in segments: what was there before stays, what a
+    live owner locks stays, an unused segment that appeared during the run goes, also when the run fails."""
+    import fcntl
+
+    def segment() -> str:
+        return f"fastrtps_{uuid.uuid4().hex[:16]}"
+
+    before, locked, dropped = segment(), segment(), segment()
+    files = [name + suffix for name in (before, locked, dropped) for suffix in ("", "_el")]
+    here = lambda name: os.path.exists(os.path.join(SHM_DIR, name))  # noqa: E731
+    owner = None
+    try:
+        for name in (before, before + "_el"):
+            Path(SHM_DIR, name).touch()
+        with pytest.raises(RuntimeError, match="an experiment failed"), new_leftovers_removed():
+            for name in files[2:]:
+                Path(SHM_DIR, name).touch()
+            owner = os.open(os.path.join(SHM_DIR, locked + "_el"), os.O_RDONLY)
+            fcntl.flock(owner, fcntl.LOCK_EX)  # as a live Fast DDS participant holds its segment
+            raise RuntimeError("an experiment failed")
+        assert here(before) and here(before + "_el"), "a file from before the run was removed"
+        assert here(locked) and here(locked + "_el"), "a segment its live owner locks was removed"
+        assert not here(dropped) and not here(dropped + "_el"), "an unused leftover of the run stayed"
+    finally:
+        if owner is not None:
+            os.close(owner)
+        for name in files:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(os.path.join(SHM_DIR, name))
 

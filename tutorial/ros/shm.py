@@ -14,7 +14,9 @@ own files stay, and so do those of the ports it had open.
 
 The launcher (:mod:`tutorial.ros.launch`) notes which files its nodes use and,
 once they are all gone, removes those nobody uses any more: Fast DDS's own
-rules, applied only to the files its own nodes used.
+rules, applied only to the files its own nodes used.  A test session and
+``make bench``, which kill nodes on purpose, remove the unused ones that
+appeared while they ran (:func:`new_leftovers_removed`).
 """
 
 from __future__ import annotations
@@ -126,6 +128,31 @@ def _lock_if_unused(path: str, held: contextlib.ExitStack) -> bool:
     except BlockingIOError:
         return False
     return True
+
+
+def shm_names() -> set[str]:
+    """The names in :data:`SHM_DIR` now (empty on a machine without it).  Any thread may call it."""
+    try:
+        return set(os.listdir(SHM_DIR))
+    except FileNotFoundError:  # no /dev/shm: nothing of Fast DDS's to look after
+        return set()
+
+
+@contextlib.contextmanager
+def new_leftovers_removed():
+    """On leaving, remove the Fast DDS files that appeared in :data:`SHM_DIR` meanwhile and no live process uses.
+
+    For a whole run that kills nodes on purpose (a benchmark suite): only
+    files new since it began are looked at, and of those only the ones whose
+    lock no live process holds are removed (:func:`remove_unused_fast_dds_shm`),
+    also when the run ends with an error.  Whoever left them, they are
+    nobody's any more.  Yields nothing.
+    """
+    before = shm_names()
+    try:
+        yield
+    finally:
+        remove_unused_fast_dds_shm(shm_names() - before)
 
 
 def is_segment(name: str) -> bool:
