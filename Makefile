@@ -67,9 +67,10 @@ test-grade: $(VENV)/.installed
 assignments: $(VENV)/.installed
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/assignments.py
 
-# Collect the submissions from the exchange, autograde them, write feedback and course/grades.csv.
+# Collect the submissions from the exchange, autograde them, write and release feedback, and course/grades.csv.
+# ARGS go to course/grade.py: make grade ARGS="01_step1_tank_controller --jobs 2".
 grade: $(VENV)/.installed
-	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/grade.py
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/grade.py $(ARGS)
 
 # Mutation testing (mutmut, configured in pyproject.toml) of the modules the notebooks build and the core they
 # stand on: each mutant is a small change to one function, run against the tests that call it; the report says

@@ -108,17 +108,42 @@ def source_notebook(notebook: dict) -> dict:
         if cell["cell_type"] == "code":
             cell["outputs"], cell["execution_count"] = [], None
         cell["metadata"].pop("execution", None)
-        if cell["cell_type"] == "markdown":  # the statement says a worked solution follows: not here
-            text = "".join(cell["source"])
-            cell["source"] = re.sub(
-                r"A worked solution follows, folded\s+away:.*?checks it\.",
-                "In this assignment the worked solutions are held back: your check cells are graded.",
-                text,
-                flags=re.S,
-            )
+    _say_solutions_held_back(
+        cells, "In this assignment the worked solutions are held back: your check cells are graded."
+    )
     nb["cells"] = [c for i, c in enumerate(cells) if i not in drop]
     nb["metadata"].pop("widgets", None)
     return nb
+
+
+def learner_notebook(notebook: dict) -> dict:
+    """A teacher's notebook as a class's hub gives it to a learner: the folded worked solutions left out.
+
+    Everything else is the notebook's, outputs included (the lessons' recorded
+    views and figures); the stubs and checks stay, so each exercise is the
+    learner's to solve and check, as in the assignment.  A new dict; the
+    notebook is not changed.
+
+    Raises:
+        ValueError: an exercise without its stub or check cell.
+    """
+    nb = copy.deepcopy(notebook)
+    drop = {ex["solution"] for ex in exercises(nb["cells"])}
+    _say_solutions_held_back(
+        nb["cells"], "On this class's server the worked solutions are held back: your teacher grades your check cells."
+    )
+    nb["cells"] = [c for i, c in enumerate(nb["cells"]) if i not in drop]
+    return nb
+
+
+def _say_solutions_held_back(cells: list[dict], sentence: str) -> None:
+    """Put ``sentence`` where a statement says a worked solution follows (the cells are changed in place)."""
+    for cell in cells:
+        if cell["cell_type"] == "markdown":
+            text = "".join(cell["source"])
+            cell["source"] = re.sub(
+                r"A worked solution follows, folded\s+away:.*?checks it\.", sentence, text, flags=re.S
+            )
 
 
 def make(course: Path, release: bool = True) -> list[str]:

@@ -28,6 +28,14 @@ import re
 import tempfile
 from pathlib import Path
 
+BOOK_NAME = "ros_domains.json"  # the hub's book of domains, in its state folder
+
+
+def hub_state() -> Path:
+    """The hub's state folder: ``RTT_HUB_STATE``, or ``course/.hub`` (database, book of domains, a trial's homes)."""
+    return Path(os.environ.get("RTT_HUB_STATE", Path(__file__).resolve().parent / ".hub")).resolve()
+
+
 # Fast DDS's port arithmetic on Linux (see the module's text); 0 is the default everyone shares.
 LEARNER_DOMAINS = tuple(range(1, 102)) + tuple(range(215, 233))
 NAME = re.compile(r"^[a-z0-9][a-z0-9._@-]{0,63}$")  # JupyterHub's usual (normalized, lower-case) names

@@ -1,26 +1,36 @@
 """Grade the class: collect, autograde, feedback and the grades' CSV, with nbgrader's own commands.
 
-    python course/grade.py [ASSIGNMENT ...] [--course DIR] [--no-collect] [--jobs N] [--domains 90-101]
+    python course/grade.py [ASSIGNMENT ...] [--course DIR] [--no-collect] [--jobs N] [--domains 215-232]
+    make grade ARGS="01_step1_tank_controller --jobs 2"
 
-For each assignment (default: every one in the course's ``release/``):
+For each assignment (default: every one released into the exchange; with
+``--no-collect``, every one in the course's ``release/``):
 
 1. ``nbgrader collect``: the submissions from the exchange into ``submitted/``;
 2. ``nbgrader autograde``, one learner at a time per job, ``--jobs`` at once.
-   Each job's kernel runs in a ROS domain of its own (``--domains``; the
-   discovery range is this machine), so submissions graded at once never
-   hear each other's nodes; the notebooks' runs end by themselves
-   (``RTT_TEST_MODE=1``).  A cell that never ends is interrupted after the
-   course's cell timeout (``nbgrader_config.py``): its exercise gets 0, the
-   rest is graded;
+   Each job's kernel runs in a ROS domain of its own (the discovery range is
+   this machine), so submissions graded at once never hear each other's
+   nodes; the notebooks' runs end by themselves (``RTT_TEST_MODE=1``).  The
+   domains (``--domains``) are by default those the hub's book has given no
+   learner, from the top (:func:`free_domains`): a learner's robots running
+   during the grading are never heard by it.  A cell that never ends is
+   interrupted after the course's cell timeout (``nbgrader_config.py``): its
+   exercise gets 0, the rest is graded;
 3. ``nbgrader generate_feedback``: each learner's feedback, in ``feedback/``;
+   and, from the exchange, ``nbgrader release_feedback``: each learner
+   fetches it in the Assignments tab (Fetch Feedback) or with
+   ``nbgrader fetch_feedback``;
 
-then ``nbgrader export`` writes every grade to ``grades.csv`` in the course.
+then ``nbgrader export`` writes the grades of every assignment graded (and,
+from the exchange, every one released) to ``grades.csv`` in the course (one not given to the class yet has no
+rows: its zeros would read as missed work).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -28,10 +38,11 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a package
+from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
 
 
 def domains(text: str) -> list[int]:
-    """``"90-101"`` or ``"5,7,9"`` as a list of ROS domain ids.
+    """``"215-232"`` or ``"5,7,9"`` as a list of ROS domain ids.
 
     Raises:
         ValueError: not a list or range of ids from 0 to 232.
@@ -45,14 +56,43 @@ def domains(text: str) -> list[int]:
     return ids
 
 
+def free_domains(book: Path | None = None) -> list[int]:
+    """The server's ROS domains the hub's book has given no learner, highest first (the hub gives the lowest).
+
+    ``book``: the hub's book of domains (default: the hub's state folder's, ``RTT_HUB_STATE``); none
+    there yet: every domain is free.
+
+    Raises:
+        ValueError: every domain is a learner's (the message says what to do).
+        domains.DomainError: the book is not a book of domains.
+    """
+    taken = set(DomainBook(book or hub_state() / BOOK_NAME).read().values())
+    free = [d for d in reversed(LEARNER_DOMAINS) if d not in taken]
+    if not free:
+        raise ValueError(
+            "every ROS domain of this server is a learner's, and graded notebooks would hear a learner's robots: "
+            "grade on another machine, or name domains no learner runs in now with --domains"
+        )
+    return free
+
+
+def released(course: Path) -> list[str]:
+    """The assignments released into the course's exchange (nbgrader's own ``list``)."""
+    said = nbgrader(course, "list").splitlines()
+    start = next((i for i, line in enumerate(said) if line.endswith("Released assignments:")), len(said))
+    return sorted(m.group(1) for line in said[start + 1 :] if (m := re.search(r"\] \S+ (\S+)$", line)))
+
+
 def learners(course: Path, assignment: str) -> list[str]:
     """Who submitted ``assignment`` (the folders of ``submitted/``)."""
     folder = course / "submitted"
     return sorted(p.name for p in folder.iterdir() if (p / assignment).is_dir()) if folder.is_dir() else []
 
 
-def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int = 1, ids=(90,)) -> Path:
+def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int = 1, ids=(232,)) -> Path:
     """Grade ``assignments`` in ``course``; the grades' CSV.
+
+    ``collect``: from the exchange (then each learner's feedback is released into it).
 
     Raises:
         GradingError: some submissions could not be graded; the others were, and the CSV was written.
@@ -85,8 +125,15 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
             list(pool.map(worker, range(jobs)))  # list(): a worker's exception is raised here
         if who:
             nbgrader(course, "generate_feedback", assignment, "--force")
+            # Into the exchange, for the learners whose submission came through it (nbgrader's timestamp.txt):
+            # one put into submitted/ by hand is handed back by hand, from feedback/.
+            by_hand = [w for w in who if not (course / "submitted" / w / assignment / "timestamp.txt").is_file()]
+            if collect and len(by_hand) < len(who):
+                exclude = [f"--CourseDirectory.student_id_exclude={','.join(by_hand)}"] if by_hand else []
+                nbgrader(course, "release_feedback", assignment, *exclude)
     csv = course / "grades.csv"
-    nbgrader(course, "export", "--to", str(csv))
+    given = sorted(set(assignments) | set(released(course) if collect else ()))
+    nbgrader(course, "export", "--to", str(csv), *(f"--assignment={name}" for name in given))
     if failed:
         raise GradingError(csv, failed)
     return csv
@@ -107,16 +154,32 @@ class GradingError(RuntimeError):
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("assignments", nargs="*", help="default: every assignment in the course's release/")
+    p.add_argument(
+        "assignments", nargs="*", help="default: every one released (with --no-collect: in the course's release/)"
+    )
     p.add_argument("--course", type=Path, default=HERE)
     p.add_argument("--no-collect", action="store_true", help="grade what is in submitted/ already")
     p.add_argument("--jobs", type=int, default=1, help="learners graded at once (default 1)")
-    p.add_argument("--domains", default="90-101", help="ROS domains for the jobs (default 90-101)")
+    p.add_argument(
+        "--domains", help="ROS domains for the jobs, as 215-232 or 5,7,9 (default: those the hub gave no learner)"
+    )
     args = p.parse_args(argv)
     course = args.course.resolve()
-    names = args.assignments or sorted(p.name for p in (course / "release").iterdir() if p.is_dir())
+    if args.assignments:
+        names = args.assignments
+    elif args.no_collect:
+        names = sorted(p.name for p in (course / "release").iterdir() if p.is_dir())
+    else:
+        names = released(course)
+        if not names:
+            print("no assignment is released into the exchange yet: nothing to collect", file=sys.stderr)
+            return 1
     try:
-        csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=domains(args.domains))
+        ids = domains(args.domains) if args.domains else free_domains()
+        csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=ids)
+    except (ValueError, DomainError) as error:
+        print(f"not graded: {error}", file=sys.stderr)
+        return 2
     except GradingError as error:
         print(f"graded {', '.join(names)}: {error.csv}, but {error}", file=sys.stderr)
         return 1

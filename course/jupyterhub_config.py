@@ -20,10 +20,13 @@
 #                       shared; a learner's own machine draws 60)
 #   RTT_HUB_PER_LEARNER_NETWORK  "1" when the spawner gives each learner a network namespace (containers,
 #                       pods): domains may then repeat
+#   RTT_HUB_WORKED_SOLUTIONS  "shown" to keep the notebooks' folded worked solutions in the learners' copies (a
+#                       workshop that grades nothing); by default they are held back, as in the assignments
 #   RTT_NBGRADER_EXCHANGE  nbgrader's exchange, where learners fetch assignments and submit them (default
 #                       the state folder's exchange/; a course's server: /srv/nbgrader/exchange); the teacher's
 #                       course/nbgrader_config.py reads the same variable
 
+import json
 import os
 import pwd
 import shutil
@@ -35,15 +38,17 @@ COURSE = Path(__file__).resolve().parent
 ROOT = COURSE.parent
 sys.path.insert(0, str(COURSE))
 
-from domains import DomainBook, DomainError  # noqa: E402 - course/ is on the path only from here
+from assignments import learner_notebook  # noqa: E402 - course/ is on the path only from here
+from domains import BOOK_NAME, DomainBook, DomainError, hub_state  # noqa: E402
 
 c = get_config()  # noqa: F821 - JupyterHub provides it
 
-STATE = Path(os.environ.get("RTT_HUB_STATE", COURSE / ".hub")).resolve()
+STATE = hub_state()
 STATE.mkdir(parents=True, exist_ok=True)
 PYTHON = Path(os.environ.get("RTT_HUB_PYTHON", ROOT / ".venv" / "bin" / "python"))
 ENV_BIN = PYTHON.parent  # jupyterhub-singleuser and the rtt-* programs of the learners' environment
 LEARNERS = [n for n in os.environ.get("RTT_HUB_LEARNERS", "learner1,learner2,learner3").split(",") if n]
+SHOW_SOLUTIONS = os.environ.get("RTT_HUB_WORKED_SOLUTIONS") == "shown"
 
 # ---- where the hub listens: this machine only, unless a course puts it behind its own HTTPS front
 c.JupyterHub.bind_url = os.environ.get("RTT_HUB_URL", "http://127.0.0.1:8000")
@@ -102,10 +107,15 @@ EXCHANGE.chmod(0o777)  # every learner writes their submissions into it
 LEARNER_CONFIG = STATE / "learner_jupyter"
 (LEARNER_CONFIG / "labconfig").mkdir(parents=True, exist_ok=True)
 (LEARNER_CONFIG / "nbgrader_config.py").write_text(
+    "import os\n"
     "c = get_config()  # noqa: F821\n"
     'c.CourseDirectory.course_id = "ros-tank-tutorial"\n'
     f"c.Exchange.root = {str(EXCHANGE)!r}\n"
     "c.Exchange.path_includes_course = True\n"
+    "# A submission is the hub's learner's, not the Unix user's: nbgrader names it after the Unix user, and\n"
+    "# on the trial's spawner every learner is the same one (their submissions would overwrite each other).\n"
+    'if os.environ.get("JUPYTERHUB_USER"):\n'
+    '    c.CourseDirectory.student_id = os.environ["JUPYTERHUB_USER"]\n'
 )
 (LEARNER_CONFIG / "labconfig" / "page_config.json").write_text(
     '{"disabledExtensions": {"@jupyter/nbgrader:create-assignment": true, "@jupyter/nbgrader:course-list": true}}\n'
@@ -119,7 +129,7 @@ for path in (LEARNER_CONFIG, LEARNER_CONFIG / "labconfig"):
 c.Spawner.environment["JUPYTER_CONFIG_PATH"] = str(LEARNER_CONFIG)
 
 DOMAINS = DomainBook(
-    STATE / "ros_domains.json",
+    STATE / BOOK_NAME,
     domains=[int(d) for d in os.environ["RTT_HUB_DOMAINS"].split(",")] if os.environ.get("RTT_HUB_DOMAINS") else None,
     per_learner_network=os.environ.get("RTT_HUB_PER_LEARNER_NETWORK") == "1",
 )
@@ -146,6 +156,10 @@ def give_learner_their_domain_and_notebooks(spawner):
     if target.exists():
         return  # a learner's own copy, made once: their work is never overwritten
     shutil.copytree(ROOT / "notebooks", target, ignore=shutil.ignore_patterns(".ipynb_checkpoints", "*.cfg"))
+    if not SHOW_SOLUTIONS:  # the folded worked solutions held back, as in the graded assignments
+        for path in target.glob("*.ipynb"):
+            notebook = json.loads(path.read_text(encoding="utf-8"))
+            path.write_text(json.dumps(learner_notebook(notebook), indent=1) + "\n", encoding="utf-8")
     # Trusted in the learner's own Jupyter, so the notebooks' recorded 3D views run (JupyterLab runs no
     # script of an untrusted output).
     subprocess.run(

@@ -140,6 +140,10 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
     assignments.make(course, release=False)
     for name in names:
         assignments.nbgrader(course, "generate_assignment", name, "--force")
+    # made and not given to the class yet: the grades' CSV must have no rows for it (they would read as zeros)
+    not_given = next(n for n in ALL if n not in names) if exchange else None
+    if not_given:
+        assignments.nbgrader(course, "generate_assignment", not_given, "--force")
     expected = {}
     if exchange:
         name, me = names[0], getpass.getuser()
@@ -159,6 +163,7 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
                 cell["source"] = solution_of(course, name)[gid]
         fetched.write_text(json.dumps(nb))
         assignments.nbgrader(home, "submit", name, *where)
+        assert grade.released(course) == [name]  # what make grade collects by default
         expected[(name, me)] = {n: float(assignments.POINTS[n]) if n == first else 0.0 for n in exercises_of(name)}
     for name in names:
         for learner, (nb, points) in submissions(course, name, every_mistake).items():
@@ -191,6 +196,14 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
     for (name, learner), points in expected.items():
         assert rows[(name, learner)] == sum(points.values()), (name, learner, rows[(name, learner)])
         assert (course / "feedback" / learner / name / f"{name}.html").is_file(), f"no feedback for {learner}"
+    assert {name for name, _ in rows} == set(names), "the CSV has rows for an assignment not given to the class"
+    if exchange:  # the learner fetches their feedback from the exchange, as from the Assignments tab
+        assignments.nbgrader(home, "fetch_feedback", names[0], *where)
+        fetched = list((home / names[0] / "feedback").glob(f"*/{names[0]}.html"))
+        assert len(fetched) == 1, f"the learner got no feedback: {list(home.rglob('*.html'))}"
+        total = sum(float(assignments.POINTS[n]) for n in exercises_of(names[0]))
+        mine = sum(expected[(names[0], me)].values())
+        assert f"Score: {mine} / {total}" in fetched[0].read_text(), "the fetched feedback is not the learner's"
 
 
 def test_the_release_shows_the_notebooks_stubs_and_no_solution(tmp_path):
@@ -209,6 +222,39 @@ def test_the_release_shows_the_notebooks_stubs_and_no_solution(tmp_path):
     assert [c["metadata"]["nbgrader"]["points"] for c in checks] == [assignments.POINTS[e["number"]] for e in found]
     assert all(c["metadata"]["nbgrader"]["locked"] for c in checks)
     assert all("".join(c["source"]).rstrip().endswith(".require()") for c in checks)
+
+
+def test_grading_takes_only_domains_no_learner_was_given(tmp_path):
+    """make grade's default domains: none the hub's book gave a learner, so a graded notebook never hears one."""
+    import domains as hub_domains
+
+    book = tmp_path / "ros_domains.json"
+    assert grade.free_domains(book)[:2] == [232, 231]  # no hub yet: every domain, from the top
+    book.write_text(json.dumps({"learner1": 1, "learner2": 2, "late": 232}))
+    free = grade.free_domains(book)
+    assert free[0] == 231 and not {1, 2, 232} & set(free) and len(free) == len(hub_domains.LEARNER_DOMAINS) - 3
+    book.write_text(json.dumps({f"l{d}": d for d in hub_domains.LEARNER_DOMAINS}))
+    with pytest.raises(ValueError, match="every ROS domain of this server is a learner's"):
+        grade.free_domains(book)
+
+
+def test_a_class_hub_gives_learners_the_notebooks_without_the_worked_solutions():
+    """Each notebook as the hub copies it to a learner: every cell but the folded solutions, outputs and all."""
+    for name in ALL:
+        teacher = json.loads((ROOT / "notebooks" / f"{name}.ipynb").read_text())
+        found = assignments.exercises(teacher["cells"])
+        given = assignments.learner_notebook(teacher)
+        assert "Worked solution to Exercise" not in json.dumps(given), name
+        solutions = {ex["solution"] for ex in found}
+        kept = [c for i, c in enumerate(teacher["cells"]) if i not in solutions]
+        assert len(given["cells"]) == len(kept) == len(teacher["cells"]) - len(found) > 0, name
+        for mine, theirs in zip(given["cells"], kept):
+            assert mine.get("outputs") == theirs.get("outputs") and mine["cell_type"] == theirs["cell_type"], name
+            if mine["cell_type"] == "code":  # the stubs and checks as the teacher's: the learner's to solve
+                assert mine["source"] == theirs["source"], name
+        assert teacher == json.loads((ROOT / "notebooks" / f"{name}.ipynb").read_text()), "the teacher's changed"
+    text = json.dumps(assignments.learner_notebook(json.loads((ROOT / "notebooks" / f"{ALL[0]}.ipynb").read_text())))
+    assert "A worked solution follows" not in text and "the worked solutions are held back" in text
 
 
 def test_a_notebook_without_points_for_an_exercise_is_refused():

@@ -88,7 +88,10 @@ def test_each_learners_robots_are_their_own(hub):
     assert env_a["RTT_FRAME_RATE"] == "20"  # a class's server: live views at 20 frames/s (the Benchmarks page)
     book = json.loads((hub_state(hub) / "ros_domains.json").read_text())
     assert book == {"learner-a": int(env_a["ROS_DOMAIN_ID"]), "learner-b": int(env_b["ROS_DOMAIN_ID"])}
-    assert (hub_state(hub) / "homes" / "learner-a" / "notebooks" / "01_step1_tank_controller.ipynb").is_file()
+    given = hub_state(hub) / "homes" / "learner-a" / "notebooks" / "01_step1_tank_controller.ipynb"
+    assert given.is_file()
+    assert "Worked solution to Exercise" not in given.read_text()  # held back, as in the graded assignments
+    both_submit_under_their_own_names(hub, [a, b])
 
     # A third learner finds no domain left: told why, given no server, and A and B run on undisturbed.
     c = Learner(hub, "learner-c")
@@ -131,6 +134,33 @@ def test_each_learners_robots_are_their_own(hub):
     # Each learner in a browser of their own: logged in through the hub's form, a notebook that starts Step 2
     # with its live view; both views get their scene over their own notebook's connection and draw.
     both_live_views_draw(hub, ["learner-a", "learner-b"])
+
+
+# What a learner's kernel runs to hand in an assignment: nbgrader's own commands, in their home, with the
+# configuration the hub gives their server (the course and its exchange).
+SUBMIT = """
+import os, subprocess, sys
+for args in (["fetch_assignment", "hello"], ["submit", "hello"]):
+    done = subprocess.run([os.path.join(os.path.dirname(sys.executable), "nbgrader"), *args],
+                          cwd=os.path.expanduser("~"), capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+print("submitted")
+"""
+
+
+def both_submit_under_their_own_names(hub: Hub, learners: list[Learner]) -> None:
+    """Each learner fetches and submits a released assignment: the exchange holds one submission per learner,
+    named after the hub's learner (the trial's learners share one Unix user, whose name nbgrader would use)."""
+    import nbformat
+
+    course = hub_state(hub) / "exchange" / "ros-tank-tutorial"
+    (course / "outbound" / "hello").mkdir(parents=True)
+    (course / "inbound").mkdir()
+    nbformat.write(nbformat.v4.new_notebook(), course / "outbound" / "hello" / "hello.ipynb")
+    for learner in learners:
+        assert learner.run(SUBMIT, timeout=180).strip().endswith("submitted")
+    handed_in = sorted(p.name.split("+")[0] for p in (course / "inbound").iterdir())
+    assert handed_in == sorted(learner.name for learner in learners), handed_in
 
 
 def both_live_views_draw(hub: Hub, names: list[str]) -> None:
