@@ -117,12 +117,36 @@ LEARNER_CONFIG = STATE / "learner_jupyter"
     'if os.environ.get("JUPYTERHUB_USER"):\n'
     '    c.CourseDirectory.student_id = os.environ["JUPYTERHUB_USER"]\n'
 )
+# Also left out: nbgrader's Validate button, which on a lesson notebook (not an assignment) reports "Success!"
+# whatever the answers (the check cells are the test), and JupyterLab's question about Jupyter's news feed.
+LEFT_OUT = ["create-assignment", "course-list", "validate-assignment"]
 (LEARNER_CONFIG / "labconfig" / "page_config.json").write_text(
-    '{"disabledExtensions": {"@jupyter/nbgrader:create-assignment": true, "@jupyter/nbgrader:course-list": true}}\n'
+    json.dumps(
+        {
+            "disabledExtensions": {
+                **{f"@jupyter/nbgrader:{name}": True for name in LEFT_OUT},
+                "@jupyterlab/apputils-extension:announcements": True,
+            }
+        }
+    )
+    + "\n"
 )
+# A learner's terminal is not a login shell, so it keeps the server's environment (PATH with the rtt-* programs,
+# the ROS domain): JupyterLab otherwise starts a login shell under a hub, and /etc/profile resets PATH.
+SHELL = "/bin/bash" if Path("/bin/bash").exists() else "/bin/sh"
 (LEARNER_CONFIG / "jupyter_server_config.json").write_text(
-    '{"ServerApp": {"jpserver_extensions": {"nbgrader.server_extensions.formgrader": false, '
-    '"nbgrader.server_extensions.course_list": false}}}\n'
+    json.dumps(
+        {
+            "ServerApp": {
+                "jpserver_extensions": {
+                    "nbgrader.server_extensions.formgrader": False,
+                    "nbgrader.server_extensions.course_list": False,
+                },
+                "terminado_settings": {"shell_command": [SHELL]},
+            }
+        }
+    )
+    + "\n"
 )
 for path in (LEARNER_CONFIG, LEARNER_CONFIG / "labconfig"):
     path.chmod(0o755)
@@ -152,10 +176,16 @@ def give_learner_their_domain_and_notebooks(spawner):
     spawner.log.info("learner %s: ROS domain %d", name, domain)
     unix_user = c.JupyterHub.spawner_class == "localprocess"
     home = Path(pwd.getpwnam(name).pw_dir) if unix_user else Path(spawner.home_dir)
+    # The learner's own copies, made once (their work is never overwritten): the notebooks, and what their
+    # "Outside Jupyter" sections run from a terminal in the home folder (rtt-run project/step1.yaml, ...).
+    for folder in ("project", "model", "launch_py"):
+        if not (home / folder).exists():
+            shutil.copytree(ROOT / folder, home / folder, ignore=shutil.ignore_patterns("__pycache__"))
+            _give_to_learner(home / folder, name, unix_user)
     target = home / "notebooks"
     if target.exists():
-        return  # a learner's own copy, made once: their work is never overwritten
-    shutil.copytree(ROOT / "notebooks", target, ignore=shutil.ignore_patterns(".ipynb_checkpoints", "*.cfg"))
+        return
+    shutil.copytree(ROOT / "notebooks", target, ignore=shutil.ignore_patterns(".*", "*.cfg", "*.toml"))
     if not SHOW_SOLUTIONS:  # the folded worked solutions held back, as in the graded assignments
         for path in target.glob("*.ipynb"):
             notebook = json.loads(path.read_text(encoding="utf-8"))
@@ -169,10 +199,17 @@ def give_learner_their_domain_and_notebooks(spawner):
         timeout=120,
         check=False,
     )
-    if unix_user and os.geteuid() == 0:  # made by the hub (root): the learner's own from now on
+    _give_to_learner(target, name, unix_user)
+    if (home / ".local").exists():
+        _give_to_learner(home / ".local", name, unix_user)
+
+
+def _give_to_learner(path: Path, name: str, unix_user: bool) -> None:
+    """Made by the hub (root) for a learner who is a Unix user: ``path`` and all in it are theirs from now on."""
+    if unix_user and os.geteuid() == 0:
         entry = pwd.getpwnam(name)
-        for path in [target, *target.rglob("*"), *(home / ".local").rglob("*"), home / ".local"]:
-            os.chown(path, entry.pw_uid, entry.pw_gid)
+        for each in [path, *path.rglob("*")]:
+            os.chown(each, entry.pw_uid, entry.pw_gid)
 
 
 c.Spawner.pre_spawn_hook = give_learner_their_domain_and_notebooks

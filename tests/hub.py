@@ -196,6 +196,36 @@ class Learner:
         headers = {"Authorization": f"token {self.token}"}
         return requests.request(method, f"{self.hub.url}/user/{self.name}/{path}", headers=headers, timeout=30, **kw)
 
+    def terminal(self, command: str, until: str, timeout: float = 60.0) -> str:
+        """Type ``command`` into a new terminal of this learner's JupyterLab; what it printed once ``until`` showed.
+
+        The terminal is closed afterwards.
+
+        Raises:
+            RuntimeError: ``until`` did not show within ``timeout`` s (the message holds what did).
+        """
+        from websockets.sync.client import connect
+
+        r = self.api("POST", "api/terminals")
+        r.raise_for_status()
+        name = r.json()["name"]
+        url = f"ws://127.0.0.1:{self.hub.port}/user/{self.name}/terminals/websocket/{name}"
+        out = ""
+        deadline = time.monotonic() + timeout
+        try:
+            with connect(url, additional_headers={"Authorization": f"token {self.token}"}, open_timeout=30) as ws:
+                ws.send(json.dumps(["stdin", command + "\r"]))
+                while until not in out:
+                    left = deadline - time.monotonic()
+                    if left <= 0:
+                        raise RuntimeError(f"{self.name}'s terminal did not print {until!r} in {timeout} s: {out!r}")
+                    kind, *text = json.loads(ws.recv(timeout=left))
+                    if kind == "stdout":
+                        out += text[0]
+        finally:
+            self.api("DELETE", f"api/terminals/{name}")
+        return out
+
     def run(self, code: str, timeout: float = 120.0) -> str:
         """Run ``code`` in this learner's kernel (started on first use); its stdout and stderr as text.
 

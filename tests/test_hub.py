@@ -91,6 +91,11 @@ def test_each_learners_robots_are_their_own(hub):
     given = hub_state(hub) / "homes" / "learner-a" / "notebooks" / "01_step1_tank_controller.ipynb"
     assert given.is_file()
     assert "Worked solution to Exercise" not in given.read_text()  # held back, as in the graded assignments
+    # A terminal of the learner's JupyterLab runs the notebooks' "Outside Jupyter" commands: the rtt-* programs
+    # on its PATH, the learner's domain, their own copy of project/ in the home folder it opens in.
+    said = a.terminal("command -v rtt-run; echo domain=$ROS_DOMAIN_ID; ls project/step1.yaml; echo en''d.", "end.\r")
+    assert "/rtt-run\r" in said and f"domain={env_a['ROS_DOMAIN_ID']}\r" in said, said
+    assert "project/step1.yaml\r" in said and "No such file" not in said, said
     both_submit_under_their_own_names(hub, [a, b])
 
     # A third learner finds no domain left: told why, given no server, and A and B run on undisturbed.
@@ -343,7 +348,8 @@ def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environme
             uid, home = learner.run("import os; print(os.getuid(), os.path.expanduser('~'))").split()
             entry = pwd.getpwnam(learner.name)
             assert (int(uid), home) == (entry.pw_uid, entry.pw_dir)
-            assert (Path(home) / "notebooks" / "02_step2_joint_state_publisher.ipynb").stat().st_uid == entry.pw_uid
+            for theirs in ("notebooks/02_step2_joint_state_publisher.ipynb", "project/step1.yaml", "model"):
+                assert (Path(home) / theirs).stat().st_uid == entry.pw_uid, f"{learner.name}'s {theirs} is not theirs"
         results = {}
         for name, learner, with_joy in (("a", a, True), ("b", b, False)):  # one after the other: a slow machine
             results[name] = run_drive(learner, with_joy)

@@ -63,3 +63,17 @@ def test_ignored_outputs_say_why(path):
             if "NBVAL_IGNORE_OUTPUT" in line:
                 assert line.strip() == "# NBVAL_IGNORE_OUTPUT", f"nbval only knows the bare marker: {line!r}"
                 assert i + 1 < len(lines) and lines[i + 1].startswith("# (why:"), lines[:3]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_saved_outputs_hold_no_widget(path):
+    """A saved output that is a widget needs the kernel that made it: reopened, JupyterLab draws its controls
+    crossed by broken-link icons (or "model not found"), and the book a dead copy.  Every panel and live view
+    leaves a stand-in or a recording at reset(), and each notebook ends with one."""
+    widgets = [
+        i
+        for i, cell in enumerate(json.loads(path.read_text())["cells"])
+        for output in cell.get("outputs", [])
+        if "application/vnd.jupyter.widget-view+json" in output.get("data", {})
+    ]
+    assert widgets == [], f"{path.name}: cells whose saved output is a widget: {widgets}"

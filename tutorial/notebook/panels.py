@@ -6,8 +6,10 @@ offers instead, so :class:`Panel` gives it a text stand-in (and an HTML one
 for the book) that says what the panel is and how to get it back, rather
 than ``VBox(children=(HBox(...``.
 
-A closed panel (``reset()``) keeps its place: its controls are disabled
-and its status line says why.
+A closed panel (``reset()``) leaves the stand-in in its place, as a
+closed view leaves its recording: its widgets are closed, so a saved
+notebook holds no widget that needs a kernel (JupyterLab draws such a
+widget's controls crossed by broken-link icons).
 
 Threads: widget callbacks and :meth:`Panel.close` run on the kernel
 thread; :meth:`RunControls.refresh` may be called from a run's owner
@@ -40,6 +42,7 @@ class Panel:
         self.line = w.HTML()
         self.controls: list = []
         self.closed = False
+        self._shown: list = []  # the display handles of the outputs showing this panel (kernel thread)
         # Two threads write the status line: the kernel thread (close(), a panel's first refresh) and a run's
         # owner thread (each new status).  Each write reads the state it shows under this lock, so the write
         # that lands last shows the newest state: without it, a refresh that read "starting" could land after
@@ -51,19 +54,32 @@ class Panel:
         color = "#b00" if warning else "#444"
         self.line.value = f'<span style="color: {color}">{html.escape(text)}</span>'
 
+    def stand_in(self) -> dict:
+        """The output bundle where the panel cannot be live: what it is, and how to get it back."""
+        return {
+            "text/plain": f"{self.title}: {self.description} (a live panel: run this cell in JupyterLab to use it)",
+            "text/html": (
+                f'<div style="border: 1px solid #bbb; border-radius: 4px; padding: 6px 10px; '
+                f'color: #444"><b>{html.escape(self.title)}</b>: {html.escape(self.description)}'
+                "<br><i>A live panel: run this cell in JupyterLab to use it.</i></div>"
+            ),
+        }
+
     def _repr_mimebundle_(self, **kwargs):
-        bundle = self.widget._repr_mimebundle_(**kwargs)
-        text = f"{self.title}: {self.description} (a live panel: run this cell in JupyterLab to use it)"
-        bundle["text/plain"] = text
-        bundle["text/html"] = (
-            f'<div style="border: 1px solid #bbb; border-radius: 4px; padding: 6px 10px; '
-            f'color: #444"><b>{html.escape(self.title)}</b>: {html.escape(self.description)}'
-            "<br><i>A live panel: in JupyterLab this cell shows its controls.</i></div>"
-        )
-        return bundle
+        return {**self.widget._repr_mimebundle_(**kwargs), **self.stand_in()}
+
+    def _ipython_display_(self) -> None:
+        """Show the panel (``display(panel)``, or a cell's last expression), in an output it can replace."""
+        from IPython.display import display
+
+        self._shown.append(display(self._repr_mimebundle_(), raw=True, display_id=True))
 
     def close(self, why: str = "closed by reset(): run this cell again to use it") -> None:
-        """Disable the controls and say why (kernel thread)."""
+        """Disable the controls, then leave the stand-in where the panel was shown and close its widgets.
+
+        Kernel thread.  The stand-in's texts are the live bundle's, so a saved
+        output reads the same whether the cell was just run or reset since.
+        """
         with self._lock:
             if self.closed:
                 return
@@ -71,6 +87,21 @@ class Panel:
             for c in self.controls:
                 c.disabled = True
             self.say(why)
+        for shown in self._shown:
+            shown.update(self.stand_in(), raw=True)
+        _close_tree(self.widget)
+
+
+def _close_tree(widget) -> None:
+    """Close an ipywidgets widget and every widget it holds (children, layout, style)."""
+    import ipywidgets as w
+
+    for name in widget.keys:
+        value = getattr(widget, name, None)
+        for held in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(held, w.Widget) and held is not widget:
+                _close_tree(held)
+    widget.close()
 
 
 class RunControls(Panel):
