@@ -77,3 +77,13 @@ def test_saved_outputs_hold_no_widget(path):
         if "application/vnd.jupyter.widget-view+json" in output.get("data", {})
     ]
     assert widgets == [], f"{path.name}: cells whose saved output is a widget: {widgets}"
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_a_notebook_opens_unchanged(path):
+    """JupyterLab writes the kernel's own display name into a notebook it opens: saved with another, the notebook
+    opens marked as changed, and a learner is asked to save what they never touched."""
+    from jupyter_client.kernelspec import KernelSpecManager
+
+    kernelspec = json.loads(path.read_text())["metadata"]["kernelspec"]
+    assert kernelspec["display_name"] == KernelSpecManager().get_kernel_spec(kernelspec["name"]).display_name
