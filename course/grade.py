@@ -38,7 +38,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a package
-from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
+from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, hub_state  # noqa: E402
 
 
 def domains(text: str) -> list[int]:
@@ -165,24 +165,25 @@ def main(argv=None) -> int:
     )
     args = p.parse_args(argv)
     course = args.course.resolve()
-    if args.assignments:
-        names = args.assignments
-    elif args.no_collect:
-        names = sorted(p.name for p in (course / "release").iterdir() if p.is_dir())
-    else:
-        names = released(course)
-        if not names:
-            print("no assignment is released into the exchange yet: nothing to collect", file=sys.stderr)
-            return 1
+    names: list[str] = []
     try:
+        if args.assignments:
+            names = args.assignments
+        elif args.no_collect:
+            names = sorted(p.name for p in (course / "release").iterdir() if p.is_dir())
+        else:
+            names = released(course)
+            if not names:
+                print("no assignment is released into the exchange yet: nothing to collect", file=sys.stderr)
+                return 1
         ids = domains(args.domains) if args.domains else free_domains()
         csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=ids)
-    except (ValueError, DomainError) as error:
-        print(f"not graded: {error}", file=sys.stderr)
-        return 2
     except GradingError as error:
         print(f"graded {', '.join(names)}: {error.csv}, but {error}", file=sys.stderr)
         return 1
+    except (ValueError, RuntimeError) as error:  # DomainError and nbgrader's failures are RuntimeErrors
+        print(f"not graded: {error}", file=sys.stderr)
+        return 2
     print(f"graded {', '.join(names)}: {csv}; feedback in {course / 'feedback'}")
     return 0
 
