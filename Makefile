@@ -39,6 +39,9 @@ $(VENV)/.installed: pyproject.toml uv.lock
 	# The Jupyter server extension tutorial.view.widget.nodelay: enabled by a file a pip install puts in the
 	# environment (pyproject.toml's data-files), and an editable install leaves out.
 	$(PY) -m tutorial.view.widget.nodelay > /dev/null
+	# nbgrader's Validate button reports "Success!" on a lesson notebook whatever its answers (no graded cells;
+	# its check cells are the test): left out of this environment's JupyterLab (nbgrader validate still runs).
+	$(VENV)/bin/jupyter labextension disable @jupyter/nbgrader:validate-assignment > /dev/null 2>&1
 	touch $@
 
 venv: $(VENV)/.installed
