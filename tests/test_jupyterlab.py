@@ -482,6 +482,8 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
     shown = max(i for i in range(teleop) if cells[i]["cell_type"] == "code" and ".show(" in "".join(cells[i]["source"]))
     reset = code_cell_index(cells, lambda src: src.startswith("reset()"), after=teleop)
     run_up_to(lane, cells, teleop)
+    # make's environment leaves out nbgrader's Validate, which calls any lesson notebook a success
+    assert lane.page.locator(".jp-Toolbar-item", has_text="Validate").count() == 0, "a Validate button is shown"
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
     view = view_cell.locator("iframe.rtt-live-view")
     line = panel.locator(".widget-html-content", has_text="/rtt:")
@@ -544,6 +546,8 @@ def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
         i for i in range(teleop) if cells[i]["cell_type"] == "code" and "views.show(" in "".join(cells[i]["source"])
     )
     run_up_to(lane, cells, teleop)
+    # make's environment leaves out nbgrader's Validate, which calls any lesson notebook a success
+    assert lane.page.locator(".jp-Toolbar-item", has_text="Validate").count() == 0, "a Validate button is shown"
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
     live = view_cell.locator("iframe.rtt-live-view")
     assert live.count() == 2, f"notebook 03 shows {live.count()} live views, not two"
