@@ -130,7 +130,9 @@ def learner_notebook(notebook: dict) -> dict:
     nb = copy.deepcopy(notebook)
     drop = {ex["solution"] for ex in exercises(nb["cells"])}
     _say_solutions_held_back(
-        nb["cells"], "On this class's server the worked solutions are held back: your teacher grades your check cells."
+        nb["cells"],
+        "On this class's server the worked solutions are held back. What your teacher grades is the "
+        "assignment you fetch and submit in the Assignments tab (Nbgrader > Assignment List), not this copy.",
     )
     nb["cells"] = [c for i, c in enumerate(nb["cells"]) if i not in drop]
     return nb

@@ -117,9 +117,10 @@ LEARNER_CONFIG = STATE / "learner_jupyter"
     'if os.environ.get("JUPYTERHUB_USER"):\n'
     '    c.CourseDirectory.student_id = os.environ["JUPYTERHUB_USER"]\n'
 )
-# Also left out: nbgrader's Validate button, which on a lesson notebook (not an assignment) reports "Success!"
-# whatever the answers (the check cells are the test), and JupyterLab's question about Jupyter's news feed.
-LEFT_OUT = ["create-assignment", "course-list", "validate-assignment"]
+# Also left out: nbgrader's toolbar Validate button, which on a lesson notebook (not an assignment) reports
+# "Success!" whatever the answers (the check cells are the test; the Assignments tab keeps its own Validate),
+# and JupyterLab's question about Jupyter's news feed.
+LEFT_OUT = ["create-assignment", "course-list", "formgrader", "validate-assignment"]
 (LEARNER_CONFIG / "labconfig" / "page_config.json").write_text(
     json.dumps(
         {

@@ -473,3 +473,22 @@ def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught
 def test_every_exercise_has_six_wrong_answers():
     counts = {number: sum(m[0] == number for m in MISTAKES) for number in EXERCISES}
     assert all(n >= 6 for n in counts.values()), counts
+
+
+def test_a_failed_line_names_its_subject_once_and_wraps_for_nbgrader():
+    """A case whose failure repeats the case's subject says it once; ``require()`` (an nbgrader test cell) raises
+    the same words in lines that fit nbgrader's feedback, which does not wrap them."""
+    from tutorial.exercises.grader import WRAP, Case, CaseFailed
+    from tutorial.exercises.grader import grade as run_check
+
+    def wrong():
+        raise CaseFailed("Pub on the Tank, a drive of 2.0 s: at t = 0.00 s the orientation was [0, 0, 1, 0].", "xyzw")
+
+    result = run_check("Exercise 9.9, a pose", [Case("Pub on the Tank, a drive of 2.0 s: the orientation", wrong)])
+    assert not result.passed and str(result).count("Pub on the Tank") == 1, str(result)
+    assert "the orientation: at t = 0.00 s the orientation was [0, 0, 1, 0]. Hint: xyzw" in str(result)
+    with pytest.raises(AssertionError) as raised:
+        result.require()
+    lines = str(raised.value).splitlines()
+    assert len(lines) > 1 and all(len(line) <= WRAP for line in lines), lines
+    assert " ".join(line.strip() for line in lines) == str(result)

@@ -170,7 +170,7 @@ def both_submit_under_their_own_names(hub: Hub, learners: list[Learner]) -> None
 
 def both_live_views_draw(hub: Hub, names: list[str]) -> None:
     """In one Chromium, a context (cookies) per learner: log in, run a live view, see it draw."""
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import expect, sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
     from tests.lab_browser import STATS, run_first_cell, step2_notebook
@@ -190,6 +190,13 @@ def both_live_views_draw(hub: Hub, names: list[str]) -> None:
                 page.wait_for_url(f"**/user/{name}/**", timeout=60_000)
                 run_first_cell(page, f"{hub.url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
                 pages[name] = page
+            # A learner's Nbgrader menu: their assignments, and none of the teacher's tools (no formgrader)
+            page.locator(".lm-MenuBar-itemLabel", has_text="Nbgrader").click()
+            menu = page.locator(".lm-Menu-itemLabel")
+            expect(menu.filter(has_text="Assignment List")).to_have_count(1)
+            assert menu.filter(has_text="Formgrader").count() == 0, menu.all_inner_texts()
+            page.keyboard.press("Escape")
+            assert page.locator(".jp-Toolbar-item", has_text="Validate").count() == 0, "a Validate button is shown"
             for name, page in pages.items():
                 drawing = f"(() => {{ const s = ({STATS})(); return s && s.scenes >= 1 && s.frames > 5; }})()"
                 page.wait_for_function(drawing, timeout=90_000)

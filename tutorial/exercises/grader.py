@@ -23,10 +23,12 @@ from __future__ import annotations
 
 import logging
 import math
+import textwrap
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 PASS, FAIL = "\u2713", "\u2717"
+WRAP = 88  # characters per line of a failed check's exception (Result.require)
 
 
 class CaseFailed(AssertionError):
@@ -80,10 +82,11 @@ class Result:
         """This result if it passed; else raise, with its one line (how an nbgrader test cell fails).
 
         Raises:
-            AssertionError: the check failed; the message is the line a learner sees.
+            AssertionError: the check failed; the message is the line a learner sees, wrapped at
+                :data:`WRAP` characters (nbgrader's feedback shows it in a box that does not wrap).
         """
         if not self.passed:
-            raise AssertionError(str(self))
+            raise AssertionError(textwrap.fill(str(self), WRAP, subsequent_indent="  ", break_long_words=False))
         return self
 
 
@@ -118,7 +121,9 @@ def _run_cases(exercise: str, cases: Iterable[Case]) -> Result:
             case.run()
         except CaseFailed as failure:
             hint = failure.hint or case.hint
-            what = failure.what if case.call in failure.what else f"{case.call}: {failure.what}"
+            what = (
+                failure.what if case.call in failure.what else f"{case.call}: {_unless_said(case.call, failure.what)}"
+            )
             return Result(exercise, False, what + (f" Hint: {hint}" if hint else ""), case.call)
         except Exception as exc:  # noqa: BLE001 - the learner's bug, reported with its input
             if not_done(exc):
@@ -134,6 +139,12 @@ def _run_cases(exercise: str, cases: Iterable[Case]) -> Result:
     if count == 0:
         raise ValueError(f"{exercise}: a check with no cases cannot pass")
     return Result(exercise, True, f"passed ({count} case{'s' if count != 1 else ''}).")
+
+
+def _unless_said(call: str, what: str) -> str:
+    """``what`` without a leading "subject: " that ``call`` already begins with (said once, not twice)."""
+    subject = call.split(": ", 1)[0]
+    return what[len(subject) + 2 :] if what.startswith(subject + ": ") else what
 
 
 def not_done(exc: BaseException | None) -> bool:
