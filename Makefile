@@ -120,11 +120,13 @@ lint: $(VENV)/.installed
 # The notebooks carry recorded 3D views (scripts in their outputs): trusting the project's own
 # notebooks lets JupyterLab show them; an untrusted notebook shows those outputs empty.
 # JupyterLab on the clone, opening notebook 00; its terminals start in the clone with the rtt-* programs on their
-# PATH, so the notebooks' "Outside Jupyter" commands run as written.
+# PATH (a shell that is not a login shell keeps it), so the notebooks' "Outside Jupyter" commands run as written.
+# As root (a container, a lab's VM) JupyterLab wants --allow-root.
 notebooks: $(VENV)/.installed
 	$(VENV)/bin/jupyter trust notebooks/[0-9][0-9]_*.ipynb
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(VENV)/bin/jupyter lab --ip=127.0.0.1 --ServerApp.root_dir=. \
-		--LabApp.default_url=/lab/tree/notebooks/00_setup_check.ipynb
+		--LabApp.default_url=/lab/tree/notebooks/00_setup_check.ipynb \
+		--ServerApp.terminado_settings=shell_command=/bin/bash $(if $(filter 0,$(shell id -u)),--allow-root)
 
 export: $(VENV)/.installed
 	$(PY) scripts/export_notebooks.py

@@ -603,7 +603,8 @@ def test_record_refuses_an_existing_file(tmp_path, capsys):
     before = path.read_bytes()
     assert rtt_bag.main(["rtt-bag", "record", "/joy", "-o", str(path)]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        f"rtt-bag: record: {path} exists already; choose another name or pass --overwrite"
+        f"rtt-bag: record: {path} exists already; choose another name, or replace it (rtt-bag record --overwrite, "
+        "overwrite=True)"
     ]
     assert path.read_bytes() == before
 

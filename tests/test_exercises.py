@@ -215,7 +215,7 @@ MISTAKES = [
     (
         "4.1",
         "self.peak_publisher.publish(Float64(data=self.peak))",
-        "self.peak_publisher.publish(Float64(data=math.hypot(*self.last[0][:2])))",
+        "self.peak_publisher.publish(Float64(data=math.hypot(*self._newest[0][:2])))",
         "(at rest, t <= 0.5 s)",
     ),
     (
@@ -300,6 +300,7 @@ MISTAKES = [
     ("6.1", "msg.step = width  # one byte a pixel", "msg.step = 3 * width", "towards the crate"),
     ("6.1", "msg.height, msg.width = height, width", "msg.height, msg.width = width, height", "towards the crate"),
     ("6.1", "        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(time_s)\n", "", "picture 2 ("),
+    ("6.1", "gray = np.round(pixels @ LUMA).astype(np.uint8)", "gray = (pixels @ LUMA).astype(np.uint8)", "crate"),
     ("6.2", "math.tan(fovy / 2)", "math.tan(math.degrees(fovy) / 2)", "k, from the vertical field of view"),
     (
         "6.2",
@@ -455,6 +456,12 @@ MISTAKES = [
     ("8.2", "return 15.0, 70", "return 70, 15.0", "at least 10 pictures/s"),
     ("8.2", "return 15.0, 70", "return 25.0, 60", "within 0.5 Mbit/s"),
     ("9.1", "while frame in newest:", "if frame in newest:", "world -> CHASSIS -> TURRET"),
+    (  # a joint that stood still taken for one with no pairs: told so, not told to use the joint asked for
+        "7.2",
+        "    speeds = np.abs(dq[moving] / dt[moving])\n",
+        "    speeds = np.abs(dq[moving] / dt[moving])\n    if speeds.max() == 0:\n        return 0.0, math.nan\n",
+        "another joint",
+    ),
 ]
 
 
@@ -468,6 +475,8 @@ def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught
     assert result.case in result.message, str(result)  # the failing input is in the line
     assert "not done yet" not in result.message
     assert "Hint:" in result.message, f"the line for {wrong!r} gives no hint: {result}"
+    if "speeds.max() == 0" in wrong:
+        assert "stood still" in result.message, str(result)
 
 
 def test_every_exercise_has_six_wrong_answers():

@@ -472,7 +472,7 @@ def check_panels_closed(lane: Lane, stem: str) -> None:
     controls = outputs.locator("button.widget-button, .widget-slider, .jupyter-widgets-disconnected").count()
     assert controls == 0, f"{stem}: {controls} controls left after the final reset()"
     for text in texts(outputs.filter(has_text="A live panel")):
-        assert "run this cell in JupyterLab to use it" in text, f"{stem}: a panel says {text!r}"
+        assert "run this cell to use it (in JupyterLab)" in text, f"{stem}: a panel says {text!r}"
 
 
 # ---- what a learner does in notebooks 01 and 03 --------------------------------------------------------------
@@ -536,7 +536,7 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
         lambda: panel.locator("button.widget-button, .widget-slider").count() == 0,
         10,
     )
-    assert output_text(panel).count("A live panel: run this cell in JupyterLab to use it.") == 2, output_text(panel)
+    assert output_text(panel).count("A live panel: run this cell to use it (in JupyterLab).") == 2, output_text(panel)
 
 
 def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:

@@ -174,7 +174,10 @@ class BagWriter:
         try:
             self._stream = open(self.path, "wb" if overwrite else "xb")  # noqa: SIM115 - closed in close()
         except FileExistsError:
-            raise BagWriteError(f"{self.path} exists already; choose another name or pass --overwrite") from None
+            raise BagWriteError(
+                f"{self.path} exists already; choose another name, or replace it (rtt-bag record --overwrite, "
+                "overwrite=True)"
+            ) from None
         except OSError as exc:
             raise BagWriteError(f"cannot create {self.path}: {exc.strerror or exc}") from None
         except ValueError as exc:  # a NUL byte in the name

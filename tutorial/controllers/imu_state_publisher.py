@@ -112,7 +112,7 @@ class RttImuStatePublisher(SimpleController):
         self.msg_type = Imu
         self.publisher = config.node.create_publisher(Imu, self.topic, imu_qos())
         self.published = 0
-        self.last = None  # (acceleration, angular velocity) of the newest message
+        self._newest = None  # (acceleration, angular velocity) of the newest message
         return True
 
     def unconfigure(self) -> None:
@@ -152,7 +152,7 @@ class RttImuStatePublisher(SimpleController):
         vel.x, vel.y, vel.z = float(w[0]), float(w[1]), float(w[2])  # rad/s
         self.publisher.publish(msg)
         self.published += 1
-        self.last = (a, w)
+        self._newest = (a, w)
 
     # ---- main thread, after the run -----------------------------------------
     def summary(self) -> dict:
@@ -162,8 +162,8 @@ class RttImuStatePublisher(SimpleController):
             "frame_id": self.frame_id,
             "published": self.published,
         }
-        if self.last is not None:
-            a, w = self.last
+        if self._newest is not None:
+            a, w = self._newest
             record["last_linear_acceleration"] = [round(float(v), 6) for v in a]
             record["last_angular_velocity"] = [round(float(v), 6) for v in w]
         return record

@@ -174,9 +174,14 @@ def check_peak_speed(func) -> Result:
             want_speed, want_at = expected
             same_at = (math.isnan(at) and math.isnan(want_at)) or abs(at - want_at) <= 1e-9
             if abs(speed - want_speed) > 1e-9 or not same_at:
-                raise CaseFailed(
-                    f"{call} returned ({speed:.6g}, {at:.6g}), expected ({want_speed:.6g}, {want_at:.6g}).", hint
-                )
+                said = f"{call} returned ({speed:.6g}, {at:.6g}), expected ({want_speed:.6g}, {want_at:.6g})."
+                if speed == want_speed == 0.0 and math.isnan(at) and not math.isnan(want_at):
+                    raise CaseFailed(  # a joint that stood still, taken for one with no pairs
+                        said,
+                        "a joint that stood still has pairs, each at speed 0.0: the first pair wins the tie, so "
+                        "the time is its later stamp; (0.0, math.nan) is for fewer than two usable states only.",
+                    )
+                raise CaseFailed(said, hint)
 
         return Case(call, run, hint)
 

@@ -59,8 +59,18 @@ class TeleopPanel(Panel):
         self.gamepad = w.Controller(index=0)
         self.gamepad.observe(self._on_gamepad, names="axes")
         self.controls = [*self.sliders, self.center]
+        convention = w.HTML(
+            '<span style="color: #444; font-size: 90%">Each slider is a Joy axis, as ROS counts it: '
+            "+ is the stick up or to the left (right H at +0.5 turns the turret left).</span>"
+        )
         self.widget = w.VBox(
-            [w.HBox(self.sliders[:2]), w.HBox(self.sliders[2:]), w.HBox([self.center, self.line]), self.gamepad]
+            [
+                convention,
+                w.HBox(self.sliders[:2]),
+                w.HBox(self.sliders[2:]),
+                w.HBox([self.center, self.line]),
+                self.gamepad,
+            ]
         )
         self.node.create_timer(1.0 / joy.AUTOREPEAT, self.publish)
         self.spin = SpinThread(self.node).start()
