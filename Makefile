@@ -32,7 +32,7 @@ UV_VERSION := 0.13.9
 # them (ros-jazzy-rclpy brings "rclpy"), and removing those deletes rclpy's files.  --compile-bytecode: the
 # install compiles every module once (uv does not by default), so a learner's first kernel, and every process
 # of a first make test, does not compile mujoco, rclpy and Jupyter's modules as it imports them.
-$(VENV)/.installed: pyproject.toml uv.lock
+$(VENV)/.installed: pyproject.toml uv.lock Makefile  # Makefile: its set-up steps below change too
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION)
 	$(VENV)/bin/uv sync --locked --inexact --all-extras --compile-bytecode --python $(PY) --quiet

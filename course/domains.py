@@ -114,4 +114,5 @@ class DomainBook:
         fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=self.path.name, suffix=".tmp")
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             json.dump(book, f, indent=1, sort_keys=True)
+        os.chmod(tmp, 0o644)  # mkstemp makes it the hub's alone: the teacher's make grade reads it too
         os.replace(tmp, self.path)  # readers see the old book or the new, never half of one

@@ -4,7 +4,7 @@
     make grade ARGS="01_step1_tank_controller --jobs 2"
 
 For each assignment (default: every one released into the exchange; with
-``--no-collect``, every one in the course's ``release/``):
+``--no-collect``, every one somebody has in ``submitted/``):
 
 1. ``nbgrader collect``: the submissions from the exchange into ``submitted/``;
 2. ``nbgrader autograde``, one learner at a time per job, ``--jobs`` at once.
@@ -38,7 +38,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a package
-from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, hub_state  # noqa: E402
+from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
 
 
 def domains(text: str) -> list[int]:
@@ -63,10 +63,12 @@ def free_domains(book: Path | None = None) -> list[int]:
     there yet: every domain is free.
 
     Raises:
-        ValueError: every domain is a learner's (the message says what to do).
-        domains.DomainError: the book is not a book of domains.
+        ValueError: every domain is a learner's, or the book cannot be read (the message says what to do).
     """
-    taken = set(DomainBook(book or hub_state() / BOOK_NAME).read().values())
+    try:
+        taken = set(DomainBook(book or hub_state() / BOOK_NAME).read().values())
+    except DomainError as error:
+        raise ValueError(f"{error}; name the domains to grade in with --domains") from None
     free = [d for d in reversed(LEARNER_DOMAINS) if d not in taken]
     if not free:
         raise ValueError(
@@ -125,9 +127,10 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
             list(pool.map(worker, range(jobs)))  # list(): a worker's exception is raised here
         if who:
             nbgrader(course, "generate_feedback", assignment, "--force")
-            # Into the exchange, for the learners whose submission came through it (nbgrader's timestamp.txt):
-            # one put into submitted/ by hand is handed back by hand, from feedback/.
-            by_hand = [w for w in who if not (course / "submitted" / w / assignment / "timestamp.txt").is_file()]
+            # Into the exchange, for the learners whose submission came through it (nbgrader submit's timestamp
+            # and secret, which release_feedback needs): one put into submitted/ by hand is handed back by hand.
+            came = ("timestamp.txt", "submission_secret.txt")
+            by_hand = [w for w in who if not all((course / "feedback" / w / assignment / f).is_file() for f in came)]
             if collect and len(by_hand) < len(who):
                 exclude = [f"--CourseDirectory.student_id_exclude={','.join(by_hand)}"] if by_hand else []
                 nbgrader(course, "release_feedback", assignment, *exclude)
@@ -155,7 +158,7 @@ class GradingError(RuntimeError):
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument(
-        "assignments", nargs="*", help="default: every one released (with --no-collect: in the course's release/)"
+        "assignments", nargs="*", help="default: every one released (with --no-collect: every one in submitted/)"
     )
     p.add_argument("--course", type=Path, default=HERE)
     p.add_argument("--no-collect", action="store_true", help="grade what is in submitted/ already")
@@ -169,8 +172,11 @@ def main(argv=None) -> int:
     try:
         if args.assignments:
             names = args.assignments
-        elif args.no_collect:
-            names = sorted(p.name for p in (course / "release").iterdir() if p.is_dir())
+        elif args.no_collect:  # what someone submitted: an assignment nobody was given has no rows
+            names = sorted({p.name for p in (course / "submitted").glob("*/*") if p.is_dir()})
+            if not names:
+                print(f"nothing in {course / 'submitted'} to grade", file=sys.stderr)
+                return 1
         else:
             names = released(course)
             if not names:

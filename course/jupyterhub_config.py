@@ -186,21 +186,26 @@ def give_learner_their_domain_and_notebooks(spawner):
     target = home / "notebooks"
     if target.exists():
         return
-    shutil.copytree(ROOT / "notebooks", target, ignore=shutil.ignore_patterns(".*", "*.cfg", "*.toml"))
+    # Made whole beside it, then renamed into place: a spawn that fails halfway leaves no copy that the next
+    # spawn would take as made (with the worked solutions still in it).
+    making = home / ".notebooks-being-made"
+    shutil.rmtree(making, ignore_errors=True)
+    shutil.copytree(ROOT / "notebooks", making, ignore=shutil.ignore_patterns(".*", "*.cfg", "*.toml"))
     if not SHOW_SOLUTIONS:  # the folded worked solutions held back, as in the graded assignments
-        for path in target.glob("*.ipynb"):
+        for path in making.glob("*.ipynb"):
             notebook = json.loads(path.read_text(encoding="utf-8"))
             path.write_text(json.dumps(learner_notebook(notebook), indent=1) + "\n", encoding="utf-8")
     # Trusted in the learner's own Jupyter, so the notebooks' recorded 3D views run (JupyterLab runs no
-    # script of an untrusted output).
+    # script of an untrusted output).  A signature is of the notebook's content, not its path.
     subprocess.run(
-        [str(ENV_BIN / "jupyter"), "trust", *map(str, sorted(target.glob("*.ipynb")))],
+        [str(ENV_BIN / "jupyter"), "trust", *map(str, sorted(making.glob("*.ipynb")))],
         env={"HOME": str(home), "PATH": spawner.environment["PATH"]},
         capture_output=True,
         timeout=120,
         check=False,
     )
-    _give_to_learner(target, name, unix_user)
+    _give_to_learner(making, name, unix_user)
+    making.rename(target)
     if (home / ".local").exists():
         _give_to_learner(home / ".local", name, unix_user)
 

@@ -237,6 +237,20 @@ def test_grading_takes_only_domains_no_learner_was_given(tmp_path):
     book.write_text(json.dumps({f"l{d}": d for d in hub_domains.LEARNER_DOMAINS}))
     with pytest.raises(ValueError, match="every ROS domain of this server is a learner's"):
         grade.free_domains(book)
+    book.write_text("{ not a book")
+    with pytest.raises(ValueError, match="name the domains to grade in with --domains"):
+        grade.free_domains(book)
+    # The hub (root, with learners as Unix users) writes the book; the teacher's make grade must read it.
+    kept = hub_domains.DomainBook(tmp_path / "kept.json")
+    kept.domain_for("learner1")
+    assert (tmp_path / "kept.json").stat().st_mode & 0o777 == 0o644
+
+
+def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
+    """make grade ARGS=--no-collect grades what is in submitted/, and says so when nothing is."""
+    (tmp_path / "submitted").mkdir()
+    assert grade.main(["--course", str(tmp_path), "--no-collect", "--domains", "232"]) == 1
+    assert "nothing in" in capsys.readouterr().err
 
 
 def test_a_class_hub_gives_learners_the_notebooks_without_the_worked_solutions():
