@@ -29,6 +29,7 @@ A test that ends up with two tiers stops the collection.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -55,28 +56,24 @@ MODEL = ROOT / "model"
 
 TIERS = ("unit", "ros", "cross_process", "launch", "browser", "notebooks", "network")
 
-_SHM_BEFORE: set[str] = set()  # the names in /dev/shm when the session started
+# The session's clean-up of Fast DDS's files in /dev/shm: entered when the session starts, left when it ends.
+_SHM_CLEAN_UP = contextlib.ExitStack()
 
 
 def pytest_sessionstart(session) -> None:
-    from tutorial.ros.shm import shm_names
+    from tutorial.ros.shm import new_leftovers_removed
 
-    _SHM_BEFORE.update(shm_names())
+    _SHM_CLEAN_UP.enter_context(new_leftovers_removed())
 
 
 def pytest_sessionfinish(session, exitstatus) -> None:
     """Remove the Fast DDS files in /dev/shm that appeared during the session and no live process uses.
 
     Several tests kill a node with SIGKILL on purpose (a crash, a recorder
-    killed), and a killed participant leaves its files.  Only files new since
-    the session started are looked at, and of those only the ones whose lock
-    no live process holds are removed (:func:`tutorial.ros.shm.remove_unused_fast_dds_shm`,
-    Fast DDS's own rule): whoever left them, they are nobody's any more.
-    (A session is two hooks, not one block: :func:`tutorial.ros.shm.new_leftovers_removed`'s rule, by hand.)
+    killed), and a killed participant leaves its files: whoever left them,
+    they are nobody's any more (:func:`tutorial.ros.shm.new_leftovers_removed`).
     """
-    from tutorial.ros.shm import remove_unused_fast_dds_shm, shm_names
-
-    remove_unused_fast_dds_shm(shm_names() - _SHM_BEFORE)
+    _SHM_CLEAN_UP.close()
 
 
 def pytest_configure(config):

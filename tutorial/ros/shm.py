@@ -130,7 +130,7 @@ def _lock_if_unused(path: str, held: contextlib.ExitStack) -> bool:
     return True
 
 
-def shm_names() -> set[str]:
+def _names_now() -> set[str]:
     """The names in :data:`SHM_DIR` now (empty on a machine without it).  Any thread may call it."""
     try:
         return set(os.listdir(SHM_DIR))
@@ -148,11 +148,11 @@ def new_leftovers_removed():
     also when the run ends with an error.  Whoever left them, they are
     nobody's any more.  Yields nothing.
     """
-    before = shm_names()
+    before = _names_now()
     try:
         yield
     finally:
-        remove_unused_fast_dds_shm(shm_names() - before)
+        remove_unused_fast_dds_shm(_names_now() - before)
 
 
 def is_segment(name: str) -> bool:
