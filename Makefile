@@ -2,7 +2,7 @@
 #   make demo   - the main job: Step 3 (simulation, demo joystick, viewer) in two meshcat pages
 #   make test   - the whole test suite: library, cross-process, launch, browser, and the notebooks (nbval)
 # Both create the virtual environment .venv on first use and reuse it after.
-# More: make test-fast (the unit tier, under a minute: the inner loop), make lint (ruff check and format),
+# More: make test-fast (the unit tier, under a minute: the inner loop), make lint (ruff check and format, and lint-imports: the layers),
 #       make notebooks (JupyterLab on notebooks/), make hub (a class's JupyterHub on 127.0.0.1:8000, course/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
@@ -121,10 +121,11 @@ lint: $(VENV)/.installed
 # notebooks lets JupyterLab show them; an untrusted notebook shows those outputs empty.
 # JupyterLab on the clone, opening notebook 00; its terminals start in the clone with the rtt-* programs on their
 # PATH (a shell that is not a login shell keeps it), so the notebooks' "Outside Jupyter" commands run as written.
-# As root (a container, a lab's VM) JupyterLab wants --allow-root.
+# As root (a container, a lab's VM) JupyterLab wants --allow-root.  jupyter-config/learner leaves nbgrader out
+# (its menu, panels and server parts are the teacher's and the class's: make assignments, make grade, make hub).
 notebooks: $(VENV)/.installed
 	$(VENV)/bin/jupyter trust notebooks/[0-9][0-9]_*.ipynb
-	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(VENV)/bin/jupyter lab --ip=127.0.0.1 --ServerApp.root_dir=. \
+	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" JUPYTER_CONFIG_PATH="$(CURDIR)/jupyter-config/learner" $(VENV)/bin/jupyter lab --ip=127.0.0.1 --ServerApp.root_dir=. \
 		--LabApp.default_url=/lab/tree/notebooks/00_setup_check.ipynb \
 		--ServerApp.terminado_settings=shell_command=/bin/bash $(if $(filter 0,$(shell id -u)),--allow-root)
 

@@ -45,14 +45,16 @@ def domains(text: str) -> list[int]:
     """``"215-232"`` or ``"5,7,9"`` as a list of ROS domain ids.
 
     Raises:
-        ValueError: not a list or range of ids from 0 to 232.
+        ValueError: not a list or range of the domains a server's learners could have
+            (:data:`domains.LEARNER_DOMAINS`: 1 to 101 and 215 to 232; the others are not usable on Linux,
+            or everyone's default).
     """
     ids = []
     for part in text.split(","):
         low, _, high = part.partition("-")
         ids.extend(range(int(low), int(high or low) + 1))
-    if not ids or not all(0 <= i <= 232 for i in ids):
-        raise ValueError(f"domains {text!r}: ROS domain ids are 0 to 232")
+    if not ids or not all(i in LEARNER_DOMAINS for i in ids):
+        raise ValueError(f"domains {text!r}: grade in ROS domains 1 to 101 or 215 to 232 (see course/domains.py)")
     return ids
 
 
@@ -97,6 +99,7 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
     ``collect``: from the exchange (then each learner's feedback is released into it).
 
     Raises:
+        ValueError: more ``jobs`` than domains in ``ids`` (checked before anything is graded).
         GradingError: some submissions could not be graded; the others were, and the CSV was written.
         RuntimeError: another nbgrader command failed (its output is in the message).
     """

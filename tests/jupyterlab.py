@@ -1,7 +1,8 @@
 """JupyterLab in headless Chromium, driven by Playwright, for the browser tests of the notebooks.
 
 :class:`JupyterLab` starts ``jupyter lab`` on 127.0.0.1 with a free port,
-no token, and a fresh Jupyter home of its own (configuration, data with
+no token, the Jupyter configuration ``make notebooks`` gives a learner
+(:data:`LEARNER_CONFIG`), and a fresh Jupyter home of its own (configuration, data with
 its own notebook-trust database, runtime, settings with the news prompt,
 update checks, autosave and the extension manager turned off, workspaces,
 IPython profile): the learner's files are never read or written.  It
@@ -52,6 +53,9 @@ def _off(host: str) -> re.Pattern:
     """Every URL but ``host``'s (a test's own network host) and in-page data."""
     return re.compile(rf"^(?!(https?|wss?)://{re.escape(host)}[:/]|data:|blob:|about:|chrome-error:)")
 
+
+# The Jupyter configuration `make notebooks` gives a learner's JupyterLab (nbgrader left out).
+LEARNER_CONFIG = Path(__file__).resolve().parents[1] / "jupyter-config" / "learner"
 
 # Settings for the test's JupyterLab, by extension and plugin.
 SETTINGS = {
@@ -112,6 +116,7 @@ class JupyterLab:
             "IPYTHONDIR": "ipython",
         }
         self.env = dict(os.environ, **{k: str(self._tmp / v) for k, v in home.items()})
+        self.env["JUPYTER_CONFIG_PATH"] = str(LEARNER_CONFIG)  # as make notebooks
         for key, value in (env or {}).items():
             if value is None:
                 self.env.pop(key, None)

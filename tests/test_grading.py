@@ -246,6 +246,14 @@ def test_grading_takes_only_domains_no_learner_was_given(tmp_path):
     assert (tmp_path / "kept.json").stat().st_mode & 0o777 == 0o644
 
 
+def test_grading_domains_named_by_hand_are_ones_fast_dds_can_use():
+    """--domains: 1 to 101 and 215 to 232; 0 is everyone's default, 102 to 214 have no ports on Linux."""
+    assert grade.domains("215-217,5") == [215, 216, 217, 5]
+    for text in ("0", "101-102", "150", "233", "", "7,x"):
+        with pytest.raises(ValueError):
+            grade.domains(text)
+
+
 def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
     """make grade ARGS=--no-collect grades what is in submitted/, and says so when nothing is."""
     (tmp_path / "submitted").mkdir()

@@ -482,8 +482,12 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
     shown = max(i for i in range(teleop) if cells[i]["cell_type"] == "code" and ".show(" in "".join(cells[i]["source"]))
     reset = code_cell_index(cells, lambda src: src.startswith("reset()"), after=teleop)
     run_up_to(lane, cells, teleop)
-    # make's environment leaves out nbgrader's Validate, which calls any lesson notebook a success
+    # make's environment leaves out nbgrader's Validate, which calls any lesson notebook a success, and
+    # make notebooks all of nbgrader: its menu and panels are the teacher's and the class's
     assert lane.page.locator(".jp-Toolbar-item", has_text="Validate").count() == 0, "a Validate button is shown"
+    menus = lane.page.locator(".lm-MenuBar-itemLabel")
+    expect(menus.filter(has_text="Kernel")).to_have_count(1)  # the menu bar is there
+    assert menus.filter(has_text="Nbgrader").count() == 0, f"an Nbgrader menu is shown: {menus.all_inner_texts()}"
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
     view = view_cell.locator("iframe.rtt-live-view")
     line = panel.locator(".widget-html-content", has_text="/rtt:")
@@ -546,8 +550,12 @@ def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:
         i for i in range(teleop) if cells[i]["cell_type"] == "code" and "views.show(" in "".join(cells[i]["source"])
     )
     run_up_to(lane, cells, teleop)
-    # make's environment leaves out nbgrader's Validate, which calls any lesson notebook a success
+    # make's environment leaves out nbgrader's Validate, which calls any lesson notebook a success, and
+    # make notebooks all of nbgrader: its menu and panels are the teacher's and the class's
     assert lane.page.locator(".jp-Toolbar-item", has_text="Validate").count() == 0, "a Validate button is shown"
+    menus = lane.page.locator(".lm-MenuBar-itemLabel")
+    expect(menus.filter(has_text="Kernel")).to_have_count(1)  # the menu bar is there
+    assert menus.filter(has_text="Nbgrader").count() == 0, f"an Nbgrader menu is shown: {menus.all_inner_texts()}"
     panel, view_cell = lane.page.locator(CELLS).nth(teleop), lane.page.locator(CELLS).nth(shown)
     live = view_cell.locator("iframe.rtt-live-view")
     assert live.count() == 2, f"notebook 03 shows {live.count()} live views, not two"

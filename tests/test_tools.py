@@ -21,6 +21,31 @@ PROGRAMS = {  # prog name: module whose main() it runs
 }
 
 
+def test_a_plot_draws_the_joints_in_the_messages_order():
+    """rtt-plot's and the notebooks' live plot: each joint keeps the colour a plot in the model's joint order
+    gives it (notebook 02 shows both, one above the other); sorted by name, TURRET_P and TURRET_Y swapped."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+    from sensor_msgs.msg import JointState
+
+    from tutorial.view.joint_plot import JointStateHistory, draw
+
+    class Node:  # the subscription is recorded, never made
+        def create_subscription(self, *args, **kw):
+            return args
+
+    history = JointStateHistory(Node(), "/Tank/joint_state")
+    names = ["TURRET_Y", "TURRET_P"]  # the tank's order: the model's, the publisher's
+    for t in range(3):
+        history.on_message(JointState(name=names, position=[0.1 * t, -0.1 * t]))
+    ax = Figure().add_subplot()
+    draw(ax, history.series(), "/Tank/joint_state")
+    assert [line.get_label() for line in ax.get_lines()] == names
+    assert [text.get_text() for text in ax.get_legend().get_texts()] == names
+
+
 @pytest.mark.parametrize("prog", sorted(PROGRAMS))
 @pytest.mark.parametrize("ros_args", [["-r", "foo"], ["-r", "__node:=bad-name"], ["-p", "x"]])
 def test_a_bad_ros_argument_is_one_line_and_status_2(prog, ros_args):

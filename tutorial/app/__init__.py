@@ -8,8 +8,9 @@ module              what
 ==================  ==============================================================
 ``app``             :class:`App`: the lifecycle of a running project (Choreonoid's
                     opening of a ``.cnoid`` project), its threads and its stop
-``frames``          :class:`FramePacer`: when the view draws a frame
+``frame_clock``     :class:`FramePacer`: when the view draws a frame
 ``descriptions``    a model taken from a robot description topic
+``floating_base``   a viewer's floating base: the root link placed where odometry says
 ``summary``         the exit summary a run prints or returns
 ==================  ==============================================================
 """

@@ -10,9 +10,10 @@ by MuJoCo.  On a CPU (Mesa's software OpenGL) one 320 x 240 picture takes
 ``control()``.  The work is split between two threads:
 
 * ``control()`` (simulation thread, every step) stays cheap.  When a picture
-  is due (Step 2's ``PeriodAccumulator``; 30 Hz of simulated time by
-  default) it copies ``qpos`` and the time into a ``Snapshot`` (a few
-  hundred bytes) and hands it to the render thread.
+  is due (``PeriodAccumulator`` of :mod:`tutorial.core.period`, met in
+  Step 2; 30 Hz of simulated time by default) it copies ``qpos`` and the
+  time into a ``Snapshot`` (a few hundred bytes) and hands it to the
+  render thread.
 * The render thread owns an ``MjData`` and a ``mujoco.Renderer`` (an OpenGL
   context belongs to the thread that made it).  It poses its ``MjData`` from
   the snapshot, renders the camera, and publishes a ``sensor_msgs/Image``

@@ -209,7 +209,7 @@ class RttTankController(SimpleController):
             joint.u = pd_torque(q_ref, joint.q, dq_ref, joint.dq)
 
     def report(self, event: str, text: str) -> None:
-        """Post a status line to the main thread (any thread): once per event."""
+        """Post a status line to the main thread, once per event (simulation thread)."""
         if self.config is None:
             return  # not configured (a unit test): nobody to tell
         x, y, z = (round(float(v), 4) for v in self.io.body.root_pose()[0])

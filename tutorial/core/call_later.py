@@ -103,7 +103,7 @@ class MainLoop:
         else:
             self._wakeup.set()
 
-    # ---- owner thread only -------------------------------------------------
+    # ---- owner thread only: each method below raises WrongThreadError on any other thread ---------
     def _check_owner(self) -> None:
         if threading.get_ident() != self._owner:
             raise WrongThreadError(
@@ -120,6 +120,9 @@ class MainLoop:
 
         The queue is swapped out under the lock and the calls run outside it,
         so posting threads never wait for a call to finish.
+
+        Raises:
+            WrongThreadError: called from a thread that is not the owner.
         """
         self._check_owner()
         with self._lock:

@@ -17,6 +17,12 @@ method            thread           when
 ``unconfigure``   main             the controller is detached (program exit)
 ================  ===============  ===========================================
 
+"Main" is Choreonoid's name for the thread that owns the project's model and
+view (its GUI thread): a program's main thread, and in a notebook a run's
+own owner thread (:class:`tutorial.notebook.runs.BackgroundApp`), so that the
+kernel's thread stays free for the next cell.  This module, :mod:`tutorial.app`
+and :mod:`tutorial.core.call_later` call it the main or the owner thread alike.
+
 ``configure``, ``initialize`` and ``start`` return False to refuse; the
 runner then reports it and stops.  ``control`` returns False to drop out of
 the simulation (the others go on).

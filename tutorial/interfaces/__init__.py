@@ -11,10 +11,14 @@ module                   message
 ``joint_state``          ``/<body>/joint_state``, ``sensor_msgs/JointState``; matching by name
 ``imu``                  ``/<body>/imu``, ``sensor_msgs/Imu``; finding a body's IMU; its checks
 ``image``                ``/<body>/camera/image``, ``sensor_msgs/Image``; reading one safely
+``compressed_image``     ``/<body>/camera/image/compressed``, ``sensor_msgs/CompressedImage``: JPEG, PNG
 ``robot_description``    ``/<body>/robot_description``, ``std_msgs/String``: the URDF; its checks
 ``odometry``             ``/<body>/odom``, ``nav_msgs/Odometry``: the root link's pose and velocity
 ``tf``                   ``/tf``, ``/tf_static``, ``tf2_msgs/msg/TFMessage``: encoded from its definition
                          (no wheel ships it: the text is kept in ``share/``)
-``timing``               simulation-time stamps, and the exact periodic counter every publisher uses
+``timing``               simulation-time stamps on the wire
+``definitions``          message definitions as rosbag2 stores them; message classes by type name
 =======================  ============================================================================
+
+When each periodic message is due is :mod:`tutorial.core.period`.
 """

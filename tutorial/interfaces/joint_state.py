@@ -133,7 +133,9 @@ def match_joint_state(joints: Sequence[JointInfo], names: Sequence[str], positio
         A :class:`MatchReport`: every entry is either applied or rejected
         with exactly one reason (see the module text).
 
-    Never raises for any content of ``names`` and ``positions``.
+    Never raises for any strings in ``names`` and any numbers in ``positions``
+    (all a received JointState can hold; a name that is not hashable, which no
+    message can carry, raises ``TypeError``).
     """
     by_name = {j.name: j for j in joints}
     occurrences = Counter(n for n in names if n in by_name)

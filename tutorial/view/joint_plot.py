@@ -67,9 +67,14 @@ class JointStateHistory:
 
 
 def draw(ax, series: dict, topic: str) -> None:
-    """Draw the series on a matplotlib Axes (main thread)."""
+    """Draw the series on a matplotlib Axes (the thread that owns its figure).
+
+    The lines go in the order of ``series`` (:meth:`JointStateHistory.series`
+    keeps the message's joint order, the model's), so each joint has the
+    colour a plot of the model's own joint order gives it.
+    """
     ax.clear()
-    for name, (ts, qs) in sorted(series.items()):
+    for name, (ts, qs) in series.items():
         ax.plot(ts, qs, label=name)
     ax.set_xlabel("simulation time (s)")
     ax.set_ylabel("position (rad or m)")
