@@ -1,6 +1,6 @@
 """A library a teacher can read: short modules, and controllers as plain as ros2/demos.
 
-Two checks, each proved to catch what it claims on a made-up module:
+Three checks, each proved to catch what it claims on a made-up module:
 
 - a module of ``tutorial/`` over :data:`MAX_LINES` lines says in its
   docstring why it is one job (the words "one job");
@@ -8,11 +8,15 @@ Two checks, each proved to catch what it claims on a made-up module:
   learner writes in notebooks 01 to 06, and 09's robot-model publisher) use no speed tricks: no
   ``memoryview``, no ``array`` module, no ``bytes``/``bytearray`` buffers.
   Where a step needs speed, it calls a library function in one line.
+- each package's docstring names every module it holds, and no module it
+  does not hold: the map a teacher reads first is the package as it is.
+  ``controllers`` and ``exercises`` are one module per notebook, said once.
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -22,6 +26,9 @@ pytestmark = pytest.mark.unit
 ROOT = Path(__file__).resolve().parent.parent
 MAX_LINES = 400
 TRICK_CALLS = {"memoryview", "bytes", "bytearray"}
+ONE_PER_NOTEBOOK = {"controllers", "exercises"}  # their docstrings give the rule, not a list
+# A module named in a package's docstring: ``name`` (or ``name/``) starting a table's row, or :mod:`tutorial.x.name`
+TABLE_ROW = re.compile(r"^``(\w+)/?``\s{2,}", re.M)
 
 
 def long_modules_without_a_reason(package: Path) -> list[str]:
@@ -32,6 +39,22 @@ def long_modules_without_a_reason(package: Path) -> list[str]:
         docstring = " ".join((ast.get_docstring(ast.parse(text)) or "").split())  # a line break is a space
         if text.count("\n") > MAX_LINES and "one job" not in docstring:
             found.append(f"{path.relative_to(package.parent)}: {text.count(chr(10))} lines")
+    return found
+
+
+def unnamed_or_gone_modules(package: Path) -> list[str]:
+    """What the docstring of ``package``'s subpackages (``__init__.py``) gets wrong about their modules."""
+    found = []
+    for init in sorted(package.glob("*/__init__.py")):
+        sub = init.parent
+        if sub.name in ONE_PER_NOTEBOOK:
+            continue
+        doc = ast.get_docstring(ast.parse(init.read_text())) or ""
+        held = {p.stem for p in sub.glob("[!_]*.py")} | {p.parent.name for p in sub.glob("[!_]*/__init__.py")}
+        named = set(TABLE_ROW.findall(doc))
+        named |= {m.group(1) for m in re.finditer(rf":mod:`{package.name}\.{sub.name}\.(\w+)", doc)}
+        found += [f"{sub.name}: {name} not named" for name in sorted(held - named)]
+        found += [f"{sub.name}: {name} named, not there" for name in sorted(named - held)]
     return found
 
 
@@ -60,6 +83,21 @@ def test_the_length_check_catches_a_long_module_without_a_reason(tmp_path):
     (package / "long_but_said.py").write_text('"""Long: one\njob, the file format."""\n' + body)
     (package / "short.py").write_text('"""Short."""\n' + "x = 1\n" * (MAX_LINES - 1))
     assert long_modules_without_a_reason(package) == [f"tutorial/long.py: {MAX_LINES + 1} lines"]
+
+
+def test_every_package_names_its_modules():
+    assert unnamed_or_gone_modules(ROOT / "tutorial") == []
+
+
+def test_the_module_map_check_catches_a_module_unnamed_or_gone(tmp_path):
+    package = tmp_path / "tutorial" / "things"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text(
+        '"""Things.\n\n``kept``      one job\n``gone``      was here\n\n:mod:`tutorial.things.also` too.\n"""\n'
+    )
+    for name in ("kept", "also", "new"):
+        (package / f"{name}.py").write_text('"""A module."""\n')
+    assert unnamed_or_gone_modules(tmp_path / "tutorial") == ["things: new not named", "things: gone named, not there"]
 
 
 def test_the_exported_controllers_use_no_speed_tricks():

@@ -6,6 +6,8 @@ them and removes everything afterwards; it also puts faults on a host's link
 (random loss, a partition, no multicast, a bandwidth limit).
 :mod:`tutorial.network.discovery` says how ROS 2 nodes on different hosts
 find each other: multicast, static peers, or a Fast DDS discovery server.
+:mod:`tutorial.network.host_program` runs one program on a host and keeps
+its output lines with the time each arrived.
 Making namespaces needs root (and ``ip``, ``nft`` and ``tc``):
 :func:`tutorial.network.hosts.why_unavailable` says what is missing.
 """
