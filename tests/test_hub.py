@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -136,9 +137,23 @@ def test_each_learners_robots_are_their_own(hub):
     assert rb["nodes"].count("rtt") == 1 and ra["nodes"].count("rtt") == 1
     assert ra["warnings"] == [] and rb["warnings"] == []  # no "2 nodes are named /rtt"
 
-    # Each learner in a browser of their own: logged in through the hub's form, a notebook that starts Step 2
-    # with its live view; both views get their scene over their own notebook's connection and draw.
-    both_live_views_draw(hub, ["learner-a", "learner-b"])
+    # rtt-run's own meshcat page, started from A's terminal as the notebooks' "Outside Jupyter" sections say:
+    # its line names the page on the hub's address, through A's Jupyter (jupyter-server-proxy).
+    said = a.terminal(
+        "nohup rtt-run project/step3.yaml --duration 120 --ros-args -r __node:=rtt_viewer > rtt-run.log 2>&1 & "
+        "echo pid=$!; until grep -q 'in a browser' rtt-run.log; do sleep 0.2; done; cat rtt-run.log; echo en''d.",
+        "end.\r",
+        timeout=90,
+    )
+    page = re.search(r"JupyterHub's address followed by (/user/learner-a/proxy/\d+/static/) in a browser", said)
+    pid = re.search(r"pid=(\d+)", said)
+    assert page and pid, said
+    try:
+        # Each learner in a browser of their own: logged in through the hub's form, a notebook that starts Step 2
+        # with its live view; both views get their scene over their own notebook's connection and draw.
+        both_live_views_draw(hub, ["learner-a", "learner-b"], rtt_run_page=("learner-a", page.group(1)))
+    finally:
+        a.terminal(f"kill {pid.group(1)}; echo en''d.", "end.\r")
 
 
 # What a learner's kernel runs to hand in an assignment: nbgrader's own commands, in their home, with the
@@ -168,8 +183,9 @@ def both_submit_under_their_own_names(hub: Hub, learners: list[Learner]) -> None
     assert handed_in == sorted(learner.name for learner in learners), handed_in
 
 
-def both_live_views_draw(hub: Hub, names: list[str]) -> None:
-    """In one Chromium, a context (cookies) per learner: log in, run a live view, see it draw."""
+def both_live_views_draw(hub: Hub, names: list[str], rtt_run_page: tuple[str, str]) -> None:
+    """In one Chromium, a context (cookies) per learner: log in, run a live view, see it draw; and the page
+    of a learner's ``rtt-run`` (``(learner, path on the hub)``) draws for that learner, and for no other."""
     from playwright.sync_api import expect, sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
@@ -204,6 +220,19 @@ def both_live_views_draw(hub: Hub, names: list[str]) -> None:
                 assert seen["dropped"] == 0, (name, seen)
                 shot = page.locator("iframe.rtt-live-view").screenshot()
                 assert len(shot) > 10_000, f"{name}'s live view is blank"  # a drawn scene, not an empty canvas
+            owner, path = rtt_run_page
+            page = pages[owner]
+            page.goto(hub.url + path)
+            # meshcat's page, its WebSocket found under the proxy's path (tutorial/view/meshcat_page.py): the tank
+            page.wait_for_function(
+                "window.viewer && Object.keys(viewer.scene_tree.find(['meshcat', 'rtt', 'Tank', 'CHASSIS']).children)"
+                ".length > 0",
+                timeout=60_000,
+            )
+            for name in set(pages) - {owner}:  # the hub lets no other learner through to it
+                other = pages[name]
+                other.goto(hub.url + path)
+                assert other.evaluate("typeof window.viewer") == "undefined", f"{name} opened {owner}'s page"
         finally:
             browser.close()
 

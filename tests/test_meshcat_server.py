@@ -311,6 +311,31 @@ def test_meshcats_own_server_serves_meshcats_own_page_and_the_project_server_its
     assert ours.count("<script>") == own.decode().count("<script>") + 1
 
 
+@pytest.mark.unit
+def test_a_programs_page_is_also_named_through_the_jupyter_it_runs_under():
+    """rtt-run's line: under a JupyterHub (its server's environment) or in a Jupyter terminal, the page through
+    jupyter-server-proxy as well; outside Jupyter, the page alone.  tests/test_hub.py opens it on a hub."""
+    from tutorial.tools.rtt_run import format_record
+    from tutorial.view.meshcat_server import through_jupyter
+
+    url = "http://127.0.0.1:7003/static/"
+    hub = {"JUPYTERHUB_SERVICE_PREFIX": "/user/ada/", "JUPYTER_SERVER_URL": "http://127.0.0.1:41000/user/ada/"}
+    assert through_jupyter(url, hub) == "/user/ada/proxy/7003/static/"  # the hub's own address is not known
+    public = dict(hub, JUPYTERHUB_PUBLIC_URL="https://hub.example.edu/user/ada/")
+    assert through_jupyter(url, public) == "https://hub.example.edu/user/ada/proxy/7003/static/"
+    terminal = {"JUPYTER_SERVER_URL": "http://127.0.0.1:8888/"}
+    assert through_jupyter(url, terminal) == "http://127.0.0.1:8888/proxy/7003/static/"
+    assert through_jupyter(url, {}) is None
+    record = {"event": "meshcat", "node": "/rtt", "url": url}
+    assert format_record(record) == f"[/rtt] meshcat: open {url} in a browser"
+    assert format_record(dict(record, through_jupyter=through_jupyter(url, hub))) == (
+        "[/rtt] meshcat: open this JupyterHub's address followed by /user/ada/proxy/7003/static/ in a browser"
+    )
+    assert format_record(dict(record, through_jupyter=through_jupyter(url, terminal))) == (
+        f"[/rtt] meshcat: open {url} in a browser, or through Jupyter: http://127.0.0.1:8888/proxy/7003/static/"
+    )
+
+
 # ---- the page, in a real browser ----------------------------------------------------------------------
 
 

@@ -224,11 +224,10 @@ class App:
         return values
 
     def _open_view(self) -> None:
+        from tutorial.view.meshcat_server import start_server, through_jupyter
         from tutorial.view.scene import Scene
 
         if self.vis is None:
-            from tutorial.view.meshcat_server import start_server
-
             self.server = start_server()
             self.vis = self.server.visualizer()
         self.scene = Scene(self.vis, self.model)
@@ -240,13 +239,11 @@ class App:
         else:
             self.camera = (root + [-1.1, -1.2, 0.8], root)  # the robot, close up
         self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it
-        self.output(
-            {
-                "event": "meshcat",
-                "node": self.node_fqn,
-                "url": self.vis.url() if self.server is None else self.server.web_url,
-            }
-        )
+        if self.server is None:  # a view it was given (a notebook's widget, a test's)
+            self.output({"event": "meshcat", "node": self.node_fqn, "url": self.vis.url(), "through_jupyter": None})
+        else:  # its own server's page, also through Jupyter's port when it runs under Jupyter
+            url, node = self.server.web_url, self.node_fqn
+            self.output({"event": "meshcat", "node": node, "url": url, "through_jupyter": through_jupyter(url)})
 
     def step(self, timeout: float = 1.0 / FRAME_RATE) -> bool:
         """Run posted calls, and draw a frame when there is something new to show (owner thread).

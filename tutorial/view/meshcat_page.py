@@ -221,6 +221,14 @@ PAGE_SCRIPT = (
     + UNHOOK_SCRIPT
     + """
   window.rttPage = rttLighten(viewer, location.search);
+  // Behind a proxy (Jupyter's /proxy/PORT/, a JupyterHub's /user/NAME/proxy/PORT/) the server's WebSocket is
+  // at the page's own path without static/, not at the host's root, where meshcat's connect() looks.
+  const base = location.pathname.replace(/static\\/(index\\.html)?$/, "");
+  if (base !== "/" && viewer.connection) {
+    viewer.connection.onclose = null;
+    viewer.connection.close();
+    viewer.connect(`ws://${location.host}${base}`);  // meshcat's connect() makes it wss: on an https: page
+  }
   // A frame's transforms in one message: each goes to the viewer's handler, one by one.
   const handleOne = viewer.handle_command.bind(viewer);
   viewer.handle_command = function (cmd) {

@@ -61,6 +61,45 @@ class MeshcatServer:
                 self.process.wait(timeout)
 
 
+def through_jupyter(web_url: str, environ=None) -> str | None:
+    """The page at ``web_url`` through the Jupyter server this process runs under, if any; else None.
+
+    On a JupyterHub, Binder, or a machine behind an SSH tunnel, a browser
+    reaches only Jupyter's port, and 127.0.0.1 is its own machine, not the
+    server's.  jupyter-server-proxy (installed with the project's
+    ``notebook`` extra) serves ``<Jupyter's address>/proxy/PORT/`` from the
+    server's own 127.0.0.1:PORT, for the user logged in to Jupyter alone; the
+    page finds the server's WebSocket under that path
+    (:mod:`tutorial.view.meshcat_page`).
+
+    Args:
+        web_url: the page on this machine, e.g. ``http://127.0.0.1:7000/static/``.
+        environ: the environment to read (default ``os.environ``): a JupyterHub
+            single-user server's (``JUPYTERHUB_SERVICE_PREFIX``, and
+            ``JUPYTERHUB_PUBLIC_URL`` when the hub knows its public address)
+            or a Jupyter terminal's (``JUPYTER_SERVER_URL``), inherited by
+            every program started from it.
+
+    Returns:
+        A URL, or on a hub that does not know its public address, the path to
+        put after it (``/user/NAME/proxy/7000/static/``); None outside Jupyter,
+        or where jupyter-server-proxy is not installed.  Any thread.
+    """
+    import importlib.util
+    from urllib.parse import urlsplit
+
+    environ = os.environ if environ is None else environ
+    if importlib.util.find_spec("jupyter_server_proxy") is None:
+        return None
+    tail = f"proxy/{urlsplit(web_url).port}/static/"
+    if environ.get("JUPYTERHUB_SERVICE_PREFIX"):
+        public = environ.get("JUPYTERHUB_PUBLIC_URL") or environ["JUPYTERHUB_SERVICE_PREFIX"]
+        return public.rstrip("/") + "/" + tail
+    if environ.get("JUPYTER_SERVER_URL"):
+        return environ["JUPYTER_SERVER_URL"].rstrip("/") + "/" + tail
+    return None
+
+
 def _quiet_window(zmq_url: str):
     """meshcat's ``ViewerWindow`` for an existing server, without its print of the URL.
 
