@@ -86,6 +86,34 @@ def test_hosts_are_closed_off_and_removed_even_after_a_killed_run():
     assert remove_stale() == []
 
 
+NOTEBOOK_08_KERNEL = """
+import json
+from tutorial.network.hosts import SHM_ROOT, namespaces
+from tutorial.notebook.two_hosts import TwoHosts
+
+first = TwoHosts()  # notebook 08's first cell ...
+made = first.net.namespaces()
+second = TwoHosts()  # ... run again
+print(json.dumps({"first": made, "second": second.net.namespaces(), "there": namespaces(), "shm": second.net.name}))
+# and the kernel ends without the notebook's last cell (lab.close())
+"""
+
+
+def test_notebook_08s_hosts_go_when_its_first_cell_runs_again_and_when_its_kernel_ends():
+    import sys
+
+    problem = network_problem()
+    if problem:
+        pytest.skip(f"the network tier needs its own hosts, and they cannot be made here: {problem}")
+    done = subprocess.run([sys.executable, "-c", NOTEBOOK_08_KERNEL], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    seen = json.loads(done.stdout.splitlines()[-1])
+    assert seen["first"] and not set(seen["first"]) & set(seen["there"]), seen  # the first pair went at once
+    assert set(seen["second"]) <= set(seen["there"]), seen
+    assert not set(seen["second"]) & set(namespaces())  # the second went with the kernel
+    assert not [d for d in os.listdir(SHM_ROOT) if d.startswith(seen["shm"])]
+
+
 def test_monitor_and_safe_stop_across_loss_and_a_partition(procs, net):  # noqa: F811 - the fixture
     """Clean link, 20 % loss, a 3 s partition, healed: the monitor stays exact and says stale and live."""
     robot, operator = net["robot"], net["operator"]

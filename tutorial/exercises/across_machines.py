@@ -76,8 +76,9 @@ def check_lossy_link_qos(func) -> Result:
     def newest_only():
         qos = profile()
         if qos.history != HistoryPolicy.KEEP_LAST or qos.depth != 1:
+            kept = {HistoryPolicy.KEEP_LAST: f"the last {qos.depth}", HistoryPolicy.KEEP_ALL: "all"}
             raise CaseFailed(
-                f"lossy_link_qos() keeps {qos.history.name.lower()} depth {qos.depth}, expected keep last 1.",
+                f"lossy_link_qos() keeps {kept.get(qos.history, qos.history.name.lower())}, expected keep last 1.",
                 "a monitor shows the newest state; after a partition a queue would replay old ones first.",
             )
 

@@ -1,9 +1,12 @@
 """Serve the ROS 2 topics, and the robot in 3D, to Foxglove over its WebSocket protocol.
 
-Foxglove (and Lichtblick) connect to a live robot through a server that
-speaks the ``foxglove.websocket.v1`` protocol; on a ROS 2 installation that
-is ``foxglove_bridge``.  :class:`FoxgloveBridge` is its stand-in here, built
-on the ``foxglove-sdk`` package's server:
+Foxglove connects to a live robot through a server that speaks its
+WebSocket protocol; on a ROS 2 installation that is ``foxglove_bridge``.
+:class:`FoxgloveBridge` is its stand-in here, built on the ``foxglove-sdk``
+package's server, which names the protocol ``foxglove.sdk.v1`` on the
+WebSocket and refuses a client that offers only the older name
+``foxglove.websocket.v1`` (the Foxglove app offers both; a viewer that does
+not, such as Lichtblick before December 2025, can still open the recordings):
 
 * every topic of the ROS graph (hidden ones aside) whose type is installed
   is advertised as a channel of encoding ``cdr`` with its ``ros2msg``
@@ -162,7 +165,7 @@ class FoxgloveBridge:
         self.port = self.server.port
         self.tf = TfRecording(_ChannelSink(self), self._say, self.tf_frame_prefix)
         self.node = rclpy.create_node(self.node_name)
-        self._say(f"serving ws://{self.host}:{self.port} (foxglove.websocket.v1): open it in Foxglove")
+        self._say(f"serving ws://{self.host}:{self.port} (foxglove.sdk.v1): open it in Foxglove")
         self._discover()
         self._timer = self.node.create_timer(POLL_PERIOD, self._discover)
         self._spin = SpinThread(self.node).start()

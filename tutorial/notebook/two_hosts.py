@@ -4,26 +4,44 @@
 computer allows it (root, ``ip``, ``nft``, ``tc``), starts the tutorial's
 programs on either host as separate processes, reads what they print, and
 removes everything in :meth:`TwoHosts.close` (also what a notebook's earlier
-kernel left).  Without root, :attr:`TwoHosts.problem` says why, and every
+kernel left).  A kernel keeps one pair: making a new :class:`TwoHosts` (the
+notebook's first cell, run again) closes the one before, and the hosts are
+removed when the kernel exits (shut down or restarted before the last cell).
+Without root, :attr:`TwoHosts.problem` says why, and every
 method that would need the hosts returns None, so each cell can say so
 instead of failing.  Main thread (the notebook's) only.
 """
 
 from __future__ import annotations
 
+import atexit
+
 from tutorial.network.host_program import HostProgram, python
 from tutorial.network.hosts import Host, Network, why_unavailable
 
+_current: TwoHosts | None = None  # this kernel's pair of hosts (main thread only)
+
 
 class TwoHosts:
-    """``robot`` (198.18.25.1) and ``operator`` (198.18.25.2), or the reason they cannot be made."""
+    """``robot`` (198.18.25.1) and ``operator`` (198.18.25.2), or the reason they cannot be made.
+
+    Making one closes the kernel's previous :class:`TwoHosts`, if any.
+    """
 
     def __init__(self):
+        global _current
+        if _current is not None:
+            _current.close()
+        _current = self
         self.problem = why_unavailable()
         self.net: Network | None = None
         self.programs: list[HostProgram] = []
+        self._open()
+
+    def _open(self) -> None:
         if self.problem is None:
             self.net = Network(("robot", "operator")).open()
+            atexit.register(self.close)  # the kernel exits before the notebook's last cell: nothing is left
 
     @property
     def ok(self) -> bool:
@@ -55,7 +73,8 @@ class TwoHosts:
         return self.start(host, argv, **env)
 
     def image_viewer(self, host: str = "operator", transport: str = "raw") -> HostProgram:
-        out = f"{self[host].shm_dir}/camera_{transport}.png"
+        """``rtt-image`` on ``host``; its newest picture in the host's ``/dev/shm`` (here: ``self[host].shm_dir``)."""
+        out = f"/dev/shm/camera_{transport}.png"  # a path on the host, whose /dev/shm is its own folder
         return self.start(
             host, python("tutorial.tools.rtt_image", "--transport", transport, "--no-window", "--output", out)
         )
@@ -72,8 +91,7 @@ class TwoHosts:
     def renew(self) -> None:
         """Stop every program and make both hosts afresh (as if both computers had restarted)."""
         self.close()
-        if self.problem is None:
-            self.net = Network(("robot", "operator")).open()
+        self._open()
 
     def close(self) -> None:
         """Stop the programs and remove the hosts (safe to call twice, and without hosts)."""
@@ -81,6 +99,7 @@ class TwoHosts:
         if self.net is not None:
             self.net.close()
             self.net = None
+            atexit.unregister(self.close)
 
 
 def publishers(monitor: HostProgram) -> int:
