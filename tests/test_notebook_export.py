@@ -54,6 +54,42 @@ def test_code_lines_fit_the_book(path):
     assert long == [], f"{path.name}: cells with lines over 88 characters: {long}"
 
 
+def unregistered_recorders(sources: list[str]) -> list[str]:
+    """The code cells that start a recorder outside ``register(...)``: reset() would leave it recording."""
+    import ast
+
+    found = []
+    for source in sources:
+        tree = ast.parse("\n".join(line for line in source.splitlines() if not line.startswith(("%", "!"))))
+        registered = {
+            id(node)
+            for call in ast.walk(tree)
+            if isinstance(call, ast.Call) and getattr(call.func, "id", None) == "register"
+            for node in ast.walk(call)
+        }
+        calls = [c for c in ast.walk(tree) if isinstance(c, ast.Call) and getattr(c.func, "id", None) == "BagRecorder"]
+        found += [source.splitlines()[call.lineno - 1] for call in calls if id(call) not in registered]
+    return found
+
+
+def test_a_section_that_records_can_run_again():
+    """A recorder a cell starts is registered, so the section's reset() closes it before it records again
+    (two recorders on one file mixed both runs in it, a learner found)."""
+    sources = [
+        "".join(cell["source"])
+        for path in NOTEBOOKS
+        for cell in json.loads(path.read_text())["cells"]
+        if cell["cell_type"] == "code" and not "".join(cell["source"]).startswith("#| export")
+    ]
+    assert any("BagRecorder(" in s for s in sources)
+    assert unregistered_recorders(sources) == []
+    left = ["r = BagRecorder(path, topics).start()", "with BagRecorder(path, topics) as r:\n    pass"]
+    assert unregistered_recorders(left + ["r = register(BagRecorder(path, topics).start())"]) == [
+        "r = BagRecorder(path, topics).start()",
+        "with BagRecorder(path, topics) as r:",
+    ]
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
 def test_ignored_outputs_say_why(path):
     """An output nbval ignores has its reason on the next line, and the marker is one nbval knows."""
