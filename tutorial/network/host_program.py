@@ -97,6 +97,11 @@ class HostProgram:
                 return None
             time.sleep(0.02)  # polling another process's output: a deadline loop
 
+    @property
+    def running(self) -> bool:
+        """The program has not ended (nor been stopped)."""
+        return self.p.poll() is None
+
     def wait_for(self, predicate, timeout: float) -> bool:
         """Whether ``predicate(self)`` became true within ``timeout`` s (checked every 0.1 s)."""
         deadline = time.monotonic() + timeout
