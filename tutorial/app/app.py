@@ -239,11 +239,11 @@ class App:
         else:
             self.camera = (root + [-1.1, -1.2, 0.8], root)  # the robot, close up
         self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it
-        if self.server is None:  # a view it was given (a notebook's widget, a test's)
-            self.output({"event": "meshcat", "node": self.node_fqn, "url": self.vis.url(), "through_jupyter": None})
-        else:  # its own server's page, also through Jupyter's port when it runs under Jupyter
-            url, node = self.server.web_url, self.node_fqn
-            self.output({"event": "meshcat", "node": node, "url": url, "through_jupyter": through_jupyter(url)})
+        # Its own server's page is also offered through Jupyter's port when it runs under Jupyter; a view it
+        # was given (a notebook's widget, a test's) is not a page of a server.
+        url = self.vis.url() if self.server is None else self.server.web_url
+        via = None if self.server is None else through_jupyter(url)
+        self.output({"event": "meshcat", "node": self.node_fqn, "url": url, "through_jupyter": via})
 
     def step(self, timeout: float = 1.0 / FRAME_RATE) -> bool:
         """Run posted calls, and draw a frame when there is something new to show (owner thread).

@@ -63,10 +63,10 @@ def format_record(record: dict) -> str:
     if event == "shake_end":
         return f"[{record['node']}] {record['body']}: shake over, back at its position"
     if event == "meshcat":
-        line = f"[{record['node']}] meshcat: open {record['url']} in a browser"
         via = record.get("through_jupyter")
         if via and via.startswith("/"):  # a hub that does not know its public address
             return f"[{record['node']}] meshcat: open this JupyterHub's address followed by {via} in a browser"
+        line = f"[{record['node']}] meshcat: open {record['url']} in a browser"
         return f"{line}, or through Jupyter: {via}" if via else line
     if event == "warning":
         return f"[{record.get('node', '')}] WARNING: {record['message']}"
