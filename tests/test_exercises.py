@@ -346,7 +346,7 @@ MISTAKES = [
         "an ordinary volatile publisher",
     ),
     ("8.2", "return 15.0, 70", "return 30.0, 80", "within 0.5 Mbit/s"),
-    ("8.2", "return 15.0, 70", "return 5.0, 80", "at least 10 pictures/s"),
+    ("8.2", "return 15.0, 70", "return 5.0, 80", "10 to 30 pictures/s"),
     ("8.2", "return 15.0, 70", "return 30.0, 10", "a picture you can recognise"),
     ("9.1", "pose_matrix(t.translation, (w, x, y, z))", "pose_matrix(t.translation, t.rotation)", "moved only"),
     (
@@ -453,7 +453,7 @@ MISTAKES = [
     ),
     ("8.1", "depth=1,  # the newest", "depth=5,  # the newest", "keep last 1"),
     ("8.2", "return 15.0, 70", "return 15.0, 100", "within 0.5 Mbit/s"),
-    ("8.2", "return 15.0, 70", "return 70, 15.0", "at least 10 pictures/s"),
+    ("8.2", "return 15.0, 70", "return 70, 15.0", "10 to 30 pictures/s"),
     ("8.2", "return 15.0, 70", "return 25.0, 60", "within 0.5 Mbit/s"),
     ("9.1", "while frame in newest:", "if frame in newest:", "world -> CHASSIS -> TURRET"),
     (  # a joint that stood still taken for one with no pairs: told so, not told to use the joint asked for
@@ -477,6 +477,32 @@ def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught
     assert "Hint:" in result.message, f"the line for {wrong!r} gives no hint: {result}"
     if "speeds.max() == 0" in wrong:
         assert "stood still" in result.message, str(result)
+
+
+@pytest.mark.parametrize(
+    "number,right,wrong,function",
+    [
+        ("8.1", "    return QoSProfile(\n", "    return dict(\n", "lossy_link_qos()"),
+        (
+            "8.1",
+            "    return QoSProfile(\n",
+            "    return (\n        HistoryPolicy.KEEP_LAST,\n    )\n    return QoSProfile(\n",
+            "lossy_link_qos()",
+        ),
+        ("8.2", "return 15.0, 70", "return 15.0", "camera_settings()"),
+        ("8.2", "return 15.0, 70", "return 15.0, 70.5", "camera_settings()"),
+        ("8.2", "return 15.0, 70", "return {'rate': 15.0, 'jpeg_quality': 70}", "camera_settings()"),
+    ],
+)
+def test_a_wrongly_shaped_answer_is_told_so_not_judged_on_a_value(ros, number, right, wrong, function):
+    """An answer of the wrong type fails on its own case (the function's name alone), saying what came back."""
+    ex = exercise(number)
+    assert right in ex["solution"], f"the solution of {number} no longer has {right!r}: update this test"
+    result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
+    assert not result.passed, f"the check of {number} passed a wrongly shaped answer ({wrong!r})"
+    assert result.case == function, str(result)
+    assert "returned" in result.message and "expected" in result.message, str(result)
+    assert "Hint:" in result.message, str(result)
 
 
 def test_every_exercise_has_six_wrong_answers():

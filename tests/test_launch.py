@@ -185,3 +185,23 @@ def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
         else:
             frames |= {(t.header.frame_id, t.child_frame_id) for t in msg.transforms}
     assert {("world", "CHASSIS"), ("CHASSIS", "TURRET_Y"), ("TURRET_Y", "TURRET_P"), ("CHASSIS", "TRACK_L")} <= frames
+
+
+@pytest.mark.parametrize("name", [f"step{n}_launch.py" for n in range(1, 7)])
+def test_help_shows_each_example_on_a_line_of_its_own(name):
+    """``--help`` keeps the launch file's example commands as written (argparse's default refills them into one
+    paragraph, a learner found)."""
+    import ast
+    import subprocess
+
+    path = ROOT / "launch_py" / name
+    examples = [
+        line.rstrip()
+        for line in ast.get_docstring(ast.parse(path.read_text()), clean=False).splitlines()
+        if line.strip().startswith("python ")
+    ]
+    assert examples, f"{name} gives no example command"
+    shown = subprocess.run(
+        [sys.executable, str(path), "--help"], capture_output=True, text=True, timeout=60, check=True
+    ).stdout.splitlines()
+    assert [line for line in examples if line not in shown] == []

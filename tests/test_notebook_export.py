@@ -1,6 +1,7 @@
 """One source: the controller modules are exactly what their notebooks export, and notebooks read well."""
 
 import json
+import re
 import subprocess
 import sys
 
@@ -88,6 +89,25 @@ def test_a_section_that_records_can_run_again():
         "r = BagRecorder(path, topics).start()",
         "with BagRecorder(path, topics) as r:",
     ]
+
+
+LEFT_BEHIND = re.compile(r"\b(mkdtemp|mkstemp|mktemp)\(|delete\s*=\s*False")
+
+
+def test_no_notebook_leaves_temporary_files_behind():
+    """A notebook's temporary files live in a ``TemporaryDirectory``, which Python removes when the kernel is shut
+    down (``mkdtemp`` left a folder in /tmp at every run of notebooks 07 and 09; a kernel that is killed, as nbval
+    kills its kernels, still leaves it)."""
+    code = [
+        "".join(cell["source"])
+        for path in NOTEBOOKS
+        for cell in json.loads(path.read_text())["cells"]
+        if cell["cell_type"] == "code"
+    ]
+    assert any("TemporaryDirectory(" in s for s in code)
+    assert [s.splitlines()[0] for s in code if LEFT_BEHIND.search(s)] == []
+    assert LEFT_BEHIND.search('folder = Path(tempfile.mkdtemp(prefix="rtt-"))')
+    assert LEFT_BEHIND.search("f = tempfile.NamedTemporaryFile(delete=False)")
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)

@@ -95,6 +95,7 @@ def check_lossy_link_qos(func) -> Result:
     return grade(
         "Exercise 8.1, a QoS for the monitor on a lossy link",
         [
+            Case("lossy_link_qos()", profile, "return QoSProfile(...)."),
             matches(
                 "the Step 2 publisher (reliable, keep last 1, transient local)",
                 joint_state_qos(),
@@ -176,7 +177,7 @@ def check_camera_settings(func) -> Result:
                 ) from None
             if not (math.isfinite(rate) and rate > 0 and 1 <= quality <= 100 and quality == got[1]):
                 raise CaseFailed(
-                    f"camera_settings() returned {got!r}: the rate must be > 0 and the quality an integer 1..100."
+                    f"camera_settings() returned {got!r}, expected a rate > 0 and a quality that is an integer 1..100."
                 )
             state["got"] = (rate, quality)
         return state["got"]
@@ -210,7 +211,8 @@ def check_camera_settings(func) -> Result:
     return grade(
         "Exercise 8.2, a camera that fits 0.5 Mbit/s",
         [
-            Case("camera_settings(): at least 10 pictures/s", watchable),
+            Case("camera_settings()", settings, "return rate, jpeg_quality: two numbers, the second an integer."),
+            Case(f"camera_settings(): {MIN_RATE:g} to {MAX_RATE:g} pictures/s", watchable),
             Case("camera_settings(): a picture you can recognise", recognisable),
             Case(f"camera_settings(): within {BUDGET_BIT_S / 1e6:g} Mbit/s (a real encode of the camera)", fits),
         ],

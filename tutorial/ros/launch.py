@@ -257,8 +257,9 @@ def _exit_status(code: int | None) -> str:
 
 
 def launch_parser(description: str) -> argparse.ArgumentParser:
-    """The command line every launch file shares."""
-    p = argparse.ArgumentParser(description=description)
+    """The command line every launch file shares; ``description`` (the launch file's docstring) is shown as written,
+    its example commands one to a line."""
+    p = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--demo", action="store_true", help="scripted joystick input instead of a gamepad/keyboard")
     p.add_argument("--headless", action="store_true", help="no meshcat pages")
     p.add_argument(
