@@ -67,13 +67,17 @@ def test_the_monitor_draws_a_real_robot_from_its_published_description(ros, node
     states = node.create_publisher(JointState, f"/{name}/joint_state", joint_state_qos())
 
     robot = yourdfpy.URDF.load(str(ROBOTS / CASES[name]), load_meshes=False, build_collision_scene_graph=False)
-    moving = list(robot.actuated_joint_names)  # a mimic joint is not among them: JointState does not carry it
+    moving = list(robot.actuated_joint_names)  # a mimic joint is not among them: the monitor moves it itself
+    # ... but joint_state_publisher sends it too, computed from its leader: the monitor must not reject it
+    mimic = {n: j.mimic for n, j in robot.joint_map.items() if j.mimic is not None}
+    assert (name == "Panda") == bool(mimic), mimic
     records = []
     app = App(project(name, tmp_path), node_name=f"monitor_{name.lower()}", headless=True, output=records.append)
     try:
         app.open()
         said = [r for r in records if r.get("event") == "description"]
         assert said and "visuals left out" not in said[0]["line"], said
+        assert ("1 of them following another (mimic)" in said[0]["line"]) == bool(mimic), said[0]["line"]
         assert [r for r in records if r.get("event") == "warning"] == []
         body = app.bodies[name]
         visuals = sum(len(link.visuals) for link in robot.robot.links)
@@ -88,10 +92,11 @@ def test_the_monitor_draws_a_real_robot_from_its_published_description(ros, node
                 lo, hi = (joint.limit.lower, joint.limit.upper) if joint.limit else (-math.pi, math.pi)
                 lo, hi = (lo, hi) if lo is not None and hi is not None and hi > lo else (-1.0, 1.0)
                 q.append(lo + (hi - lo) * (0.5 + 0.4 * math.sin(0.3 * k + j)))
-            msg = JointState(name=moving, position=q)
+            q += [m.multiplier * q[moving.index(m.joint)] + m.offset for m in mimic.values()]
+            msg = JointState(name=moving + list(mimic), position=q)
             msg.header.stamp.sec = k
             states.publish(msg)
-            final = dict(zip(moving, q))
+            final = dict(zip(moving, q[: len(moving)]))
         monitor = app.controller("RttJointStateMonitor")
         app.loop.run_until(
             lambda: body.joint_positions() and all(abs(body.joint(n).q - final[n]) <= 1e-6 for n in moving),

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from types import SimpleNamespace
 
 import mujoco
 import numpy as np
@@ -61,7 +62,7 @@ class FakeNode:
     """Stands in for the rclpy node: subscriptions are recorded, never made."""
 
     def create_subscription(self, msg_type, topic, callback, qos, **kw):
-        return (msg_type, topic, callback)
+        return SimpleNamespace(msg_type=msg_type, topic_name=topic, callback=callback)
 
     def destroy_subscription(self, subscription):
         pass

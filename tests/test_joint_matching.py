@@ -38,6 +38,15 @@ def test_unknown_names_are_ignored_and_counted(tank):
     assert r.missing == ["TURRET_P"]
 
 
+def test_a_following_joint_is_ignored_not_rejected(tank):
+    """A mimic joint (``Body.following``), which joint_state_publisher sends too: neither applied nor rejected;
+    a name the body does not have at all is still an unknown name."""
+    r = match_joint_state(tank.joint_infos, ["TURRET_Y", "finger_2", "finger_3"], [0.5, 0.1, 0.2], {"finger_2"})
+    assert r.applied == {"TURRET_Y": 0.5} and r.ignored == ["finger_2"]
+    assert r.rejected == [(2, "finger_3", "unknown_name")]
+    assert match_joint_state(tank.joint_infos, ["finger_2"], [0.1]).counts() == {"unknown_name": 1}
+
+
 def test_duplicates_are_all_rejected(tank):
     r = match_joint_state(tank.joint_infos, ["TURRET_Y", "TURRET_P", "TURRET_Y"], [0.1, 0.2, 0.3])
     assert r.applied == {"TURRET_P": 0.2}
@@ -78,8 +87,8 @@ def test_every_entry_gets_exactly_one_outcome(tank):
     for _ in range(2000):
         names = [rng.choice(pool) for _ in range(rng.randint(0, 6))]
         positions = [rng.choice(values) for _ in range(rng.randint(0, 6))]
-        r = match_joint_state(tank.joint_infos, names, positions)
-        assert r.matched + len(r.rejected) == max(len(names), len(positions))
+        r = match_joint_state(tank.joint_infos, names, positions, following={"X"})
+        assert r.matched + len(r.rejected) + len(r.ignored) == max(len(names), len(positions))
         assert set(r.counts()) <= set(REASONS)
         assert all(math.isfinite(v) for v in r.applied.values())
 

@@ -105,6 +105,35 @@ def test_a_viewer_with_no_description_to_read_says_so(ros, tmp_path):
         app.close()
 
 
+def test_a_description_published_volatile_is_named_as_the_cause(ros, capfd):
+    """A learner's description publisher with rclpy's default QoS (volatile) cannot reach the transient-local
+    subscription: the viewer's error says that, and how to publish it; rclpy's own warning is not printed."""
+    from rclpy.qos import QoSProfile
+    from std_msgs.msg import String
+
+    from tutorial.app.app import App
+
+    node = ros.create_node("volatile_description")
+    publisher = node.create_publisher(String, "/Tank/robot_description", QoSProfile(depth=1))
+    app = App(
+        load_project(PROJECT / "step3_description.yaml"),
+        node_name="viewer_of_a_volatile_description",
+        headless=True,
+        output=lambda record: None,
+        description_timeout=2.0,
+    )
+    try:
+        with pytest.raises(DescriptionError) as caught:
+            app.open()
+    finally:
+        app.close()
+        node.destroy_publisher(publisher)
+        node.destroy_node()
+    assert "a publisher offers it with an incompatible QoS (durability)" in str(caught.value), str(caught.value)
+    assert "transient local" in str(caught.value)
+    assert "incompatible QoS" not in capfd.readouterr().err  # rclpy's warning, had no handler been given
+
+
 def test_the_step3_monitor_draws_the_published_description(procs):
     """rtt-run step3_description.yaml beside a Step 2 simulation: the monitor takes its model from
     /Tank/robot_description, says so, mirrors the simulation's final joint state by name, and stands where

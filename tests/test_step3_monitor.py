@@ -31,7 +31,7 @@ class Node:
         return "/rtt_viewer"
 
     def create_subscription(self, msg_type, topic, callback, qos, event_callbacks=None):
-        sub = SimpleNamespace(topic=topic, callback=callback, qos=qos, events=event_callbacks)
+        sub = SimpleNamespace(topic=topic, topic_name=topic, callback=callback, qos=qos, events=event_callbacks)
         self.subscriptions.append(sub)
         return sub
 
@@ -161,6 +161,55 @@ def test_rejections_are_counted_by_reason_and_unconfigure_drops_both_subscriptio
     assert late in monitor.node.destroyed and live in monitor.node.destroyed
 
 
+def test_a_rejected_name_is_in_the_status_line_printable_and_short():
+    """The status line names what it rejected, newest first, three a reason at most; a received name is shown
+    printable and cut short (it comes from the network)."""
+    from tutorial.view.status import format_status
+
+    t = make_timed_monitor()
+    live = t.node.subscriptions[0]
+    for k, name in enumerate(["elbow", "wrist", "elbow", "x" * 100, "bad\nname"]):
+        live.callback(state(1.0 + k, [name, "TURRET_P"], [0.0, 0.1]))
+        t.loop.process_pending()
+    live.callback(state(9.0, ["TURRET_P"], [9.0]))
+    t.loop.process_pending()
+    t.m.report_status()
+    (status,) = events(t.out, "status")
+    assert status["rejected_names"] == {
+        "out_of_range": ["TURRET_P"],
+        "unknown_name": ["'bad\\nname'", "x" * 37 + "...", "elbow"],
+    }
+    line = format_status(status)
+    assert "rejected: out_of_range 1 (TURRET_P), unknown_name 5 ('bad\\nname', xxx" in line, line
+    assert "\n" not in line
+
+
+def test_the_topic_said_is_the_remapped_one_and_the_late_subscription_is_quiet_on_volatile_publishers():
+    """With ``-r /Tank/joint_state:=/joint_states`` the monitor says the topic it really hears; and a volatile
+    publisher, which cannot match the late joiner's transient-local subscription, gives no rclpy warning."""
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
+    body = Body(model, mujoco.MjData(model), "Tank")
+    node, loop = Node(), MainLoop()
+    node.create_subscription = lambda msg_type, topic, callback, qos, event_callbacks=None: (
+        node.subscriptions.append(
+            sub := SimpleNamespace(
+                topic=topic, topic_name="/joint_states", callback=callback, qos=qos, events=event_callbacks
+            )
+        )
+        or sub
+    )
+    config = ControllerConfig(
+        name="RttJointStateMonitor", body=body, node=node, parameters={}, call_later=loop.call_later,
+        call_every=loop.call_every, output=[].append,
+    )  # fmt: skip
+    m = RttJointStateMonitor()
+    assert m.configure(config)
+    live, late = node.subscriptions
+    assert live.topic == "/Tank/joint_state" and m.topic == "/joint_states" == late.topic
+    assert late.events is not None and late.events.incompatible_qos is not None
+    late.events.incompatible_qos(SimpleNamespace(total_count=1))  # handled, and nothing said
+
+
 class Clock:
     def __init__(self, now=10.0):
         self.now = now
@@ -199,7 +248,8 @@ def test_the_status_line_and_the_stale_watch_run_on_their_timers_and_name_the_no
     (status,) = events(t.out, "status")
     assert status == {
         "event": "status", "rate_hz": 1.0, "received": 1, "applied": 1, "age_ms": 500.0, "matched": 1, "joints": 2,
-        "rejected": {"unknown_name": 1}, "stale": False, "stamps_back": 0, "node": "/rtt_viewer",
+        "rejected": {"unknown_name": 1}, "rejected_names": {"unknown_name": ["X"]}, "stale": False,
+        "stamps_back": 0, "node": "/rtt_viewer",
     }  # fmt: skip
     t.clock.now = 12.0
     t.m.check_stale()

@@ -40,6 +40,9 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
         text, left_out, tree = load_description(urdf, entry.description)
         models[models.index(entry)] = dataclasses.replace(entry, text=text)
         note = f"; {len(left_out)} mesh visuals left out" if left_out else ""
+        mimic = sum(j.mimic is not None for j in tree.moving)
+        # a mimic joint moves with its leader: a joint state need not carry it (the status line counts the others)
+        following = f", {mimic} of them following another (mimic)" if mimic else ""
         for line in left_out:  # which mesh, and why: the rest of the robot is drawn
             output({"event": "warning", "node": fqn, "body": entry.name, "message": f"{entry.description}: {line}"})
         output(
@@ -52,7 +55,7 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
                 "moving_joints": [j.name for j in tree.moving],
                 "line": f"[{fqn}] {entry.name}: no model file of its own: drawing the robot description "
                 f"on {entry.description} (robot {tree.name}, {len(tree.links)} links, "
-                f"{len(tree.moving)} moving joints{note})",
+                f"{len(tree.moving)} moving joints{following}{note})",
             }
         )
     return dataclasses.replace(project, models=models)

@@ -41,16 +41,16 @@ class RttJointStateSubscriber(SimpleController):
 
         self.config = config
         self.body = config.body
-        self.topic = joint_state_topic(config.body_name)
         self.applied = 0
         self.rejected: Counter = Counter()
         self.subscription = config.node.create_subscription(
             JointState,
-            self.topic,
+            joint_state_topic(config.body_name),
             self.on_joint_state,
             joint_state_viewer_qos(),
             event_callbacks=self.subscription_events(),
         )
+        self.topic = self.subscription.topic_name  # as remapped (-r): what it hears
         return True
 
     def subscription_events(self):
@@ -80,7 +80,9 @@ class RttJointStateSubscriber(SimpleController):
 
     def apply(self, msg):
         """Match ``msg`` to the body's joints, set them, update the link poses."""
-        report = match_joint_state(self.body.joint_infos, msg.name, msg.position)
+        report = match_joint_state(
+            self.body.joint_infos, msg.name, msg.position, self.body.following
+        )
         for name, q in report.applied.items():
             self.body.joint(name).q = q
         self.body.notify_kinematic_state_change()  # forward kinematics, then redrawn
@@ -123,6 +125,7 @@ class RttJointStateMonitor(RttJointStateSubscriber):
 
     # ---- main thread ------------------------------------------------------
     def configure(self, config: ControllerConfig) -> bool:
+        from rclpy.event_handler import SubscriptionEventCallbacks
         from sensor_msgs.msg import JointState
 
         self.status = ViewerStatus(config.body.num_joints)
@@ -133,8 +136,14 @@ class RttJointStateMonitor(RttJointStateSubscriber):
             return False
         # Transient local: matches transient-local publishers only, which hand it
         # the newest state they kept.  Live states come through the first one.
+        # A volatile publisher cannot match it, as meant: the handler of that
+        # event keeps rclpy from warning "no messages will be received from it".
         self.late_subscription = config.node.create_subscription(
-            JointState, self.topic, self.on_late_state, joint_state_qos()
+            JointState,
+            self.topic,
+            self.on_late_state,
+            joint_state_qos(),
+            event_callbacks=SubscriptionEventCallbacks(incompatible_qos=lambda _: None),
         )
         config.call_every(self.STATUS_PERIOD, self.report_status)
         config.call_every(STALE_CHECK_PERIOD, self.check_stale)
@@ -176,7 +185,7 @@ class RttJointStateMonitor(RttJointStateSubscriber):
         first = self.status.applied == 0
         report = super().update_joint_state(msg)
         self.status.applied_message(
-            arrival, report.matched, report.counts(), report.applied
+            arrival, report.matched, report.rejected, report.applied
         )
         if first:
             self.drop_late_subscription()  # live states flow: no more need for it

@@ -186,6 +186,9 @@ class Body:
         followers: with ``mimic``, ``(follower qpos address, leader qpos address,
             polynomial coefficients (5,), follower's and leader's reference
             positions)`` per following joint.
+        following: the names of those following joints (with ``mimic``; else
+            empty).  A publisher may send them too (``joint_state_publisher``
+            does): a viewer neither applies nor rejects them.
 
     Raises:
         KeyError: the world has no model named ``name``: no top-level body and
@@ -217,10 +220,12 @@ class Body:
         self.root_id = self.root_ids[0] if self.root_ids else 0
         self.joint_infos, self.skipped_joints = self._sort_joints()
         self.followers = self._followers() if mimic else []
+        self.following: frozenset[str] = frozenset()
         if self.followers:
             following = {int(m.jnt_qposadr[j]) for j in self.joint_ids} & {f[0] for f in self.followers}
             for info in [i for i in self.joint_infos if i.qpos_adr in following]:
                 self.skipped_joints[info.name] = "follows another joint (a URDF mimic joint)"
+            self.following = frozenset(i.name for i in self.joint_infos if i.qpos_adr in following)
             self.joint_infos = [i for i in self.joint_infos if i.qpos_adr not in following]
         self.joints = [Joint(info, data) for info in self.joint_infos]
         self._by_name = {j.name: j for j in self.joints}

@@ -25,6 +25,11 @@ reason              the entry
                     tolerance
 ==================  ===========================================================
 
+An entry naming a joint the body computes from another (a URDF mimic
+joint, ``Body.following``: a gripper's second finger) is *ignored*, neither
+applied nor rejected: ``joint_state_publisher`` sends those too, and the
+viewer moves them with the joint they follow.
+
 Policy for ranges: *reject*, do not clamp.  A value a little past a limit
 (within ``tolerance``: 0.05 rad or 0.01 m) is what a simulated or real joint
 does when it presses on its stop, so it is applied unchanged.  A value far
@@ -41,7 +46,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 
 from tutorial.core.body import JointInfo
@@ -102,11 +107,13 @@ class MatchReport:
         applied: joint name -> position to apply (rad or m), in message order.
         rejected: (entry index, name or None, reason) for each rejected entry.
         missing: names of body joints the message gave no usable value for.
+        ignored: names of the entries that named a following joint (see ``following``).
     """
 
     applied: dict[str, float] = field(default_factory=dict)
     rejected: list[tuple[int, str | None, str]] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
+    ignored: list[str] = field(default_factory=list)
 
     def counts(self) -> Counter:
         """Rejections by reason."""
@@ -121,17 +128,25 @@ def _tolerance(joint: JointInfo) -> float:
     return SLIDE_TOLERANCE if joint.kind == "slide" else HINGE_TOLERANCE
 
 
-def match_joint_state(joints: Sequence[JointInfo], names: Sequence[str], positions: Sequence[float]) -> MatchReport:
+def match_joint_state(
+    joints: Sequence[JointInfo],
+    names: Sequence[str],
+    positions: Sequence[float],
+    following: Collection[str] = (),
+) -> MatchReport:
     """Decide which entries of a JointState to apply to which joints.
 
     Args:
         joints: the body's numbered joints (``Body.joint_infos``).
         names: ``JointState.name`` as received (any length, any order).
         positions: ``JointState.position`` as received (any length, any values).
+        following: names of the body's joints that follow another
+            (``Body.following``): their entries are ignored, not rejected.
 
     Returns:
-        A :class:`MatchReport`: every entry is either applied or rejected
-        with exactly one reason (see the module text).
+        A :class:`MatchReport`: every entry is applied, ignored (it names a
+        following joint), or rejected with exactly one reason (see the
+        module text).
 
     Never raises for any strings in ``names`` and any numbers in ``positions``
     (all a received JointState can hold; a name that is not hashable, which no
@@ -146,6 +161,9 @@ def match_joint_state(joints: Sequence[JointInfo], names: Sequence[str], positio
             report.rejected.append((i, None, "no_name"))
             continue
         joint = by_name.get(name)
+        if joint is None and name in following:
+            report.ignored.append(name)
+            continue
         if joint is None:
             report.rejected.append((i, name, "unknown_name"))
             continue

@@ -96,13 +96,23 @@ def receive_robot_description(node, topic: str, timeout: float) -> str:
         DescriptionError: nothing arrived within ``timeout`` s (with a hint),
             or what arrived is not a usable URDF (:func:`check_robot_description`).
     """
+    from rclpy.event_handler import SubscriptionEventCallbacks
     from rclpy.executors import SingleThreadedExecutor
     from std_msgs.msg import String
 
     received: list[str] = []
+    volatile: list[str] = []  # a publisher that offers less than transient local: the policy it lacks
     subscription = node.create_subscription(
-        String, topic, lambda msg: received.append(msg.data), robot_description_qos()
+        String,
+        topic,
+        lambda msg: received.append(msg.data),
+        robot_description_qos(),
+        # said in the error below, with what to do, instead of rclpy's own warning
+        event_callbacks=SubscriptionEventCallbacks(
+            incompatible_qos=lambda event: volatile.append(_policy_name(event.last_policy_kind))
+        ),
     )
+    topic = subscription.topic_name  # as remapped (-r): the topic it really waits on
     executor = SingleThreadedExecutor(context=node.context)
     executor.add_node(node)
     try:
@@ -113,9 +123,21 @@ def receive_robot_description(node, topic: str, timeout: float) -> str:
         executor.remove_node(node)
         executor.shutdown(timeout_sec=0)
         node.destroy_subscription(subscription)
+    if not received and volatile:
+        raise DescriptionError(
+            f"no robot description on {topic} within {timeout:g} s: a publisher offers it with an incompatible "
+            f"QoS ({volatile[-1]}): publish it as robot_state_publisher does, reliable, keep last 1, transient "
+            "local, so a program that starts later still gets it"
+        )
     if not received:
         raise DescriptionError(
-            f"no robot description on {topic} within {timeout:g} s: start the simulation first "
-            "(its RttRobotModelPublisher publishes it), or name a model file instead"
+            f"no robot description on {topic} within {timeout:g} s: start its publisher first (the tank's "
+            "simulation: its RttRobotModelPublisher; another robot: robot_state_publisher, or a publisher of "
+            "your own, transient local), or name a model file instead"
         )
     return check_robot_description(received[-1], topic)
+
+
+def _policy_name(kind) -> str:
+    """rclpy's ``QoSPolicyKind`` as a word: ``rmw_qos_policy_durability`` -> ``durability``."""
+    return getattr(kind, "name", str(kind)).lower().removeprefix("rmw_qos_policy_")

@@ -18,10 +18,18 @@ from __future__ import annotations
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 STALE_AFTER = 1.0  # s without a state before the view is called stale
 STALE_CHECK_PERIOD = 0.25  # s between checks for silence
+NAMES_SHOWN = 3  # rejected joint names the status line gives per reason, the newest
+NAME_CHARS = 40  # of each: a name comes from the network, any length
+
+
+def _shown_name(name: str) -> str:
+    """A received joint name as a status line shows it: printable, at most :data:`NAME_CHARS` characters."""
+    text = name if isinstance(name, str) and name and name.isprintable() else repr(name)
+    return text if len(text) <= NAME_CHARS else text[: NAME_CHARS - 3] + "..."
 
 
 class ViewerStatus:
@@ -42,6 +50,7 @@ class ViewerStatus:
         self.applied_arrival: float | None = None
         self.matched = 0
         self.rejections: Counter = Counter()
+        self.rejected_names: dict[str, list[str]] = {}  # reason -> the names rejected for it, newest first
         self.last_positions: dict[str, float] = {}
         self.stale = False
         self.stamps_back = 0  # times a state's stamp was older than the one before (a restarted publisher)
@@ -56,12 +65,27 @@ class ViewerStatus:
             self._last_arrival = now
         return now
 
-    def applied_message(self, arrival: float, matched: int, rejected: Counter, positions: dict[str, float]) -> None:
-        """Record one message applied to the model (main thread)."""
+    def applied_message(
+        self, arrival: float, matched: int, rejected: Sequence[tuple[int, str | None, str]], positions: dict[str, float]
+    ) -> None:
+        """Record one message applied to the model (main thread).
+
+        ``rejected``: ``MatchReport.rejected``, (entry index, name or None,
+        reason) per rejected entry; the status line names the newest
+        :data:`NAMES_SHOWN` names rejected for each reason.
+        """
         self.applied += 1
         self.applied_arrival = arrival
         self.matched = matched
-        self.rejections.update(rejected)
+        for _, name, reason in rejected:
+            self.rejections[reason] += 1
+            if name is not None:
+                names = self.rejected_names.setdefault(reason, [])
+                shown = _shown_name(name)
+                if shown in names:
+                    names.remove(shown)
+                names.insert(0, shown)
+                del names[NAMES_SHOWN:]
         self.last_positions.update(positions)
 
     def late_state_shown(self, arrival: float | None, matched: int, positions: dict[str, float]) -> None:
@@ -110,6 +134,7 @@ class ViewerStatus:
                 "matched": self.matched,
                 "joints": self.joint_count,
                 "rejected": dict(sorted(self.rejections.items())),
+                "rejected_names": {k: list(v) for k, v in sorted(self.rejected_names.items())},
                 "stale": last_arrival is None or self.stale,
                 "stamps_back": self.stamps_back,
             }
@@ -135,7 +160,13 @@ def format_status(record: dict, node: str = "") -> str:
     if event == "recovered":
         return f"{tag}joint state is arriving again: the view is live"
     age = "no state yet" if record["age_ms"] is None else f"newest state {record['age_ms']:.0f} ms old"
-    rejected = ", ".join(f"{k} {v}" for k, v in record["rejected"].items()) or "none"
+    names = record.get("rejected_names", {})
+    rejected = (
+        ", ".join(
+            f"{k} {v}" + (f" ({', '.join(names[k])})" if names.get(k) else "") for k, v in record["rejected"].items()
+        )
+        or "none"
+    )
     stale = " [STALE]" if record["stale"] and record["received"] else ""
     back = record.get("stamps_back", 0)
     went_back = f", stamps went back {back}x (a publisher restarted)" if back else ""
