@@ -408,6 +408,14 @@ MISTAKES = [
         "(hitting the wall",
     ),
     ("4.2", "            self.last_report = now\n", "", "threshold=10.0, the wall"),
+    (  # the holdoff started again by every period above threshold, reported or not: a learner's trial found it
+        "4.2",
+        "        if math.hypot(a.x, a.y) > self.threshold and not recent:\n",
+        "        if math.hypot(a.x, a.y) > self.threshold and recent:\n"
+        "            self.last_report = now\n"
+        "        if math.hypot(a.x, a.y) > self.threshold and not recent:\n",
+        "threshold=3.0, holdoff=0.12",
+    ),
     (
         "5.1",
         "np.array([self.accel[0], self.accel[1], 0.0])",

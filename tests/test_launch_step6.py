@@ -55,7 +55,8 @@ def test_step6_launch_shows_camera_pictures_and_stops_cleanly(procs, tmp_path, e
     summary = re.search(r"^\[rtt\] RttCameraImagePublisher: .*published=(\d+),", launch.out, re.M)
     assert summary and int(summary.group(1)) >= 10, launch.out
     assert re.search(
-        r"^\[rtt_image\] \[/rtt_image\] done: \d+ pictures accepted, 0 rejected, \d+ file\(s\) written",
+        r"^\[rtt_image\] \[/rtt_image\] done: \d+ pictures accepted, 0 rejected, \S+\.png written \d+ times?, "
+        r"holding the newest picture$",
         launch.out,
         re.M,
     ), launch.out

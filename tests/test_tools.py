@@ -137,3 +137,12 @@ def test_rtt_joy_ends_on_ctrl_c_or_sigterm_with_its_count_and_no_traceback(procs
     assert joy.wait(15) == 0, joy.err
     assert "[rtt_joy] published" in joy.out
     assert "Traceback" not in joy.out + joy.err, joy.out + joy.err
+
+
+def test_rtt_image_says_one_file_written_over_or_numbered_files():
+    """Without ``{n}`` one file holds the newest picture, written over and over: not "N files", as it said."""
+    from tutorial.tools.rtt_image import _written
+
+    assert _written(10, "camera_image.png") == "camera_image.png written 10 times, holding the newest picture"
+    assert _written(1, "camera_image.png") == "camera_image.png written 1 time, holding the newest picture"
+    assert _written(3, "frame_{n}.png") == "3 files written (frame_{n}.png)"

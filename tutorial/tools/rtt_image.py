@@ -217,7 +217,7 @@ def main(argv: list[str] | None = None) -> int:
         received = receiver.counts()
         viewer.say(
             f"done: {received['accepted']} pictures accepted, {received['rejected']} rejected"
-            + (f", {writer.written} file(s) written to {args.output}" if writer else "")
+            + (f", {_written(writer.written, args.output)}" if writer else "")
         )
         if spin.error is not None:
             viewer.say(f"ERROR: the subscription callback raised: {spin.error!r}")
@@ -225,6 +225,13 @@ def main(argv: list[str] | None = None) -> int:
         node.destroy_node()
         rclpy.try_shutdown()
     return status
+
+
+def _written(count: int, output: str) -> str:
+    """What the files of a run came to: numbered files, or one file written over and over (the newest picture)."""
+    if "{n}" in output:
+        return f"{count} file{'' if count == 1 else 's'} written ({output})"
+    return f"{output} written {count} time{'' if count == 1 else 's'}, holding the newest picture"
 
 
 if __name__ == "__main__":
