@@ -232,7 +232,7 @@ def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, na
     monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))
     latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE)
     urdf = (ROBOTS / PICTURED[name]).read_text()
-    pictures = {}
+    pictures, camera = {}, []
     for case, text in (("meshes", urdf), ("no meshes", urdf.replace("package://", "package://missing_"))):
         topic = f"/{name}_{len(pictures)}/robot_description"
         node.create_publisher(String, topic, latched).publish(String(data=text))
@@ -241,6 +241,8 @@ def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, na
         app = App(load_project(tmp_path / "p.yaml"), node_name=f"page_{len(pictures)}", output=records.append)
         try:
             app.open()
+            camera += [] if camera else [app.camera]  # the robot framed, then the same view without its meshes
+            app.scene.set_camera(*camera[0])
             app.step(0.1)
             url = next(r["url"] for r in records if r.get("event") == "meshcat")
             pictures[case] = screenshot(url, tmp_path / f"{len(pictures)}.png")

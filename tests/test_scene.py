@@ -257,3 +257,51 @@ def test_an_arrow_refuses_non_finite_numbers_and_a_second_arrow_of_the_same_name
         arrow.set((0, 0, 0), (np.nan, 0, 0))
     with pytest.raises(ValueError, match="exists already"):
         overlays.arrow("a", (0, 0, 1))
+
+
+def test_a_robot_of_any_size_is_framed_whole_and_stands_on_a_grid():
+    """A robot drawn from its description has no room around it: the camera aims at the centre of its geoms and
+    backs off until they fit meshcat's 75-degree view (a 1 m arm and the Panda reached the page's top edge from
+    the tank's close-up), and a grid is its ground; the tank in its room keeps meshcat's grid hidden."""
+    from tutorial.view.scene import look_at_geoms
+
+    xml = """<mujoco><worldbody>
+      <body name="R/base"><geom type="box" size="0.2 0.2 0.05" pos="0 0 0.05"/>
+        <body name="R/arm" pos="0 0 0.1"><joint type="hinge"/><geom type="capsule" fromto="0 0 0 0 0 1.8" size="0.05"/>
+        <geom type="sphere" size="0.1" pos="0 0 1.9" group="3"/></body></body>
+      <geom type="plane" size="0 0 1"/></worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    position, target = look_at_geoms(model, data, range(model.ngeom))
+    shown = [g for g in range(model.ngeom) if model.geom_group[g] < 3 and model.geom_type[g] != 0]  # 0: plane
+    for g in shown:  # each geom's bounding sphere inside the view cone
+        to = data.geom_xpos[g] - position
+        axis = (target - position) / np.linalg.norm(target - position)
+        off_axis = np.degrees(np.arccos(np.dot(to, axis) / np.linalg.norm(to)))
+        reach = np.degrees(np.arcsin(min(1.0, model.geom_rbound[g] / np.linalg.norm(to))))
+        assert off_axis + reach <= 37.5, (g, off_axis, reach)
+    assert 0.8 < target[2] < 1.2  # the middle of the 2 m robot, not its root
+    assert look_at_geoms(model, data, [g for g in range(model.ngeom) if g not in shown]) is None  # hidden, plane
+
+    class Vis(RecordingVisualizer):
+        objects: dict = {}
+        properties: dict = {}
+
+        def __getitem__(self, path):
+            return Vis(self.sent, f"{self.path}/{path}")
+
+        def set_object(self, obj, *args):
+            Vis.objects[self.path] = obj
+
+        def set_property(self, key, value):
+            Vis.properties[(self.path, key)] = value
+
+    Scene(Vis(), model).build(data, grid=True)
+    ground = next(obj for path, obj in Vis.objects.items() if path.endswith("/ground"))
+    points = ground.geometry.position
+    assert points.shape[0] == 3 and np.all(points[2] == 0.0) and points[:2].min() == -5.0 and points[:2].max() == 5.0
+    assert Vis.properties[("meshcat//Grid", "visible")] is False  # meshcat's own stays still when the camera aims
+    Vis.objects.clear()
+    Scene(Vis(), model).build(data)
+    assert not any(path.endswith("/ground") for path in Vis.objects)

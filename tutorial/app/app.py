@@ -225,17 +225,24 @@ class App:
 
     def _open_view(self) -> None:
         from tutorial.view.meshcat_server import start_server, through_jupyter
-        from tutorial.view.scene import Scene
+        from tutorial.view.scene import Scene, look_at_geoms
 
         if self.vis is None:
             self.server = start_server()
             self.vis = self.server.visualizer()
+        # A robot drawn from its description, with no world around it: meshcat's grid is its ground, and the
+        # camera frames the robot whatever its size (the tank's close-up assumes the tank's).
+        described = self.project.simulator is None and any(m.description for m in self.project.models)
         self.scene = Scene(self.vis, self.model)
-        self.scene.build(self.data)
+        self.scene.build(self.data, grid=described)
         self.overlay_view = MeshcatOverlays(self.vis, self.overlays)
-        root = self.bodies[self.project.models[-1].name].root_pose()[0]
+        robot = self.bodies[self.project.models[-1].name]
+        root = robot.root_pose()[0]
+        framed = look_at_geoms(self.model, self.data, robot.geom_ids) if described else None
         if self.project.simulator is not None:
             self.camera = (root + [-1.4, -2.2, 1.6], root + [1.0, 0.2, 0.0])  # the robot in its room
+        elif framed is not None:
+            self.camera = framed
         else:
             self.camera = (root + [-1.1, -1.2, 0.8], root)  # the robot, close up
         self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it

@@ -130,16 +130,21 @@ class Scene:
             b = int(m.body_parentid[b])
         return t
 
-    def build(self, data: mujoco.MjData) -> None:
+    def build(self, data: mujoco.MjData, grid: bool = False) -> None:
         """Create every visible geom; static ones are placed from ``data`` now.
 
         ``data`` must hold current poses (after ``mj_kinematics`` or ``mj_step``).
+        ``grid``: draw a grid on the ground (z = 0, 10 m square, 0.5 m cells),
+        for a world with no floor of its own (a robot drawn from its
+        description).
         """
         import meshcat.geometry as g
 
         m = self.model
         self.vis[self.root].delete()
-        self.vis["/Grid"].set_property("visible", False)  # our floor is the ground
+        self.vis["/Grid"].set_property("visible", False)  # meshcat's own: it stays put when the camera is aimed
+        if grid:
+            self.vis[f"{self.root}/ground"].set_object(_ground_grid(g))
         self.vis["/Axes"].set_property("visible", False)
         moving = set()
         for gid in range(m.ngeom):
@@ -245,6 +250,44 @@ class Scene:
         self.vis["/Cameras/default"].set_transform(np.eye(4))
         # meshcat's camera frame is Y-up: world (x, y, z) -> (x, z, -y)
         self.vis["/Cameras/default/rotated/<object>"].set_property("position", [x, z, -y])
+
+
+def _ground_grid(g, half: float = 5.0, cell: float = 0.5):
+    """Grid lines on z = 0, ``2 * half`` m square, ``cell`` m apart: a ground that moves with the drawing.
+
+    Each line is drawn as one segment a cell: a 10 m segment that passes
+    under a close camera was left out whole by the browser (SwiftShader).
+    """
+    ticks = np.arange(-half, half + cell / 2, cell)
+    ends = []
+    for t in ticks:
+        for a, b in zip(ticks[:-1], ticks[1:]):
+            ends += [(t, a, 0.0), (t, b, 0.0), (a, t, 0.0), (b, t, 0.0)]
+    return g.LineSegments(g.PointsGeometry(np.array(ends, dtype=np.float32).T), g.LineBasicMaterial(color=0x8A94A8))
+
+
+def look_at_geoms(model: mujoco.MjModel, data: mujoco.MjData, geom_ids, direction=(-1.1, -1.2, 0.8)):
+    """A camera ``(position, target)``, m, that shows the visible geoms of ``geom_ids`` whole; None if there are none.
+
+    The target is the centre of their bounding box (each geom grown by its
+    bounding sphere, ``geom_rbound``, placed where ``data`` has it); the
+    camera looks at it from ``direction``, far enough that the box's
+    half-diagonal fits meshcat's 75-degree field of view, and never nearer
+    than ``|direction|`` (the tank's close-up).  Planes (infinite) are left out.
+    """
+    ids = [
+        g
+        for g in geom_ids
+        if model.geom_group[g] < HIDDEN_GEOM_GROUP and model.geom_type[g] != mujoco.mjtGeom.mjGEOM_PLANE
+    ]
+    if not ids:
+        return None
+    centres, radii = data.geom_xpos[ids], model.geom_rbound[ids][:, None]
+    low, high = (centres - radii).min(axis=0), (centres + radii).max(axis=0)
+    target = (low + high) / 2
+    along = np.asarray(direction, dtype=float)
+    distance = max(float(np.linalg.norm(along)), 1.8 * float(np.linalg.norm(high - low)) / 2)  # 1/sin(37.5 deg) ~ 1.64
+    return target + along / np.linalg.norm(along) * distance, target
 
 
 class _Pipeline:
