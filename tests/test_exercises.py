@@ -408,6 +408,30 @@ MISTAKES = [
         "(hitting the wall",
     ),
     ("4.2", "            self.last_report = now\n", "", "threshold=10.0, the wall"),
+    # the shot count kept outside the lock: on_joy runs on the spin thread, summary() on the main thread
+    (
+        "1.2",
+        "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
+        "            self.a_down = down\n",
+        "        if down and not self.a_down:\n            self.shots += 1\n        self.a_down = down\n",
+        "what on_joy() remembers, under self._lock",
+    ),
+    (
+        "1.2",
+        "        with self._lock:\n            shots = self.shots\n",
+        "        shots = self.shots\n",
+        "what on_joy() remembers, under self._lock",
+    ),
+    # unconfigure() that leaves the exercise's publisher in place
+    (
+        "2.2",
+        "        self.node.destroy_publisher(self.publisher)\n",
+        "        pass\n",
+        "RttPosePublisher.unconfigure()",
+    ),
+    ("4.1", "        self.node.destroy_publisher(self.peak_publisher)\n", "", "PeakImuPublisher.unconfigure()"),
+    ("4.2", "        self.node.destroy_publisher(self.collision_publisher)\n", "", "CollisionReporter.unconfigure()"),
+    ("6.2", "        self.node.destroy_publisher(self.info_publisher)\n", "", "unconfigure() removes the CameraInfo"),
     (  # the holdoff started again by every period above threshold, reported or not: a learner's trial found it
         "4.2",
         "        if math.hypot(a.x, a.y) > self.threshold and not recent:\n",

@@ -471,7 +471,7 @@ def check_panels_closed(lane: Lane, stem: str) -> None:
     outputs = lane.page.locator(f"{CELLS} .jp-OutputArea-output")
     controls = outputs.locator("button.widget-button, .widget-slider, .jupyter-widgets-disconnected").count()
     assert controls == 0, f"{stem}: {controls} controls left after the final reset()"
-    for text in texts(outputs.filter(has_text="A live panel")):
+    for text in texts(outputs.filter(has_text="Not live now")):
         assert "run this cell to use it (in JupyterLab)" in text, f"{stem}: a panel says {text!r}"
 
 
@@ -540,7 +540,7 @@ def drive_the_tank(lane: Lane, cells: list[dict]) -> None:
         lambda: panel.locator("button.widget-button, .widget-slider").count() == 0,
         10,
     )
-    assert output_text(panel).count("A live panel: run this cell to use it (in JupyterLab).") == 2, output_text(panel)
+    assert output_text(panel).count("Not live now: run this cell to use it (in JupyterLab).") == 2, output_text(panel)
 
 
 def two_views_side_by_side(lane: Lane, cells: list[dict]) -> None:

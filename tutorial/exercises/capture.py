@@ -17,6 +17,7 @@ class CapturingPublisher:
     def __init__(self, real, msg_type, topic: str):
         self.real, self.msg_type, self.topic = real, msg_type, topic
         self.sent: list[bytes] = []
+        self.destroyed = False  # the controller gave it back (node.destroy_publisher), as unconfigure() should
 
     def publish(self, msg) -> None:
         from rclpy.serialization import serialize_message
@@ -51,6 +52,8 @@ class CapturingNode:
         return pub
 
     def destroy_publisher(self, publisher) -> bool:
+        if isinstance(publisher, CapturingPublisher):
+            publisher.destroyed = True
         return self.node.destroy_publisher(getattr(publisher, "real", publisher))
 
     def published(self, topic: str | None = None) -> list[CapturingPublisher]:

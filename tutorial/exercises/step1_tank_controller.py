@@ -153,6 +153,78 @@ def check_shot_counter(cls) -> Result:
                 "call super().on_joy(msg) first, so the controller still drives.",
             )
 
+    def under_the_lock():
+        controller = _watched(cls)()
+        lock = _WatchedLock()
+        object.__setattr__(controller, "_lock", lock)
+        object.__setattr__(controller, "_watch", [])  # (what, name, lock held) of each write, then each read
+        for buttons in (A, NONE, A):
+            controller.on_joy(_joy(buttons))
+        ours = {name for what, name, _ in controller._watch} - _BASE_STATE  # what the exercise added
+        object.__setattr__(controller, "_reading", ours)
+        controller.summary()
+        loose = sorted({(what, name) for what, name, held in controller._watch if not held and name not in _BASE_STATE})
+        if loose:
+            what, name = loose[0]
+            where = "on_joy() writes" if what == "write" else "summary() reads"
+            raise CaseFailed(
+                f"{cls.__name__}: {where} self.{name} outside `with self._lock:`.",
+                "on_joy runs on the spin thread and summary() on the main thread: read and write what on_joy "
+                "remembers under self._lock, as RttTankController.on_joy does.",
+            )
+
     cases = [count(*row) for row in sequences]
     cases.append(Case(f"{cls.__name__}: on_joy(a Joy with the left stick up)", still_drives))
+    cases.append(Case(f"{cls.__name__}: what on_joy() remembers, under self._lock", under_the_lock))
     return grade("Exercise 1.2, count the shots", cases)
+
+
+# What RttTankController's own on_joy keeps (under its lock); a check looks at what an exercise adds.
+_BASE_STATE = {"_axes", "_buttons", "_received", "_malformed"}
+
+
+class _WatchedLock:
+    """The check's stand-in for ``self._lock``: a real lock that also says whether it is held."""
+
+    def __init__(self):
+        import threading
+
+        self._real = threading.Lock()
+        self.held = False
+
+    def acquire(self, *args, **kwargs) -> bool:
+        got = self._real.acquire(*args, **kwargs)
+        self.held = self.held or got
+        return got
+
+    def release(self) -> None:
+        self.held = False
+        self._real.release()
+
+    def locked(self) -> bool:
+        return self._real.locked()
+
+    __enter__ = acquire
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+def _watched(cls):
+    """``cls`` noting each attribute it writes, and each it reads of ``_reading``, with whether its lock is held."""
+
+    class Watched(cls):
+        def __setattr__(self, name, value):
+            watch = self.__dict__.get("_watch")
+            if watch is not None:
+                watch.append(("write", name, self.__dict__["_lock"].held))
+            object.__setattr__(self, name, value)
+
+        def __getattribute__(self, name):
+            d = object.__getattribute__(self, "__dict__")
+            if name in d.get("_reading", ()):
+                d["_watch"].append(("read", name, d["_lock"].held))
+            return object.__getattribute__(self, name)
+
+    Watched.__name__ = Watched.__qualname__ = cls.__name__
+    return Watched

@@ -227,11 +227,20 @@ def check_pose_publisher(cls) -> Result:
                 )
             if pubs[0].msg_type is not PoseStamped:
                 raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__}, expected geometry_msgs/PoseStamped.")
-            runs[kind] = (pubs[0].messages(), probe)
+            runs[kind] = (pubs[0].messages(), probe, pubs[0])
         return runs[kind]
 
+    def removed():
+        *_, publisher = poses()  # the drive ended with unconfigure()
+        if not publisher.destroyed:
+            raise CaseFailed(
+                f"{cls.__name__}.unconfigure() left the publisher of /Tank/pose in place, expected it destroyed.",
+                "in unconfigure(): config.node.destroy_publisher(...) of the publisher configure() made "
+                "(keep the node: self.node = config.node).",
+            )
+
     def timing(kind: str = "drive", rate: float = 10.0, who: str = call):
-        messages, _ = poses(kind)
+        messages, *_ = poses(kind)
         want = round(rate * DURATION)
         if len(messages) < want:
             raise CaseFailed(
@@ -251,7 +260,7 @@ def check_pose_publisher(cls) -> Result:
     want = round(10.0 * DURATION)
 
     def position():
-        messages, probe = poses()
+        messages, probe, _ = poses()
         for msg in messages[:want]:
             t = _stamp(msg)
             if msg.header.frame_id != "world":
@@ -270,7 +279,7 @@ def check_pose_publisher(cls) -> Result:
                 )
 
     def orientation(kind: str = "drive", who: str = call):
-        messages, probe = poses(kind)
+        messages, probe, _ = poses(kind)
         turned = 0.0
         for msg in messages:
             t = _stamp(msg)
@@ -297,6 +306,7 @@ def check_pose_publisher(cls) -> Result:
             Case(f"{call}: the root's orientation", orientation),
             Case(f"{turning}: 25 Hz from t = 0", lambda: timing("turn", 25.0, turning)),
             Case(f"{turning}: the root's orientation as it turns", lambda: orientation("turn", turning)),
+            Case(f"{cls.__name__}.unconfigure()", removed),
         ],
     )
 

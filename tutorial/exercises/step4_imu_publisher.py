@@ -169,14 +169,14 @@ def check_peak_publisher(cls) -> Result:
                     "expected one peak after each Imu message.",
                     "publish the peak in publish(), right after super().publish().",
                 )
-            runs[rate] = (imu, [p.data for p in peaks], probe)
+            runs[rate] = (imu, [p.data for p in peaks], probe, node.published("/Tank/peak_acceleration")[0])
         return runs[rate]
 
     def compare(label: str, rate: float, chosen, hint: str):
         call = f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s ({label})"
 
         def check():
-            imu, peaks, probe = run(rate)
+            imu, peaks, probe, _ = run(rate)
             readings = probe.readings
             for k, ((first, last), got) in enumerate(zip(_windows(imu), peaks)):
                 t = _stamp_ns(imu[k]) * 1e-9
@@ -213,8 +213,21 @@ def check_peak_publisher(cls) -> Result:
                 "every period", 20.0, lambda t: True, "each peak covers exactly the steps its Imu message averages."
             ),
             compare("every period", 10.0, lambda t: True, "the rate parameter still sets the period."),
+            Case(
+                f"{cls.__name__}.unconfigure()",
+                lambda: _destroyed(run(20.0)[3], f"{cls.__name__}.unconfigure()", "peak_publisher"),
+            ),
         ],
     )
+
+
+def _destroyed(publisher, call: str, name: str) -> None:
+    """CaseFailed unless the controller destroyed ``publisher`` (its ``unconfigure()``, when the run ended)."""
+    if not publisher.destroyed:
+        raise CaseFailed(
+            f"{call} left the publisher of {publisher.topic} in place, expected it destroyed.",
+            f"in unconfigure(): self.node.destroy_publisher(self.{name}), then super().unconfigure().",
+        )
 
 
 def _num(value) -> str:
@@ -264,6 +277,8 @@ def check_collision_reporter(cls) -> Result:
     """
     from geometry_msgs.msg import Vector3Stamped
 
+    made: list = []  # each run's publisher of /Tank/collision, for the unconfigure() case
+
     def reports(parameters: dict):
         where = ", ".join(f"{k}={v}" for k, v in parameters.items()) or "default parameters"
         call = f"{cls.__name__} with {where}, the wall script for {DURATION} s"
@@ -271,14 +286,16 @@ def check_collision_reporter(cls) -> Result:
         def check():
             node, _ = _drive("CollisionReporter", cls, parameters)
             imu = _imu_messages(node, call)
-            got = _one_publisher(
+            publisher = _one_publisher(
                 node,
                 "/Tank/collision",
                 Vector3Stamped,
                 call,
                 "create it in configure: config.node.create_publisher("
                 'Vector3Stamped, f"/{config.body_name}/collision", imu_qos()).',
-            ).messages()
+            )
+            made.append(publisher)
+            got = publisher.messages()
             threshold, holdoff = parameters.get("threshold", 20.0), parameters.get("holdoff", 0.5)
             expected, last = [], None
             for msg in imu:
@@ -334,5 +351,9 @@ def check_collision_reporter(cls) -> Result:
             # driving hard is above 3 m/s^2 for most periods from 0.55 s on: the holdoff runs from the last
             # report, not from the last period above threshold (that would report once and fall silent)
             reports({"threshold": 3.0, "holdoff": 0.12}),
+            Case(
+                f"{cls.__name__}.unconfigure()",
+                lambda: _destroyed(made[0], f"{cls.__name__}.unconfigure()", "collision_publisher"),
+            ),
         ],
     )

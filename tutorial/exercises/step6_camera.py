@@ -375,6 +375,15 @@ def check_camera_info(cls) -> Result:
 
         return run
 
+    def removed(call):
+        _, pub, _ = drive()  # the drive ended with unconfigure()
+        if not pub.destroyed:
+            raise CaseFailed(
+                f"{call}: the publisher of {INFO_TOPIC} was left in place, expected it destroyed.",
+                "in unconfigure(): super().unconfigure() first (the render thread ends), then "
+                "self.node.destroy_publisher(...) of the CameraInfo publisher.",
+            )
+
     return grade(
         "Exercise 6.2, publish the CameraInfo",
         [
@@ -393,5 +402,6 @@ def check_camera_info(cls) -> Result:
                 matrix("p"),
                 "p is the 3 x 4 matrix [k | 0], row by row: a single camera has no baseline.",
             ),
+            case("unconfigure() removes the CameraInfo publisher", removed),
         ],
     )

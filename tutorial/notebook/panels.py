@@ -57,11 +57,12 @@ class Panel:
     def stand_in(self) -> dict:
         """The output bundle where the panel cannot be live: what it is, and how to get it back."""
         return {
-            "text/plain": f"{self.title}: {self.description} (a live panel: run this cell to use it, in JupyterLab)",
+            "text/plain": f"{self.title}: {self.description} "
+            "(a live panel, not live now: run this cell to use it, in JupyterLab)",
             "text/html": (
                 f'<div style="border: 1px solid #bbb; border-radius: 4px; padding: 6px 10px; '
                 f'color: #444"><b>{html.escape(self.title)}</b>: {html.escape(self.description)}'
-                "<br><i>A live panel: run this cell to use it (in JupyterLab).</i></div>"
+                "<br><i>Not live now: run this cell to use it (in JupyterLab).</i></div>"
             ),
         }
 
