@@ -244,7 +244,7 @@ _PAGE = """<!DOCTYPE html>
 body {{ margin: 0; display: flex; height: 100vh; background: #fff; font: 12px sans-serif; }}
 .pane {{ flex: 1; position: relative; min-width: 0; border-left: 1px solid #ccc; }}
 .pane:first-child {{ border-left: none; }}
-.label {{ position: absolute; left: 6px; top: 6px; z-index: 2; padding: 2px 6px;
+.label {{ position: absolute; left: 6px; bottom: 6px; z-index: 2; padding: 2px 6px;
           background: rgba(255,255,255,0.8); border-radius: 3px; pointer-events: none; }}
 .view {{ position: absolute; inset: 0; }}
 </style></head><body>
