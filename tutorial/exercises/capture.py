@@ -25,6 +25,13 @@ class CapturingPublisher:
         self.sent.append(serialize_message(msg))
         self.real.publish(msg)
 
+    def require_destroyed(self, call: str, hint: str) -> None:
+        """Raise the check's ``CaseFailed`` unless the controller destroyed this publisher (in ``unconfigure()``)."""
+        from tutorial.exercises.grader import CaseFailed
+
+        if not self.destroyed:
+            raise CaseFailed(f"{call} left the publisher of {self.topic} in place, expected it destroyed.", hint)
+
     def messages(self) -> list:
         """Every message published so far, deserialized, oldest first."""
         from rclpy.serialization import deserialize_message

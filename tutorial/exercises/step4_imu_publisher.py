@@ -223,11 +223,9 @@ def check_peak_publisher(cls) -> Result:
 
 def _destroyed(publisher, call: str, name: str) -> None:
     """CaseFailed unless the controller destroyed ``publisher`` (its ``unconfigure()``, when the run ended)."""
-    if not publisher.destroyed:
-        raise CaseFailed(
-            f"{call} left the publisher of {publisher.topic} in place, expected it destroyed.",
-            f"in unconfigure(): self.node.destroy_publisher(self.{name}), then super().unconfigure().",
-        )
+    publisher.require_destroyed(
+        call, f"in unconfigure(): self.node.destroy_publisher(self.{name}), then super().unconfigure()."
+    )
 
 
 def _num(value) -> str:

@@ -9,11 +9,10 @@ view) on ``/<body>/camera/camera_info``, one with each picture, stamped alike.
 The learner's controller is configured on the tank and this thread plays
 the simulation thread, as ``tests/test_camera_publisher.py`` does: it poses
 the turret, calls ``control()`` up to the step a picture is due, and waits
-until the controller's own render thread has published it before going on.
-So no picture is ever skipped, and each is compared with a picture this
-check renders itself from the same pose: the same answer on every run.
-What the controller publishes is captured in-process
-(:mod:`tutorial.exercises.capture`).
+until the controller's own render thread has published it (captured
+in-process, :mod:`tutorial.exercises.capture`) before going on.  So no
+picture is skipped, and each is compared with one this check renders from
+the same pose: the same answer on every run.
 """
 
 from __future__ import annotations
@@ -375,14 +374,8 @@ def check_camera_info(cls) -> Result:
 
         return run
 
-    def removed(call):
-        _, pub, _ = drive()  # the drive ended with unconfigure()
-        if not pub.destroyed:
-            raise CaseFailed(
-                f"{call}: the publisher of {INFO_TOPIC} was left in place, expected it destroyed.",
-                "in unconfigure(): super().unconfigure() first (the render thread ends), then "
-                "self.node.destroy_publisher(...) of the CameraInfo publisher.",
-            )
+    def removed(call):  # the drive ended with unconfigure(); super().unconfigure() ends the render thread
+        drive()[1].require_destroyed(f"{name}.unconfigure()", "super().unconfigure() first, then destroy_publisher().")
 
     return grade(
         "Exercise 6.2, publish the CameraInfo",
