@@ -242,7 +242,7 @@ def check_pose_publisher(cls) -> Result:
         want = round(rate * DURATION)
         if len(messages) < want:
             raise CaseFailed(
-                f"{who} published {len(messages)} poses, expected {want} ({rate:g} Hz for {DURATION} s).",
+                f"{who}: published {len(messages)} poses, expected {want} ({rate:g} Hz for {DURATION} s).",
                 "use a PeriodAccumulator(io.time_step, rate) in initialize, with the rate parameter, "
                 "and tick() it in control().",
             )
