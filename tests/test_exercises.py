@@ -537,6 +537,75 @@ def test_a_wrongly_shaped_answer_is_told_so_not_judged_on_a_value(ros, number, r
     assert "Hint:" in result.message, str(result)
 
 
+LOCKED_COUNT = (
+    "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
+    "            self.a_down = down\n"
+)
+LOCKED_SUMMARY = (
+    "    def summary(self) -> dict:\n        with self._lock:\n            shots = self.shots\n"
+    '        return {**super().summary(), "shots": shots}\n'
+)
+
+
+@pytest.mark.parametrize(
+    "right,other",
+    [
+        (  # acquire() and release() instead of `with`
+            LOCKED_COUNT,
+            "        self._lock.acquire()\n        try:\n            if down and not self.a_down:\n"
+            "                self.shots += 1\n            self.a_down = down\n        finally:\n"
+            "            self._lock.release()\n",
+        ),
+        (  # an RLock of its own, so summary() can hold it around super().summary()
+            LOCKED_SUMMARY,
+            "    def __init__(self):\n        super().__init__()\n        import threading\n\n"
+            "        self._lock = threading.RLock()\n\n    def summary(self) -> dict:\n"
+            '        with self._lock:\n            return {**super().summary(), "shots": self.shots}\n',
+        ),
+        (  # what only on_joy (the spin thread) reads kept outside the lock
+            LOCKED_COUNT,
+            "        pressed = down and not self.a_down\n        self.a_down = down\n        if pressed:\n"
+            "            with self._lock:\n                self.shots += 1\n",
+        ),
+        (  # the count read through a property that takes the lock
+            LOCKED_SUMMARY,
+            "    @property\n    def count(self) -> int:\n        with self._lock:\n            return self.shots\n\n"
+            '    def summary(self) -> dict:\n        return {**super().summary(), "shots": self.count}\n',
+        ),
+    ],
+    ids=["acquire-release", "rlock", "a_down-outside", "property"],
+)
+def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, other):
+    """Exercise 1.2's lock check judges what the two threads share, however the learner takes the lock."""
+    ex = exercise("1.2")
+    assert right in ex["solution"], "the worked solution of 1.2 changed: update this test"
+    result = grade(ex, ex["stub"], ex["solution"].replace(right, other))
+    assert result.passed, str(result)
+
+
+def test_a_count_changed_in_place_outside_the_lock_fails_the_lock_check(ros):
+    """No attribute is assigned when a container is changed in place: the reads of it are watched too."""
+    ex = exercise("1.2")
+    wrong = (
+        ex["solution"]
+        .replace(
+            LOCKED_COUNT,
+            "        if down and not self.a_down:\n            self.tally[0] += 1\n        self.a_down = down\n",
+        )
+        .replace(
+            LOCKED_SUMMARY,
+            '    def summary(self) -> dict:\n        return {**super().summary(), "shots": self.tally[0]}\n',
+        )
+        .replace(
+            "    shots = 0  #",
+            "    def __init__(self):\n        super().__init__()\n        self.tally = [0]\n\n    shots = 0  #",
+        )
+    )
+    assert "self.tally = [0]" in wrong and LOCKED_COUNT not in wrong
+    result = grade(ex, ex["stub"], wrong)
+    assert not result.passed and "outside `with self._lock:`" in str(result), str(result)
+
+
 def test_every_exercise_has_six_wrong_answers():
     counts = {number: sum(m[0] == number for m in MISTAKES) for number in EXERCISES}
     assert all(n >= 6 for n in counts.values()), counts

@@ -25,6 +25,11 @@ class CapturingPublisher:
         self.sent.append(serialize_message(msg))
         self.real.publish(msg)
 
+    def destroy(self) -> None:
+        """Destroy the real publisher (rclpy's ``Publisher.destroy``), noted as ``node.destroy_publisher`` is."""
+        self.destroyed = True
+        self.real.destroy()
+
     def require_destroyed(self, call: str, hint: str) -> None:
         """Raise the check's ``CaseFailed`` unless the controller destroyed this publisher (in ``unconfigure()``)."""
         from tutorial.exercises.grader import CaseFailed

@@ -155,22 +155,26 @@ def check_shot_counter(cls) -> Result:
 
     def under_the_lock():
         controller = _watched(cls)()
-        lock = _WatchedLock()
-        object.__setattr__(controller, "_lock", lock)
-        object.__setattr__(controller, "_watch", [])  # (what, name, lock held) of each write, then each read
-        for buttons in (A, NONE, A):
-            controller.on_joy(_joy(buttons))
-        ours = {name for what, name, _ in controller._watch} - _BASE_STATE  # what the exercise added
-        object.__setattr__(controller, "_reading", ours)
-        controller.summary()
-        loose = sorted({(what, name) for what, name, held in controller._watch if not held and name not in _BASE_STATE})
+        base = next(c for c in cls.__mro__ if c.__name__ == "RttTankController")
+        own = set(vars(base()))  # RttTankController's own state: its on_joy keeps it under the lock
+        object.__setattr__(controller, "_lock", _WatchedLock(controller._lock))  # the learner's lock, watched
+        object.__setattr__(controller, "_watch", [])
+        for phase, run in (("on_joy", lambda: [controller.on_joy(_joy(b)) for b in (A, NONE, A)]), ("summary", None)):
+            object.__setattr__(controller, "_phase", phase)
+            (run or controller.summary)()
+        object.__setattr__(controller, "_phase", None)
+        seen = [row for row in controller.__dict__["_watch"] if row[2] not in own]
+        # what both threads touch: read by summary() (the main thread), read or written by on_joy (the spin thread)
+        shared = {n for p, w, n, _ in seen if p == "summary" and w == "read"} & {
+            n for p, *_, n, _ in seen if p == "on_joy"
+        }
+        loose = [(phase, what, name) for phase, what, name, held in seen if name in shared and not held]
         if loose:
-            what, name = loose[0]
-            where = "on_joy() writes" if what == "write" else "summary() reads"
+            phase, what, name = loose[0]
             raise CaseFailed(
-                f"{cls.__name__}: {where} self.{name} outside `with self._lock:`.",
-                "on_joy runs on the spin thread and summary() on the main thread: read and write what on_joy "
-                "remembers under self._lock, as RttTankController.on_joy does.",
+                f"{cls.__name__}: {phase}() {what}s self.{name} outside `with self._lock:`.",
+                "on_joy runs on the spin thread and summary() on the main thread: what both touch (the count) is "
+                "read and written under self._lock, as RttTankController.on_joy does.",
             )
 
     cases = [count(*row) for row in sequences]
@@ -179,30 +183,28 @@ def check_shot_counter(cls) -> Result:
     return grade("Exercise 1.2, count the shots", cases)
 
 
-# What RttTankController's own on_joy keeps (under its lock); a check looks at what an exercise adds.
-_BASE_STATE = {"_axes", "_buttons", "_received", "_malformed"}
-
-
 class _WatchedLock:
-    """The check's stand-in for ``self._lock``: a real lock that also says whether it is held."""
+    """The check's wrapper of the controller's own lock (a Lock or an RLock): it also says whether it is held."""
 
-    def __init__(self):
-        import threading
+    def __init__(self, real):
+        self._real = real
+        self.depth = 0  # acquisitions not yet released (an RLock may be taken again by its holder)
 
-        self._real = threading.Lock()
-        self.held = False
+    @property
+    def held(self) -> bool:
+        return self.depth > 0
 
     def acquire(self, *args, **kwargs) -> bool:
         got = self._real.acquire(*args, **kwargs)
-        self.held = self.held or got
+        self.depth += bool(got)
         return got
 
     def release(self) -> None:
-        self.held = False
+        self.depth -= 1
         self._real.release()
 
     def locked(self) -> bool:
-        return self._real.locked()
+        return self.depth > 0
 
     __enter__ = acquire
 
@@ -211,19 +213,26 @@ class _WatchedLock:
 
 
 def _watched(cls):
-    """``cls`` noting each attribute it writes, and each it reads of ``_reading``, with whether its lock is held."""
+    """``cls`` noting, while ``_phase`` names a phase, each state attribute it reads or writes, and if its lock is held.
+
+    A method, a property or any other descriptor is not noted itself: what it reads and writes is.
+    """
+
+    def note(obj, what: str, name: str) -> None:
+        d = object.__getattribute__(obj, "__dict__")
+        if d.get("_phase") is None or name.startswith("__") or name in ("_phase", "_watch", "_lock"):
+            return
+        if hasattr(type(getattr(type(obj), name, None)), "__get__"):
+            return  # a method or a property: what it touches is noted when it runs
+        d["_watch"].append((d["_phase"], what, name, d["_lock"].held))
 
     class Watched(cls):
         def __setattr__(self, name, value):
-            watch = self.__dict__.get("_watch")
-            if watch is not None:
-                watch.append(("write", name, self.__dict__["_lock"].held))
+            note(self, "write", name)
             object.__setattr__(self, name, value)
 
         def __getattribute__(self, name):
-            d = object.__getattribute__(self, "__dict__")
-            if name in d.get("_reading", ()):
-                d["_watch"].append(("read", name, d["_lock"].held))
+            note(self, "read", name)
             return object.__getattribute__(self, name)
 
     Watched.__name__ = Watched.__qualname__ = cls.__name__

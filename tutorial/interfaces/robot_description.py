@@ -101,7 +101,7 @@ def receive_robot_description(node, topic: str, timeout: float) -> str:
     from std_msgs.msg import String
 
     received: list[str] = []
-    volatile: list[str] = []  # a publisher that offers less than transient local: the policy it lacks
+    refused: list[str] = []  # a publisher that offers too little (volatile, best effort): the policy it lacks
     subscription = node.create_subscription(
         String,
         topic,
@@ -109,7 +109,7 @@ def receive_robot_description(node, topic: str, timeout: float) -> str:
         robot_description_qos(),
         # said in the error below, with what to do, instead of rclpy's own warning
         event_callbacks=SubscriptionEventCallbacks(
-            incompatible_qos=lambda event: volatile.append(_policy_name(event.last_policy_kind))
+            incompatible_qos=lambda event: refused.append(_policy_name(event.last_policy_kind))
         ),
     )
     topic = subscription.topic_name  # as remapped (-r): the topic it really waits on
@@ -123,10 +123,10 @@ def receive_robot_description(node, topic: str, timeout: float) -> str:
         executor.remove_node(node)
         executor.shutdown(timeout_sec=0)
         node.destroy_subscription(subscription)
-    if not received and volatile:
+    if not received and refused:
         raise DescriptionError(
             f"no robot description on {topic} within {timeout:g} s: a publisher offers it with an incompatible "
-            f"QoS ({volatile[-1]}): publish it as robot_state_publisher does, reliable, keep last 1, transient "
+            f"QoS ({refused[-1]}): publish it as robot_state_publisher does, reliable, keep last 1, transient "
             "local, so a program that starts later still gets it"
         )
     if not received:

@@ -273,7 +273,9 @@ def look_at_geoms(model: mujoco.MjModel, data: mujoco.MjData, geom_ids, directio
     bounding sphere, ``geom_rbound``, placed where ``data`` has it); the
     camera looks at it from ``direction``, far enough that the box's
     half-diagonal fits meshcat's 75-degree field of view, and never nearer
-    than ``|direction|`` (the tank's close-up).  Planes (infinite) are left out.
+    than ``|direction|`` (the tank's close-up).  Planes (infinite) are left out;
+    a pane narrower than it is tall may still cut the robot's sides (only the
+    vertical field of view is used).
     """
     ids = [
         g
@@ -285,6 +287,8 @@ def look_at_geoms(model: mujoco.MjModel, data: mujoco.MjData, geom_ids, directio
     centres, radii = data.geom_xpos[ids], model.geom_rbound[ids][:, None]
     low, high = (centres - radii).min(axis=0), (centres + radii).max(axis=0)
     target = (low + high) / 2
+    if not np.all(np.isfinite(target)):
+        return None  # a pose not yet known (NaN): the caller's close-up instead
     along = np.asarray(direction, dtype=float)
     distance = max(float(np.linalg.norm(along)), 1.8 * float(np.linalg.norm(high - low)) / 2)  # 1/sin(37.5 deg) ~ 1.64
     return target + along / np.linalg.norm(along) * distance, target
