@@ -204,7 +204,7 @@ class _WatchedLock:
         self._real.release()
 
     def locked(self) -> bool:
-        return self.depth > 0
+        return self.held
 
     __enter__ = acquire
 
