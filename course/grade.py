@@ -29,8 +29,10 @@ rows: its zeros would read as missed work).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import re
+import shutil
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -39,6 +41,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a package
 from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
+from sandboxing import (  # noqa: E402
+    Sandboxes,
+    add_flags_column,
+    apply,
+    clear,
+    judge,
+    record_flags,
+    say_in_feedback,
+    test_calls,
+)
 
 
 def domains(text: str) -> list[int]:
@@ -93,20 +105,35 @@ def learners(course: Path, assignment: str) -> list[str]:
     return sorted(p.name for p in folder.iterdir() if (p / assignment).is_dir()) if folder.is_dir() else []
 
 
-def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int = 1, ids=(232,)) -> Path:
-    """Grade ``assignments`` in ``course``; the grades' CSV.
+def grade(
+    course: Path, assignments: list[str], collect: bool = True, jobs: int = 1, ids=(232,), sandboxed: bool = True
+) -> Path:
+    """Grade ``assignments`` in ``course``; the grades' CSV (with its ``flags`` column).
 
-    ``collect``: from the exchange (then each learner's feedback is released into it).
+    ``collect``: from the exchange (then each learner's feedback is released into it).  ``sandboxed``: each
+    submission runs as a user of its own, without network, limited and sealed (``sandboxing.py``); its
+    exercises' points stand only where the seal saw the teacher's check pass them.
 
     Raises:
         ValueError: more ``jobs`` than domains in ``ids`` (checked before anything is graded).
+        SandboxError: ``sandboxed`` and the sandbox cannot be made here (not root).
         GradingError: some submissions could not be graded; the others were, and the CSV was written.
         RuntimeError: another nbgrader command failed (its output is in the message).
     """
     ids = list(ids)
-    failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
     if jobs > len(ids):
         raise ValueError(f"{jobs} jobs need {jobs} ROS domains, {len(ids)} given")
+    with Sandboxes(course, jobs) if sandboxed else contextlib.nullcontext() as boxes:
+        return _grade(course, assignments, collect, jobs, ids, boxes)
+
+
+def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: list[int], boxes) -> Path:
+    failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
+    flagged: list[str] = []
+    private = [course / p for p in ("source", "submitted", "autograded", "feedback", "gradebook.db")]
+    for path in private:  # the teacher's alone (a learner's server, or a sandbox, never reads them)
+        if path.exists():
+            os.chmod(path, 0o700 if path.is_dir() else 0o600)
     for assignment in assignments:
         if collect:
             nbgrader(course, "collect", assignment, "--update")
@@ -120,11 +147,33 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
             env = dict(
                 os.environ, ROS_DOMAIN_ID=str(ids[k]), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RTT_TEST_MODE="1"
             )
+            job = boxes.users[k] if boxes else None
             for learner in who[k::jobs]:
+                log, died = "", False
+                if job:
+                    job.test_calls = test_calls(course, assignment)
+                    Path(job.verdicts).unlink(missing_ok=True)
+                    env["RTT_SANDBOX"] = job.to_env()
                 try:
-                    nbgrader(course, "autograde", assignment, "--student", learner, "--force", env=env)
+                    log = nbgrader(course, "autograde", assignment, "--student", learner, "--force", env=env)
                 except RuntimeError as error:
+                    log, died = str(error), True
                     failed.append(f"{assignment}, {learner}: {str(error).splitlines()[0]}")
+                finally:
+                    if job:
+                        clear(job)
+                if job and not died and not Path(job.verdicts).exists():
+                    failed.append(f"{assignment}, {learner}: not graded in the sandbox (nbgrader's log: {log[-500:]})")
+                    continue
+                if job:
+                    notebook = course / "autograded" / learner / assignment / f"{assignment}.ipynb"
+                    judged = judge(notebook, Path(job.verdicts), log, died)
+                    if notebook.parent.is_dir():  # what the seal said, and why, for the teacher
+                        shutil.copyfile(job.verdicts, notebook.parent / "seal.txt")
+                    if notebook.is_file():
+                        apply(f"sqlite:///{course / 'gradebook.db'}", assignment, learner, judged)
+                        say_in_feedback(notebook, judged)
+                    record_flags(course, assignment, learner, judged)
 
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(worker, range(jobs)))  # list(): a worker's exception is raised here
@@ -140,6 +189,9 @@ def grade(course: Path, assignments: list[str], collect: bool = True, jobs: int 
     csv = course / "grades.csv"
     given = sorted(set(assignments) | set(released(course) if collect else ()))
     nbgrader(course, "export", "--to", str(csv), *(f"--assignment={name}" for name in given))
+    flagged.extend(add_flags_column(course, csv))
+    if flagged:
+        print(f"{len(flagged)} flagged submission(s) (the flags column of {csv.name}):", *flagged, sep="\n  ")
     if failed:
         raise GradingError(csv, failed)
     return csv
@@ -169,6 +221,9 @@ def main(argv=None) -> int:
     p.add_argument(
         "--domains", help="ROS domains for the jobs, as 215-232 or 5,7,9 (default: those the hub gave no learner)"
     )
+    p.add_argument(
+        "--unsandboxed", action="store_true", help="run submissions with your own rights, unsealed (not for a class)"
+    )
     args = p.parse_args(argv)
     course = args.course.resolve()
     names: list[str] = []
@@ -186,7 +241,7 @@ def main(argv=None) -> int:
                 print("no assignment is released into the exchange yet: nothing to collect", file=sys.stderr)
                 return 1
         ids = domains(args.domains) if args.domains else free_domains()
-        csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=ids)
+        csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=ids, sandboxed=not args.unsandboxed)
     except GradingError as error:
         print(f"graded {', '.join(names)}: {error.csv}, but {error}", file=sys.stderr)
         return 1

@@ -56,5 +56,28 @@ c.GenerateAssignment.preprocessors = [
 # its own (a camera's render thread) cannot be interrupted and slows the kernel for the rest of the
 # notebook: its outputs may come late, which must not end the grading of the notebook.
 c.Execute.timeout = int(os.environ.get("RTT_GRADING_CELL_TIMEOUT", "120"))
+# course/grade.py grades in a sandbox (tutorial/exercises/sandbox.py): each kernel as the job's own user,
+# without network, limited and sealed; RTT_SANDBOX describes the job.
+if os.environ.get("RTT_SANDBOX"):
+    from nbconvert.preprocessors import ClearMetadataPreprocessor
+    from nbgrader.preprocessors import (
+        AssignLatePenalties,
+        IgnorePattern,
+        LimitOutput,
+        SaveAutoGrades,
+    )
+
+    from tutorial.exercises.sandbox import SandboxedExecute
+
+    # nbgrader's own list (nbgrader.converters.autograde), its Execute sandboxed
+    c.Autograde.autograde_preprocessors = [
+        SandboxedExecute,
+        IgnorePattern,
+        ClearMetadataPreprocessor,
+        LimitOutput,
+        SaveAutoGrades,
+        AssignLatePenalties,
+        CheckCellMetadata,
+    ]
 c.Execute.raise_on_iopub_timeout = False
 c.Execute.iopub_timeout = 30

@@ -52,6 +52,7 @@ DOMAINS = [int(os.environ["ROS_DOMAIN_ID"]), int(os.environ["ROS_DOMAIN_ID"]) + 
 # The endless answer is interrupted after this: notebook 01's cells take under 4 s here; all nine notebooks'
 # under 10 s alone, more with two graded at once.
 CELL_TIMEOUT_S = 12
+ROOT_USER = os.geteuid() == 0  # grading in the sandbox needs root; elsewhere the tests grade unsandboxed
 CELL_TIMEOUT_ALL_S = 40
 
 
@@ -128,7 +129,9 @@ def submissions(course: Path, name: str, every_mistake: bool = True) -> dict[str
     return out
 
 
-def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange: bool = False) -> None:
+def grade_all(
+    tmp: Path, names: list[str], every_mistake: bool = True, exchange: bool = False, cheats: tuple[str, ...] = ()
+) -> None:
     """Make the course, put every fake submission in, grade, and hold each exercise's points to the expected.
 
     ``exchange``: one more learner (this Unix user) fetches the first assignment from nbgrader's exchange,
@@ -137,6 +140,7 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
     import getpass
 
     course, home, exchange_dir = tmp / "course", tmp / "learner", tmp / "exchange"
+    cheats = cheats if ROOT_USER else ()  # the sandbox, which catches them, needs root
     assignments.make(course, release=False)
     for name in names:
         assignments.nbgrader(course, "generate_assignment", name, "--force")
@@ -167,7 +171,11 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
         assert grade.released(course) == [name]  # what make grade collects by default
         expected[(name, me)] = {n: float(assignments.POINTS[n]) if n == first else 0.0 for n in exercises_of(name)}
     for name in names:
-        for learner, (nb, points) in submissions(course, name, every_mistake).items():
+        made = submissions(course, name, every_mistake)
+        for learner, nb in cheating_submissions(course, name, list(cheats), CHEAT_FILL).items():
+            target = CHEATS[learner.removeprefix("cheat-")][0]
+            made[learner] = (nb, {n: 0.0 if n == target else float(assignments.POINTS[n]) for n in exercises_of(name)})
+        for learner, (nb, points) in made.items():
             folder = course / "submitted" / learner / name
             folder.mkdir(parents=True)
             (folder / f"{name}.ipynb").write_text(json.dumps(nb))
@@ -177,11 +185,11 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
         broken.mkdir(parents=True)
         (broken / f"{names[0]}.ipynb").write_text("{ not a notebook")
         with pytest.raises(grade.GradingError) as caught:
-            grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS)
+            grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS, sandboxed=ROOT_USER)
         assert [line.split(":")[0] for line in caught.value.failed] == [f"{names[0]}, broken"], caught.value.failed
         csv_path = caught.value.csv
     else:
-        csv_path = grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS)
+        csv_path = grade.grade(course, names, collect=exchange, jobs=2, ids=DOMAINS, sandboxed=ROOT_USER)
 
     from nbgrader.api import Gradebook
 
@@ -198,6 +206,11 @@ def grade_all(tmp: Path, names: list[str], every_mistake: bool = True, exchange:
         assert rows[(name, learner)] == sum(points.values()), (name, learner, rows[(name, learner)])
         assert (course / "feedback" / learner / name / f"{name}.html").is_file(), f"no feedback for {learner}"
     assert {name for name, _ in rows} == set(names), "the CSV has rows for an assignment not given to the class"
+    flags = {(r["assignment"], r["student_id"]): r["flags"] for r in csv.DictReader(csv_path.open())}
+    for cheat in cheats:  # its target flagged; the honest submissions not at all
+        target, _, flag = CHEATS[cheat]
+        assert f"{target}: {flag}" in flags[(names[0], f"cheat-{cheat}")], flags
+    assert flags[(names[0], "solutions")] == "", flags
     if exchange:  # the learner fetches their feedback from the exchange, as from the Assignments tab
         assignments.nbgrader(home, "fetch_feedback", names[0], *where)
         fetched = list((home / names[0] / "feedback").glob(f"*/{names[0]}.html"))
@@ -293,9 +306,10 @@ def test_a_notebook_without_points_for_an_exercise_is_refused():
 
 
 def test_grading_notebook_01s_assignment(tmp_path, monkeypatch):
+    """Graded sandboxed (as root), with one cheat among the submissions: 0 for its target, flagged."""
     monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))  # read by the course's nbgrader_config.py
     monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "exchange"))
-    grade_all(tmp_path, IN_MAKE_TEST, every_mistake=False, exchange=True)
+    grade_all(tmp_path, IN_MAKE_TEST, every_mistake=False, exchange=True, cheats=tuple(IN_MAKE_TEST_CHEATS))
 
 
 @pytest.mark.slow
@@ -304,3 +318,149 @@ def test_grading_every_assignment(tmp_path, monkeypatch):
     monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_ALL_S))
     monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "exchange"))
     grade_all(tmp_path, ALL)
+
+
+# ---- submissions that cheat (the sandbox and seal: tutorial/exercises/sandbox.py, seal.py; course/sandboxing.py) ----
+
+STUB_1_1 = "def dpad_track_velocities(axes):\n    raise NotImplementedError\n"
+GRADER = "import tutorial.exercises.grader as grader\n"
+# Each cheat: (the exercise it targets, the code put in that exercise's answer cell after its stub, the flag
+# it must get).  The other exercise keeps its worked solution and its points.  A cheat on a global (the grader,
+# IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
+CHEATS = {
+    "rebind-check": (
+        "1.1",
+        GRADER + "import tutorial.exercises.step1_tank_controller as m\n"
+        "m.check_dpad_steering = lambda f: grader.Result('Exercise 1.1, steer with the D-pad', True, 'passed')\n",
+        "tampering",
+    ),
+    "patch-grader": ("1.2", GRADER + "grader.Result.require = lambda self: self\n", "tampering"),
+    "always-equal": (
+        "1.1",
+        "class Anything(float):\n    def __eq__(self, other):\n        return True\n"
+        "    def __sub__(self, other):\n        return 0.0\n"
+        "def dpad_track_velocities(axes):\n    return (Anything(0), Anything(0))\n",
+        "tampering",
+    ),
+    "showtraceback": (
+        "1.2",
+        "shell = get_ipython()\nshell.showtraceback = lambda *a, **k: None\n"
+        "shell._showtraceback = lambda *a, **k: None\n",
+        "tampering",
+    ),
+    "read-solutions": (
+        "1.1",
+        "for path in ('{root}/notebooks/01_step1_tank_controller.ipynb',\n"
+        "             '{course}/source/01_step1_tank_controller/01_step1_tank_controller.ipynb'):\n"
+        "    try:\n        exec(open(path).read().split('Worked solution to Exercise 1.1.')[1].split('check_')[0])\n"
+        "    except (OSError, IndexError, SyntaxError):\n        pass\n",
+        "outside its folder",
+    ),
+    "read-another-learner": (
+        "1.1",
+        "try:\n    open('{course}/submitted/cheat-endless/01_step1_tank_controller/01_step1_tank_controller.ipynb')\n"
+        "except OSError:\n    pass\n" + STUB_1_1,
+        "outside its folder",
+    ),
+    "write-home-and-gradebook": (
+        "1.1",
+        "for path in ('{home}/rtt-cheat', '{course}/gradebook.db'):\n"
+        "    try:\n        open(path, 'a').write('cheat')\n    except OSError:\n        pass\n" + STUB_1_1,
+        "outside its folder",
+    ),
+    "network": (
+        "1.1",
+        "import socket\ntry:\n    socket.create_connection(('127.0.0.1', {port}), timeout=2).sendall(b'answers?')\n"
+        "except OSError:\n    pass\n" + STUB_1_1,
+        "network",
+    ),
+    "fork-bomb": (
+        "1.2",
+        "import os, time\nborn = 0\nwhile born < 2000:\n    if os.fork() == 0:\n        time.sleep(120)\n"
+        "        os._exit(0)\n    born += 1\n",
+        "over a limit",
+    ),
+    "memory-hog": (
+        "1.2",
+        "hog = []\nwhile len(hog) < 16:  # 4 GiB, every page touched\n"
+        "    hog.append(bytearray(256 << 20))\n    hog[-1][::4096] = b'x' * (256 << 8)\n",
+        "over a limit",
+    ),
+    "endless": ("1.1", "while True:\n    pass\n", "timeout"),
+    "grader-aware": (
+        "1.1",
+        "import os\nif os.environ.get('NBGRADER_EXECUTION'):\n"
+        + "    "
+        + GRADER
+        + "    grader.Result.__bool__ = lambda s: True\n",
+        "grader-aware",
+    ),
+}
+IN_MAKE_TEST_CHEATS = ["rebind-check"]  # graded among make test's submissions of notebook 01
+# where the cheats that read, write or connect point: none of it may be reached
+CHEAT_FILL = {"root": ROOT, "course": "/nonexistent-course", "home": "/nonexistent-home", "port": 9}
+
+
+def cheating_submissions(course: Path, name: str, which: list[str], fill: dict[str, str]) -> dict:
+    """Each cheat's submission of ``name`` (assignment 01): the cheat in its exercise, the other solved."""
+    solved = solution_of(course, name)
+    stubs = {grade_id(c): "".join(c["source"]) for c in cells_of(course, name) if grade_id(c)}
+    out = {}
+    for cheat in which:
+        target, code, _ = CHEATS[cheat]
+        gid = f"exercise_{target.replace('.', '_')}"
+        answers = dict(solved, **{gid: stubs[gid] + "\n\n" + code.format(**fill)})
+        out[f"cheat-{cheat}"] = submission(course, name, answers)
+    return out
+
+
+def grade_cheats(tmp_path: Path, which: list[str]) -> None:
+    """Grade the cheats of ``which``, sandboxed; each gets 0 and its flag in its target, full points in the other."""
+    import socket
+
+    if os.geteuid() != 0:
+        pytest.skip("the grading sandbox needs root (a user per job, namespaces)")
+    name = IN_MAKE_TEST[0]
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    listener = socket.create_server(("127.0.0.1", 0))  # the only address a cheat may try; it must hear nothing
+    listener.settimeout(0.1)
+    home = Path(os.path.expanduser("~"))
+    fill = {"root": ROOT, "course": course, "home": home, "port": listener.getsockname()[1]}
+    try:
+        for learner, nb in cheating_submissions(course, name, which, fill).items():
+            folder = course / "submitted" / learner / name
+            folder.mkdir(parents=True)
+            (folder / f"{name}.ipynb").write_text(json.dumps(nb))
+        gradebook_before = (course / "gradebook.db").read_bytes()
+        csv_path = grade.grade(course, [name], collect=False, jobs=2, ids=DOMAINS)
+        with pytest.raises(TimeoutError):
+            listener.accept()  # nobody connected
+    finally:
+        listener.close()
+    assert not (home / "rtt-cheat").exists(), "a cheat wrote into the grader's home"
+    rows = {r["student_id"]: r for r in csv.DictReader(csv_path.open())}
+    wrong = []
+    for cheat in which:
+        target, _, flag = CHEATS[cheat]
+        row = rows[f"cheat-{cheat}"]
+        other = next(n for n in exercises_of(name) if n != target)
+        if float(row["score"]) != assignments.POINTS[other]:
+            wrong.append(f"{cheat}: score {row['score']}, expected {assignments.POINTS[other]} (exercise {other})")
+        flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
+        if flag not in flags.get(target, ""):
+            wrong.append(f"{cheat}: flags {row['flags']!r}, expected {flag!r} on {target}")
+        if flags.get(other):
+            wrong.append(f"{cheat}: the honest exercise {other} was flagged {flags[other]!r}")
+    assert not wrong, "\n".join(wrong)
+    assert (course / "gradebook.db").read_bytes() != gradebook_before  # the grader wrote it, nobody else could
+    feedback = (course / "feedback" / f"cheat-{which[0]}" / name / f"{name}.html").read_text()
+    assert f"The grader flagged exercise {CHEATS[which[0]][0]}" in feedback
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1200)
+def test_every_cheat_gets_0_and_is_flagged(tmp_path, monkeypatch):
+    monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))
+    grade_cheats(tmp_path, sorted(CHEATS))

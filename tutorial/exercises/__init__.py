@@ -3,4 +3,10 @@
 
 A notebook imports the check of each exercise from its notebook's module, e.g.
 ``from tutorial.exercises.step1_tank_controller import check_dpad_steering``.
+
+Grading's own parts, which no notebook imports: ``release`` (the release's
+stubs, in ``nbgrader generate_assignment``), ``sandbox`` (each graded
+kernel as a user of its own, without network, limited), ``seal`` and
+``sealed_kernel`` (the grading kernel's verdicts, signed only when the
+teacher's own check made them).  ``course/grade.py`` uses them.
 """

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
 import textwrap
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
@@ -85,6 +86,7 @@ class Result:
             AssertionError: the check failed; the message is the line a learner sees, wrapped at
                 :data:`WRAP` characters (nbgrader's feedback shows it in a box that does not wrap).
         """
+        sys.audit("rtt.verdict", self)  # to the grading kernel's seal (tutorial.exercises.seal), if any
         if not self.passed:
             raise AssertionError(textwrap.fill(str(self), WRAP, subsequent_indent="  ", break_long_words=False))
         return self
@@ -106,8 +108,11 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
     quiet, propagate = logging.NullHandler(), logger.propagate
     logger.addHandler(quiet)  # a handler, so Python's last-resort handler does not print to stderr
     logger.propagate = False
+    sys.audit("rtt.check_begin", exercise)  # the grading kernel's seal (tutorial.exercises.seal) takes note
     try:
-        return _run_cases(exercise, cases)
+        result = _run_cases(exercise, cases)
+        sys.audit("rtt.result", result)
+        return result
     finally:
         logger.removeHandler(quiet)
         logger.propagate = propagate
@@ -156,20 +161,57 @@ def not_done(exc: BaseException | None) -> bool:
     return False
 
 
+def _number_types() -> frozenset[type]:
+    import numpy
+
+    scalars = {t for t in numpy.sctypeDict.values() if issubclass(t, (numpy.integer, numpy.floating))}
+    return frozenset({int, float} | scalars)
+
+
+# The types of number an answer may return, exactly: a subclass of float could compare equal to anything.
+NUMBER_TYPES = _number_types()
+
+
 def same_numbers(got, expected, tol: float = 1e-9) -> bool:
-    """True when ``got`` is a number or a sequence of numbers equal to ``expected`` within ``tol``."""
+    """True when ``got`` is a number or a sequence of numbers equal to ``expected`` within ``tol``.
+
+    A number is an ``int``, a ``float`` or a NumPy scalar, of exactly that type (not a subclass, whose
+    comparisons an answer could make say anything).
+    """
     if isinstance(expected, (int, float)):
-        return (
-            isinstance(got, (int, float))
-            and not isinstance(got, bool)
-            and math.isfinite(got)
-            and abs(got - expected) <= tol
-        )
+        if type(got) not in NUMBER_TYPES:
+            _suspect(got)
+            return False
+        return math.isfinite(got) and abs(float(got) - expected) <= tol
     try:
         got = list(got)
     except TypeError:
         return False
     return len(got) == len(expected) and all(same_numbers(g, e, tol) for g, e in zip(got, expected))
+
+
+def same_value(got, expected) -> bool:
+    """True when ``got`` is ``expected``'s type exactly (an int may be a NumPy integer) and equal to it.
+
+    Never calls a method of a class an answer made (its ``__eq__`` could say anything).
+    """
+    if type(expected) is int:
+        if type(got) not in NUMBER_TYPES:
+            _suspect(got)
+            return False
+        return float(got).is_integer() and int(got) == expected
+    if type(got) is not type(expected):
+        _suspect(got)
+        return False
+    return got == expected
+
+
+def _suspect(got) -> None:
+    """Tell the grading kernel's seal when a value's class is an answer's own and could compare as it likes."""
+    kind = type(got)
+    if isinstance(got, (int, float, str)) or any("__eq__" in vars(k) for k in kind.__mro__[:-1]):
+        if kind.__module__ not in ("builtins", "numpy"):
+            sys.audit("rtt.suspect", f"a {kind.__name__!s:.40}, a class of its own that compares as it likes")
 
 
 def show(value) -> str:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_numbers, grade, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, expect_numbers, grade, same_numbers, same_value, show
 from tutorial.interfaces import joy
 
 DPAD_SPEED = 1.0  # m/s of both tracks for D-pad up
@@ -136,7 +136,7 @@ def check_shot_counter(cls) -> Result:
             for buttons in presses:
                 controller.on_joy(_joy(buttons))
             shots = controller.summary().get("shots")
-            if shots != expected:
+            if not same_value(shots, expected):
                 raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.", hint)
 
         return Case(call, run, hint)
@@ -146,7 +146,11 @@ def check_shot_counter(cls) -> Result:
         stick = [0.0, 1.0] + [0.0] * (joy.NUM_AXES - 2)
         controller.on_joy(_joy(A, stick))
         count_, axes, _ = controller.take_input()
-        if list(axes) != stick or count_ != 1 or controller.summary().get("joy_received") != 1:
+        if not (
+            same_numbers(axes, stick)
+            and same_value(count_, 1)
+            and same_value(controller.summary().get("joy_received"), 1)
+        ):
             raise CaseFailed(
                 f"after on_joy(axes={show(stick)}), take_input() gave ({count_}, {show(list(axes))}, ...) "
                 f"and summary() {controller.summary()}: the sticks are no longer stored.",

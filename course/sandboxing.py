@@ -1,0 +1,245 @@
+"""The grading sandbox's side in ``course/grade.py``: its users, the seal's verdicts, the flags a teacher sees.
+
+``grade.py`` grades each submission in a sandbox
+(:mod:`tutorial.exercises.sandbox`): :class:`Sandboxes` makes one Unix user
+per grading job and removes it afterwards.  After ``nbgrader autograde``,
+:func:`judge` reads what the kernel's seal (:mod:`tutorial.exercises.seal`)
+signed, nbgrader's own log and the autograded notebook, and decides each
+exercise: its points stand only if nbgrader *and* the seal say it passed.
+Its flags say why not, or what else was seen:
+
+- ``changed cell``: nbgrader put back a read-only cell the learner had changed;
+- ``tampering``: the check cell passed in the notebook, but the seal saw no genuine
+  passing verdict (a check or the grader replaced, a verdict not the check's,
+  a refused operation);
+- ``timeout``: a cell of the exercise ran past the cell timeout;
+- ``crash``: the kernel died;
+- ``over a limit``: memory, processes or CPU time ran out (``MemoryError``, ...);
+- ``network``, ``processes``, ``outside its folder``: what the seal noted the answer doing;
+- ``grader-aware``: the answer looks for nbgrader (``NBGRADER_...``).
+
+The flags go to ``flags.json`` in the course (kept across runs), the
+``flags`` column of ``grades.csv``, the learner's feedback (one line under
+the check), and ``make grade``'s summary.  Runs in the grader's process, as root.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import json
+import os
+import pwd
+import re
+import secrets
+import shutil
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tutorial.exercises.sandbox import Job
+
+ROOT = Path(__file__).resolve().parent.parent
+JOBS = Path("/var/lib/rtt-grading")
+TEACHERS_ONLY = ("notebooks", "course", "book", ".git")  # the repository's folders with worked solutions
+LIMIT_ERRORS = re.compile(r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory")
+
+
+class SandboxError(RuntimeError):
+    """The sandbox cannot be made here (not root, or no unshare): the message says what to do."""
+
+
+@dataclass
+class Sandboxes:
+    """One Unix user per grading job, a folder for their kernels; removed with all they ran on :meth:`close`."""
+
+    course: Path
+    jobs: int
+    users: list[Job] = field(default_factory=list)
+
+    def __enter__(self) -> Sandboxes:
+        if os.geteuid() != 0 or not shutil.which("unshare") or not shutil.which("setpriv"):
+            raise SandboxError(
+                "grading runs each submission as a user of its own, in a namespace of its own: "
+                "run make grade as root (Linux, util-linux), or pass --unsandboxed to grade with your own "
+                "rights (a learner's code then runs as you: not for a real class)"
+            )
+        JOBS.mkdir(parents=True, exist_ok=True)
+        os.chmod(JOBS, 0o711)
+        self.folder = JOBS / secrets.token_hex(4)
+        self.folder.mkdir(mode=0o711)
+        hide = sorted({str(self.course), *(str(ROOT / f) for f in TEACHERS_ONLY), "/home", "/root", "/srv"})
+        for k in range(self.jobs):
+            name = f"rttgrade{self.folder.name[:5]}{k}"
+            subprocess.run(
+                ["useradd", "--system", "--no-create-home", "--shell", "/usr/sbin/nologin", name],
+                check=True,
+                capture_output=True,
+                timeout=30,
+            )
+            entry = pwd.getpwnam(name)
+            folder = self.folder / name
+            folder.mkdir(mode=0o711)
+            self.users.append(
+                Job(name, entry.pw_uid, entry.pw_gid, str(folder), str(folder / "verdicts"), hide, test_calls=[])
+            )
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        for job in self.users:
+            clear(job)
+            subprocess.run(["userdel", job.user], capture_output=True, timeout=30, check=False)
+            for controller in ("memory", "pids"):
+                with contextlib.suppress(OSError):
+                    (Path("/sys/fs/cgroup") / controller / f"rtt-grade-{job.user}").rmdir()
+        self.users = []
+        shutil.rmtree(getattr(self, "folder", JOBS / "none"), ignore_errors=True)
+
+
+def clear(job: Job) -> None:
+    """Everything the job's user still runs, killed (a fork bomb's children, say); its kernels' folders removed."""
+    subprocess.run(["pkill", "-KILL", "-u", job.user], capture_output=True, timeout=30, check=False)
+    for group in (Path("/sys/fs/cgroup") / c / f"rtt-grade-{job.user}" for c in ("memory", "pids")):
+        with contextlib.suppress(OSError):
+            for pid in (group / "cgroup.procs").read_text().split():
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(int(pid), 9)
+    for kernel in Path(job.folder).iterdir():
+        if kernel.is_dir():
+            shutil.rmtree(kernel, ignore_errors=True)
+
+
+def test_calls(course: Path, assignment: str) -> list[str]:
+    """The statement each test cell of ``assignment`` ends with (``check_x(answer).require()``), from its source."""
+    notebook = json.loads((course / "source" / assignment / f"{assignment}.ipynb").read_text())
+    out = []
+    for cell in notebook["cells"]:
+        if cell["metadata"].get("nbgrader", {}).get("grade"):
+            lines = [line for line in "".join(cell["source"]).splitlines() if line.strip()]
+            out.append(lines[-1].strip())
+    return out
+
+
+def number(grade_id: str) -> str:
+    """``check_1_2`` or ``exercise_1_2`` as ``1.2``."""
+    return grade_id.split("_", 1)[1].replace("_", ".")
+
+
+def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dict[str, tuple[bool, list[str]]]:
+    """Each exercise of one graded notebook: (whether the seal let its points stand, its flags).
+
+    ``autograded``: the notebook nbgrader executed; ``verdicts``: the seal's checked lines; ``log``: what
+    nbgrader autograde printed; ``died``: the kernel died (nbgrader could not finish the notebook).
+    """
+    notebook = json.loads(autograded.read_text()) if autograded.is_file() else {"cells": []}
+    exercises: dict[str, dict] = {}
+    current = None
+    for cell in notebook["cells"]:
+        grade_id = cell["metadata"].get("nbgrader", {}).get("grade_id") or ""
+        if grade_id.startswith(("exercise_", "check_")):
+            current = number(grade_id)
+            exercises.setdefault(current, {"cells": [], "source": ""})
+            if grade_id.startswith("exercise_"):
+                exercises[current]["source"] = "".join(cell["source"])
+        if current and cell["cell_type"] == "code":
+            exercises[current]["cells"].append(cell)
+    passed: dict[str, bool] = {}
+    flags: dict[str, list[str]] = {n: [] for n in exercises}
+    pending: list[str] = []  # notes before a check: the answer cell's, which comes before it
+    lines = verdicts.read_text().splitlines() if verdicts.is_file() else []
+    for line in lines:
+        kind, *rest = line.split("\t")
+        if kind == "note":
+            flag = {"refused": "tampering", "outside": "outside its folder"}.get(rest[0], rest[0])
+            if len(rest) > 2 and rest[2] in flags:  # a note that names its exercise
+                flags[rest[2]].append(flag)
+            else:
+                pending.append(flag)
+        elif kind == "begin" and rest:
+            passed[rest[0]] = False  # the last begin of an exercise must be followed by its verdict
+            flags.setdefault(rest[0], []).extend(pending)
+            pending = []
+        elif kind == "verdict" and len(rest) >= 3:
+            ex, ok, intact = rest[0], rest[1] == "1", rest[2] == "1"
+            passed[ex] = ok and intact
+            flags.setdefault(ex, []).extend(pending + ([] if intact else ["tampering"]))
+            pending = []
+    for match in re.finditer(r"Attribute '\w+' for cell (\w+) has changed", log):
+        flags.setdefault(number(match.group(1)), []).append("changed cell")
+    out = {}
+    for ex, found in exercises.items():
+        errors = [o for c in found["cells"] for o in c.get("outputs", []) if o.get("output_type") == "error"]
+        text = " ".join(f"{o.get('ename')}: {o.get('evalue')}" for o in errors)
+        check_ok = any(
+            c["metadata"].get("nbgrader", {}).get("grade")
+            and not any(o.get("output_type") == "error" for o in c.get("outputs", []))
+            for c in found["cells"]
+        )
+        mine = flags.setdefault(ex, [])
+        if "CellTimeoutError" in text or "KeyboardInterrupt" in text:
+            mine.append("timeout")
+        if LIMIT_ERRORS.search(text):
+            mine.append("over a limit")
+        if died:
+            mine.append("crash")
+        if "showtraceback was disabled" in json.dumps(found["cells"]):  # nbgrader's words for a hidden error
+            mine.append("tampering")
+        if "NBGRADER" in found["source"]:
+            mine.append("grader-aware")
+        if check_ok and not passed.get(ex, False) and "tampering" not in mine:
+            mine.append("tampering")
+        out[ex] = (passed.get(ex, False), sorted(set(mine)))
+    return out
+
+
+def apply(gradebook_url: str, assignment: str, learner: str, judged: dict[str, tuple[bool, list[str]]]) -> None:
+    """nbgrader's automatic score of each check the seal did not let stand, set to 0 (a manual score stays)."""
+    from nbgrader.api import Gradebook
+
+    with Gradebook(gradebook_url) as gb:
+        for ex, (ok, _) in judged.items():
+            if not ok:
+                grade = gb.find_grade(f"check_{ex.replace('.', '_')}", assignment, assignment, learner)
+                grade.auto_score = 0.0
+        gb.db.commit()
+
+
+def say_in_feedback(autograded: Path, judged: dict[str, tuple[bool, list[str]]]) -> None:
+    """One line under each flagged check, in the autograded notebook the feedback is made from."""
+    notebook = json.loads(autograded.read_text())
+    for cell in notebook["cells"]:
+        grade_id = cell["metadata"].get("nbgrader", {}).get("grade_id") or ""
+        if grade_id.startswith("check_") and judged.get(number(grade_id), (True, []))[1]:
+            ok, mine = judged[number(grade_id)]
+            points = "" if ok else " It gets 0 points."
+            line = f"The grader flagged exercise {number(grade_id)}: {', '.join(mine)}.{points}\n"
+            cell.setdefault("outputs", []).append({"output_type": "stream", "name": "stdout", "text": line})
+    autograded.write_text(json.dumps(notebook))
+
+
+def record_flags(course: Path, assignment: str, learner: str, judged: dict[str, tuple[bool, list[str]]]) -> None:
+    """``flags.json`` in the course: each (assignment, learner)'s flags, as ``1.1: tampering; 1.2: timeout``."""
+    path = course / "flags.json"
+    kept = json.loads(path.read_text()) if path.is_file() else {}
+    kept[f"{assignment}/{learner}"] = "; ".join(f"{ex}: {', '.join(f)}" for ex, (_, f) in sorted(judged.items()) if f)
+    path.write_text(json.dumps(kept, indent=1, sort_keys=True) + "\n")
+    os.chmod(path, 0o600)
+
+
+def add_flags_column(course: Path, csv_path: Path) -> list[str]:
+    """``grades.csv`` with a ``flags`` column (from ``flags.json``); the flagged rows, one line each."""
+    kept = json.loads((course / "flags.json").read_text()) if (course / "flags.json").is_file() else {}
+    with csv_path.open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        return []
+    for row in rows:
+        row["flags"] = kept.get(f"{row['assignment']}/{row['student_id']}", "")
+    with csv_path.open("w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=[*rows[0].keys()])
+        writer.writeheader()
+        writer.writerows(rows)
+    return [f"{r['assignment']}, {r['student_id']}: {r['flags']}" for r in rows if r["flags"]]
