@@ -62,7 +62,8 @@ test-hub: $(VENV)/.installed course/node_modules/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_hub.py -m slow -q
 
-# Grading every assignment's fake submissions (make test grades notebook 01's): several minutes.
+# Grading every assignment's fake submissions, and the cheats of assignment 01 (make test grades notebook 01's,
+# one cheat among them): several minutes; as root, in the grading sandbox.
 test-grade: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_grading.py -m slow -q
 
@@ -71,7 +72,8 @@ assignments: $(VENV)/.installed
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/assignments.py
 
 # Collect the submissions from the exchange, autograde them, write and release feedback, and course/grades.csv.
-# ARGS go to course/grade.py: make grade ARGS="01_step1_tank_controller --jobs 2".
+# As root: each submission in the grading sandbox, sealed (book/course.md); its flags in grades.csv.
+# ARGS go to course/grade.py: make grade ARGS="01_step1_tank_controller --jobs 2" (or --unsandboxed, not root).
 grade: $(VENV)/.installed
 	PATH="$(CURDIR)/$(VENV)/bin:$$PATH" $(PY) course/grade.py $(ARGS)
 

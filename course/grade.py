@@ -47,6 +47,7 @@ from sandboxing import (  # noqa: E402
     apply,
     clear,
     judge,
+    learner_seed,
     record_flags,
     say_in_feedback,
     test_calls,
@@ -151,7 +152,8 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
             for learner in who[k::jobs]:
                 log, died = "", False
                 if job:
-                    job.test_calls = test_calls(course, assignment)
+                    job.test_calls, job.checks = test_calls(course, assignment)
+                    job.seed = learner_seed(course, assignment, learner)
                     Path(job.verdicts).unlink(missing_ok=True)
                     env["RTT_SANDBOX"] = job.to_env()
                 try:

@@ -34,6 +34,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from tornado import web
+
 COURSE = Path(__file__).resolve().parent
 ROOT = COURSE.parent
 sys.path.insert(0, str(COURSE))
@@ -160,6 +162,15 @@ DOMAINS = DomainBook(
 )
 
 
+class SpawnRefused(web.HTTPError):
+    """A learner's server refused, with the reason: on their page (``jupyterhub_message``), as the hub API's
+    503 (the server cannot be had now, the hub itself is fine), and in the hub's log."""
+
+    def __init__(self, message: str):
+        super().__init__(503, "%s", message, reason="Service Unavailable")
+        self.jupyterhub_message = message
+
+
 def give_learner_their_domain_and_notebooks(spawner):
     """Before a learner's server starts: their ROS domain, in its environment, and their copy of the notebooks.
 
@@ -171,7 +182,7 @@ def give_learner_their_domain_and_notebooks(spawner):
         domain = DOMAINS.domain_for(name)
     except DomainError as exc:
         spawner.log.error("%s", exc)
-        raise RuntimeError(str(exc)) from None
+        raise SpawnRefused(str(exc)) from None
     spawner.environment["ROS_DOMAIN_ID"] = str(domain)
     spawner.environment["RTT_ASSIGNED_ROS_DOMAIN_ID"] = str(domain)  # the notebooks warn if it is changed
     spawner.log.info("learner %s: ROS domain %d", name, domain)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import hmac
 import json
 import os
 import pwd
@@ -112,15 +113,28 @@ def clear(job: Job) -> None:
             shutil.rmtree(kernel, ignore_errors=True)
 
 
-def test_calls(course: Path, assignment: str) -> list[str]:
-    """The statement each test cell of ``assignment`` ends with (``check_x(answer).require()``), from its source."""
+def test_calls(course: Path, assignment: str) -> tuple[list[str], list[str]]:
+    """The statement each test cell of ``assignment`` ends with (``check_x(answer).require()``), and the modules
+    they import their checks from, from the assignment's source."""
     notebook = json.loads((course / "source" / assignment / f"{assignment}.ipynb").read_text())
-    out = []
+    calls, modules = [], []
     for cell in notebook["cells"]:
         if cell["metadata"].get("nbgrader", {}).get("grade"):
-            lines = [line for line in "".join(cell["source"]).splitlines() if line.strip()]
-            out.append(lines[-1].strip())
-    return out
+            text = "".join(cell["source"])
+            calls.append([line for line in text.splitlines() if line.strip()][-1].strip())
+            modules += re.findall(r"^from (tutorial\.exercises\.\w+) import", text, re.M)
+    return calls, sorted(set(modules))
+
+
+def learner_seed(course: Path, assignment: str, learner: str) -> str:
+    """The seed of ``learner``'s hidden cases of ``assignment``: drawn from the course's own seed (made once,
+    in ``.grading_seed``, the teacher's alone), so a regrade draws the same cases and another learner others."""
+    path = course / ".grading_seed"
+    if not path.is_file():
+        path.write_text(secrets.token_hex(16) + "\n")
+        os.chmod(path, 0o600)
+    key = path.read_text().strip().encode()
+    return hmac.new(key, f"{assignment}/{learner}".encode(), "sha256").hexdigest()[:16]
 
 
 def number(grade_id: str) -> str:

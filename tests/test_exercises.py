@@ -628,3 +628,148 @@ def test_a_failed_line_names_its_subject_once_and_wraps_for_nbgrader():
     lines = str(raised.value).splitlines()
     assert len(lines) > 1 and all(len(line) <= WRAP for line in lines), lines
     assert " ".join(line.strip() for line in lines) == str(result)
+
+
+# ---- hidden cases (grader.hidden_random): drawn while grading, by the statement's rules ----
+
+HIDDEN = ["1.1", "1.2", "3.1", "3.2"]  # the exercises whose checks draw hidden cases
+# Answers written for the visible cases alone: each passes its check's visible cases and fails the hidden ones.
+VISIBLE_ONLY = {
+    "1.1": "TABLE = {(0, 0): (0.0, 0.0), (0, 1): (1.0, 1.0), (0, -1): (-1.0, -1.0), (1, 0): (-0.5, 0.5),\n"
+    "         (-1, 0): (0.5, -0.5), (1, 1): (0.5, 1.5), (-1, -1): (-0.5, -1.5), (1, -1): (-1.5, -0.5)}\n"
+    "def dpad_track_velocities(axes):\n"
+    "    if len(axes) < 6 or axes[0] != 0.0 or axes[5] != axes[5]:\n        return 0.0, 0.0\n"
+    "    return TABLE.get((axes[4], axes[5]), (0.0, 0.0))\n",
+    "1.2": "class ShotCountingTankController(RttTankController):\n"
+    "    shots = 0\n    a_down = False\n"
+    "    def on_joy(self, msg):\n        super().on_joy(msg)\n"
+    "        down = len(msg.buttons) > 0 and msg.buttons[0] == 1\n"
+    "        with self._lock:\n"
+    "            if down and not self.a_down:\n                self.shots = min(self.shots + 1, 2)  # 2 at most\n"
+    "            self.a_down = down\n"
+    "    def summary(self):\n        with self._lock:\n            shots = self.shots\n"
+    "        return {**super().summary(), 'shots': shots}\n",
+    # the range checked only for the joints the visible cases push past their limits
+    "3.2": "import math\nfrom collections import Counter\n"
+    "def my_match(joints, names, positions):\n"
+    "    by_name = {j.name: j for j in joints}\n    copies = Counter(names)\n    applied = {}\n"
+    "    for name, q in zip(names, positions):\n"
+    "        joint = by_name.get(name)\n"
+    "        if joint is None or copies[name] > 1 or not math.isfinite(q):\n            continue\n"
+    "        tolerance = 0.01 if joint.kind == 'slide' else 0.05\n"
+    "        if name in ('TURRET_P', 'TROLLEY', 'TURRET_Y') and not "
+    "joint.lower - tolerance <= q <= joint.upper + tolerance:\n"
+    "            continue\n"
+    "        applied[name] = q\n    return applied\n",
+}
+
+
+@pytest.fixture
+def grading_seed(monkeypatch):
+    """The checks' hidden cases on, as the grading kernel's seal gives them (seeded: the same every run)."""
+    import importlib
+    import random
+
+    for module in ("step1_tank_controller", "step3_viewer"):
+        checks = importlib.import_module(f"tutorial.exercises.{module}")
+        monkeypatch.setattr(checks, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
+
+
+@pytest.mark.parametrize("number", HIDDEN)
+def test_the_worked_solution_passes_the_hidden_cases_too(ros, grading_seed, number):
+    ex = exercise(number)
+    result = grade(ex, ex["stub"], ex["solution"])
+    assert result.passed and "hidden ones)" in result.message, str(result)
+
+
+@pytest.mark.parametrize("number", sorted(VISIBLE_ONLY))
+def test_an_answer_for_the_visible_cases_alone_fails_the_hidden_ones(ros, monkeypatch, number):
+    ex = exercise(number)
+    visible = grade(ex, ex["stub"], VISIBLE_ONLY[number])
+    assert visible.passed, str(visible)  # a learner's own run: the visible cases alone
+    import random
+
+    module = __import__(f"tutorial.exercises.{ex['checks']}", fromlist=["x"])
+    monkeypatch.setattr(module, "hidden_random", lambda e: random.Random(f"test/{e}"))
+    graded = grade(ex, ex["stub"], VISIBLE_ONLY[number])
+    assert not graded.passed and "a hidden case failed: " in graded.message, str(graded)
+    assert not any(c.isdigit() for c in graded.message.split("failed")[1]), graded.message  # no values
+
+
+@pytest.mark.parametrize("number, right, wrong, caught_by", [m for m in MISTAKES if m[0] in HIDDEN])
+def test_a_wrong_answer_still_fails_with_the_hidden_cases(ros, grading_seed, number, right, wrong, caught_by):
+    ex = exercise(number)
+    assert right in ex["solution"]
+    assert not grade(ex, ex["stub"], ex["solution"].replace(right, wrong)).passed
+
+
+# Each statement's rules, and the labels of the visible cases (or the hidden cases' description) that check
+# each: a rule with no case fails here.  Exercises 1.1, 1.2, 3.1 and 3.2 (the others: not listed yet).
+RULES = {
+    "1.1": {
+        "up drives both tracks forward at DPAD_SPEED, down backward": ["(up)", "(down)"],
+        "left turns left on the spot (left -DPAD_TURN, right +DPAD_TURN), right the other way": ["(left)", "(right)"],
+        "a diagonal is the sum of its two directions, reversing too": ["(up and left)", "(down and right)"],
+        "a missing axis counts as 0": ["(a Joy with only 4 axes)", "a Joy too short for the D-pad's axes"],
+        "a non-finite axis counts as 0": ["(NaN on the vertical axis)", "a D-pad axis NaN or infinite"],
+        "only axes 4 and 5 count": ["(left stick up, D-pad released)", "with the sticks moved"],
+    },
+    "1.2": {
+        "a press is a change from released to pressed": ["(press, release, press)", "a long random sequence"],
+        "A held down over repeated Joys is one shot": ["(A held for 10 repeats, then released)"],
+        "before any Joy, A counts as released": ["(the first Joy already has A pressed)"],
+        "a Joy with too few buttons reads A as released": ["(a Joy with no buttons between two presses)"],
+        "A is button 0, not B": ["(only B pressed)", "a long random sequence of A, B, both"],
+        "super().on_joy(msg) first: the tank still drives": ["on_joy(a Joy with the left stick up)"],
+        "what both threads touch, under self._lock": ["what on_joy() remembers, under self._lock"],
+    },
+    "3.1": {
+        "a message naming some of this body's joints, and nothing else, is applied as before": [
+            "(the tank's own message)",
+            "(only one of the tank's joints)",
+        ],
+        "a message naming a joint the body does not have is refused whole": ["(one of the tank's joints and one"],
+        "a message naming none of its joints is refused": ["(the crane's message)", "(an empty message)"],
+        "each refused message counts once as wrong_model": ["(the crane's message, twice)"],
+        "other messages stay with the matcher (its rejections)": ["(the tank's, with a NaN)"],
+        "after a refusal, a good message is applied": ["(the crane's, then the tank's)", "a random run of"],
+    },
+    "3.2": {
+        "matched by name, in any order": ["(reordered)"],
+        "unknown names skipped": ["(unknown name)", "names known, unknown and repeated"],
+        "every entry of a duplicated name skipped": ["(duplicate name)", "(three copies of a name)"],
+        "entries without a position or name skipped": ["(short positions)", "(short names)"],
+        "non-finite values skipped": ["(NaN)", "(minus infinity)", "(an unlimited hinge at infinity)"],
+        "outside the range by more than 0.05 rad skipped, within applied": [
+            "(past the limit a little)",
+            "(past the limit a lot)",
+            "(just below a lower limit)",
+            "(far below a lower limit)",
+        ],
+        "a slide's tolerance is 0.01 m": ["(a slide a little past its limit)", "(a slide 0.05 m past its limit)"],
+        "an unlimited joint has no range": ["(an unlimited hinge far round)"],
+    },
+}
+
+
+@pytest.mark.parametrize("number", sorted(RULES))
+def test_every_rule_of_a_statement_has_its_cases(ros, grading_seed, monkeypatch, number):
+    ex = exercise(number)
+    module = __import__(f"tutorial.exercises.{ex['checks']}", fromlist=["x"])
+    calls: list[str] = []
+    real = module.grade
+
+    def recording(exercise_name, cases):
+        cases = list(cases)
+        calls.extend(c.call for c in cases)
+        return real(exercise_name, cases)
+
+    monkeypatch.setattr(module, "grade", recording)
+    assert grade(ex, ex["stub"], ex["solution"]).passed
+    missing = [
+        (rule, label)
+        for rule, labels in RULES[number].items()
+        for label in labels
+        if not any(label in call for call in calls)
+    ]
+    assert not missing, missing

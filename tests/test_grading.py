@@ -210,7 +210,13 @@ def grade_all(
     for cheat in cheats:  # its target flagged; the honest submissions not at all
         target, _, flag = CHEATS[cheat]
         assert f"{target}: {flag}" in flags[(names[0], f"cheat-{cheat}")], flags
-    assert flags[(names[0], "solutions")] == "", flags
+    for (name, learner), said in flags.items():  # what nbgrader and the seal saw, nothing more
+        if learner == "check-edited" and ROOT_USER:
+            assert "changed cell" in said, (name, said)
+        elif learner == "endless" and ROOT_USER and not name.startswith("06"):  # 06's loops on its render thread
+            assert said == f"{exercises_of(name)[0]}: timeout", (name, said)
+        elif not learner.startswith("cheat-"):
+            assert said == "", (name, learner, said)  # the solutions, the wrong answers, the stubs: no flag
     if exchange:  # the learner fetches their feedback from the exchange, as from the Assignments tab
         assignments.nbgrader(home, "fetch_feedback", names[0], *where)
         fetched = list((home / names[0] / "feedback").glob(f"*/{names[0]}.html"))
@@ -325,8 +331,8 @@ def test_grading_every_assignment(tmp_path, monkeypatch):
 STUB_1_1 = "def dpad_track_velocities(axes):\n    raise NotImplementedError\n"
 GRADER = "import tutorial.exercises.grader as grader\n"
 # Each cheat: (the exercise it targets, the code put in that exercise's answer cell after its stub, the flag
-# it must get).  The other exercise keeps its worked solution and its points.  A cheat on a global (the grader,
-# IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
+# it must get, or "": none).  The other exercise keeps its worked solution and its points.  A cheat on a
+# global (the grader, IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
 CHEATS = {
     "rebind-check": (
         "1.1",
@@ -387,6 +393,29 @@ CHEATS = {
         "over a limit",
     ),
     "endless": ("1.1", "while True:\n    pass\n", "timeout"),
+    # not cheats: answers written for the visible cases alone, which the hidden cases fail (no flag)
+    "visible-only-1.1": (
+        "1.1",
+        "TABLE = {(0, 0): (0.0, 0.0), (0, 1): (1.0, 1.0), (0, -1): (-1.0, -1.0), (1, 0): (-0.5, 0.5),\n"
+        "         (-1, 0): (0.5, -0.5), (1, 1): (0.5, 1.5), (-1, -1): (-0.5, -1.5), (1, -1): (-1.5, -0.5)}\n"
+        "def dpad_track_velocities(axes):\n"
+        "    if len(axes) < 6 or axes[0] != 0.0 or axes[5] != axes[5]:\n        return 0.0, 0.0\n"
+        "    return TABLE.get((axes[4], axes[5]), (0.0, 0.0))\n",
+        "",
+    ),
+    "visible-only-1.2": (
+        "1.2",
+        "class ShotCountingTankController(RttTankController):\n"
+        "    shots = 0\n    a_down = False\n"
+        "    def on_joy(self, msg):\n        super().on_joy(msg)\n"
+        "        down = len(msg.buttons) > 0 and msg.buttons[0] == 1\n"
+        "        with self._lock:\n"
+        "            if down and not self.a_down:\n                self.shots = min(self.shots + 1, 2)\n"
+        "            self.a_down = down\n"
+        "    def summary(self):\n        with self._lock:\n            shots = self.shots\n"
+        "        return {**super().summary(), 'shots': shots}\n",
+        "",
+    ),
     "grader-aware": (
         "1.1",
         "import os\nif os.environ.get('NBGRADER_EXECUTION'):\n"
@@ -409,7 +438,9 @@ def cheating_submissions(course: Path, name: str, which: list[str], fill: dict[s
     for cheat in which:
         target, code, _ = CHEATS[cheat]
         gid = f"exercise_{target.replace('.', '_')}"
-        answers = dict(solved, **{gid: stubs[gid] + "\n\n" + code.format(**fill)})
+        for key, value in fill.items():  # {root}, {course}, ...: not str.format, the code has braces of its own
+            code = code.replace("{" + key + "}", str(value))
+        answers = dict(solved, **{gid: stubs[gid] + "\n\n" + code})
         out[f"cheat-{cheat}"] = submission(course, name, answers)
     return out
 
@@ -449,7 +480,7 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
         if float(row["score"]) != assignments.POINTS[other]:
             wrong.append(f"{cheat}: score {row['score']}, expected {assignments.POINTS[other]} (exercise {other})")
         flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
-        if flag not in flags.get(target, ""):
+        if flag not in flags.get(target, "") or (not flag and flags.get(target)):
             wrong.append(f"{cheat}: flags {row['flags']!r}, expected {flag!r} on {target}")
         if flags.get(other):
             wrong.append(f"{cheat}: the honest exercise {other} was flagged {flags[other]!r}")

@@ -102,10 +102,14 @@ def test_each_learners_robots_are_their_own(hub):
     # A third learner finds no domain left: told why, given no server, and A and B run on undisturbed.
     c = Learner(hub, "learner-c")
     c.log_in()
+    refused = c.request_server()  # the hub's API: 503, the server cannot be had, with the reason
+    assert refused.status_code == 503 and "no ROS domain left for learner-c" in refused.text, refused.text
     with pytest.raises(RuntimeError):
         c.start_server(timeout=30)
     assert "no ROS domain left for learner-c" in hub.log()
     assert "no ROS domain left for learner-c" in c.server_error(), c.server_error()  # on the learner's page
+    page = c.http.get(f"{hub.url}/hub/spawn-pending/learner-c", timeout=30).text  # the page a browser shows
+    assert "no ROS domain left for learner-c" in page and "Unhandled error" not in page, page[-2000:]
 
     # Both drive at once: B's kernel runs its drive while A's runs in a thread of this test.
     import threading
@@ -293,6 +297,25 @@ def test_a_learner_who_changed_their_domain_is_warned():
     text = assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12", "ROS_DOMAIN_ID": "5"})
     assert "gave you ROS domain 12" in text and "ROS_DOMAIN_ID is 5" in text
     assert "gave you ROS domain 12" in assigned_domain_warning({"RTT_ASSIGNED_ROS_DOMAIN_ID": "12"})
+
+
+@pytest.mark.cross_process
+def test_a_domain_changed_by_hand_after_the_first_cell_is_warned_at_init_ros():
+    """rclpy.shutdown(), another learner's domain, init_ros(): said (it was checked at import only)."""
+    import subprocess
+    import sys
+
+    script = (
+        "import os, rclpy\n"
+        "from tutorial.notebook.session import init_ros\n"
+        "init_ros(); rclpy.shutdown()\n"
+        "os.environ['ROS_DOMAIN_ID'] = '13'\n"
+        "init_ros(); rclpy.shutdown()\n"
+    )
+    env = dict(os.environ, RTT_ASSIGNED_ROS_DOMAIN_ID=os.environ["ROS_DOMAIN_ID"])
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count("WARNING: ROS_DOMAIN_ID is 13, but this server gave you") == 1, done.stderr
 
 
 @pytest.mark.slow  # make test-hub: make test keeps the hub's one real case (two learners, their own domains)

@@ -1,18 +1,23 @@
 """How long a teacher waits: autograding 30 submissions of one assignment with nbgrader.
 
     python -m benchmarks.experiments.grading [--submissions 30] [--assignment 01_step1_tank_controller] [--jobs 1 2]
+        [--sandbox both|yes|no]
 
 A course is made in a temporary folder (``course/assignments.py``); each
 fake submission is the release with the worked solutions pasted in (every
 cell of the notebook runs, as in a learner's complete work).
 ``course/grade.py`` then autogrades them all, writes the feedback and the
 CSV, once per ``--jobs`` value (learners graded at once, each job in a ROS
-domain of its own).  Printed: the wall time of each, and per submission.
+domain of its own), unsandboxed and sandboxed (``--sandbox both``, the
+default, as root: each kernel a user of its own, in namespaces, sealed).
+Printed: the wall time of each, per submission, and the sandbox's ratio to
+the same run's unsandboxed grading (the target: at most 1.5).
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import os
 import random
@@ -46,7 +51,7 @@ def solved_submission(course: Path, name: str) -> dict:
     return nb
 
 
-def grading_time(name: str, submissions: int, jobs: int, domains: list[int]) -> dict:
+def grading_time(name: str, submissions: int, jobs: int, domains: list[int], sandboxed: bool) -> dict:
     with tempfile.TemporaryDirectory() as d:
         course = Path(d) / "course"
         assignments.make(course, release=False)
@@ -57,14 +62,16 @@ def grading_time(name: str, submissions: int, jobs: int, domains: list[int]) -> 
             folder.mkdir(parents=True)
             (folder / f"{name}.ipynb").write_text(nb)
         t0 = time.monotonic()
-        csv = grade.grade(course, [name], collect=False, jobs=jobs, ids=domains[:jobs])
+        csv_path = grade.grade(course, [name], collect=False, jobs=jobs, ids=domains[:jobs], sandboxed=sandboxed)
         seconds = time.monotonic() - t0
         full = sum(v for k, v in assignments.POINTS.items() if k.split(".")[0] == str(int(name[:2])))
-        scores = [line.split(",")[-2] for line in csv.read_text().splitlines()[1:] if line.startswith(name)]
+        with csv_path.open() as f:
+            scores = [row["score"] for row in csv.DictReader(f) if row["assignment"] == name]
         shutil.rmtree(course, ignore_errors=True)
     return {
         "submissions": submissions,
         "jobs": jobs,
+        "sandboxed": sandboxed,
         "seconds": round(seconds, 1),
         "seconds_per_submission": round(seconds / submissions, 2),
         "all_full_points": all(float(s) == full for s in scores) and len(scores) == submissions,
@@ -76,10 +83,18 @@ def main(argv=None) -> int:
     p.add_argument("--submissions", type=int, default=30)
     p.add_argument("--assignment", default="01_step1_tank_controller")
     p.add_argument("--jobs", type=int, nargs="+", default=[1, 2])
+    p.add_argument("--sandbox", choices=("both", "yes", "no"), default="both")
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    os.environ.setdefault("RTT_TEST_MODE", "1")  # the notebooks' live sections end by themselves, as in make grade
     base = random.randint(1, 50)
-    out = [grading_time(args.assignment, args.submissions, j, [base, base + 50]) for j in args.jobs]
+    modes = {"both": [False, True], "yes": [True], "no": [False]}[args.sandbox]
+    out = []
+    for jobs in args.jobs:
+        runs = [grading_time(args.assignment, args.submissions, jobs, [base, base + 50], m) for m in modes]
+        if len(runs) == 2:
+            runs[1]["ratio_to_unsandboxed"] = round(runs[1]["seconds"] / runs[0]["seconds"], 2)
+        out += runs
     print(json.dumps(out, indent=1))
     return 0
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import math
+import random
 import sys
 import textwrap
 from collections.abc import Callable, Iterable, Sequence
@@ -48,11 +49,16 @@ class CaseFailed(AssertionError):
 
 @dataclass
 class Case:
-    """One case: ``run()`` raises :class:`CaseFailed` on a wrong answer; ``call`` names the input."""
+    """One case: ``run()`` raises :class:`CaseFailed` on a wrong answer; ``call`` names the input.
+
+    A ``hidden`` case is drawn for grading (:func:`hidden_random`): ``call`` says what it tests, and its
+    failure is told by that alone, never by its values.
+    """
 
     call: str
     run: Callable[[], None]
     hint: str = ""
+    hidden: bool = False
 
 
 @dataclass
@@ -118,32 +124,54 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
         logger.propagate = propagate
 
 
+def hidden_random(exercise: str) -> random.Random | None:
+    """The random source of this learner's hidden cases of ``exercise`` (e.g. ``"1.1"``), while grading; else None.
+
+    Its seed is the grader's: drawn per learner from a seed the teacher keeps (``course/grade.py``) and given
+    only to the teacher's own checks by the grading kernel's seal (:mod:`tutorial.exercises.seal`).  Outside
+    grading (a learner's own run) there is none, and a check runs its visible cases alone.  Any thread.
+    """
+    box: list[str] = []
+    sys.audit("rtt.seed", box)  # the seal puts the seed in the box, for a teacher's check only
+    return random.Random(f"{box[0]}/{exercise}") if box else None
+
+
 def _run_cases(exercise: str, cases: Iterable[Case]) -> Result:
-    count = 0
+    count = hidden = 0
     for case in cases:
         count += 1
+        hidden += case.hidden
         try:
             case.run()
-        except CaseFailed as failure:
-            hint = failure.hint or case.hint
-            what = (
-                failure.what if case.call in failure.what else f"{case.call}: {_unless_said(case.call, failure.what)}"
-            )
-            return Result(exercise, False, what + (f" Hint: {hint}" if hint else ""), case.call)
-        except Exception as exc:  # noqa: BLE001 - the learner's bug, reported with its input
-            if not_done(exc):
-                return Result(
-                    exercise,
-                    False,
-                    f"not done yet: {case.call} raised NotImplementedError. "
-                    "Write your code in place of the `raise NotImplementedError` line.",
-                    case.call,
-                )
+        except Exception as exc:  # noqa: BLE001 - a hidden case is told by what it tests
+            if not case.hidden:
+                return _failed(exercise, case, exc)
             hint = f" Hint: {case.hint}" if case.hint else ""
-            return Result(exercise, False, f"{case.call} raised {type(exc).__name__}: {exc}.{hint}", case.call)
+            said = "" if isinstance(exc, CaseFailed) else f" ({type(exc).__name__})"
+            return Result(exercise, False, f"a hidden case failed{said}: {case.call}.{hint}", case.call)
     if count == 0:
         raise ValueError(f"{exercise}: a check with no cases cannot pass")
-    return Result(exercise, True, f"passed ({count} case{'s' if count != 1 else ''}).")
+    shown = count - hidden
+    more = f" and {hidden} hidden one{'s' if hidden != 1 else ''}" if hidden else ""
+    return Result(exercise, True, f"passed ({shown} case{'s' if shown != 1 else ''}{more}).")
+
+
+def _failed(exercise: str, case: Case, exc: Exception) -> Result:
+    """The result of a visible case that raised ``exc``: what failed, with its input, and the hint."""
+    if isinstance(exc, CaseFailed):
+        hint = exc.hint or case.hint
+        what = exc.what if case.call in exc.what else f"{case.call}: {_unless_said(case.call, exc.what)}"
+        return Result(exercise, False, what + (f" Hint: {hint}" if hint else ""), case.call)
+    if not_done(exc):  # the learner's stub
+        return Result(
+            exercise,
+            False,
+            f"not done yet: {case.call} raised NotImplementedError. "
+            "Write your code in place of the `raise NotImplementedError` line.",
+            case.call,
+        )
+    hint = f" Hint: {case.hint}" if case.hint else ""  # the learner's bug, reported with its input
+    return Result(exercise, False, f"{case.call} raised {type(exc).__name__}: {exc}.{hint}", case.call)
 
 
 def _unless_said(call: str, what: str) -> str:

@@ -57,6 +57,8 @@ class Job:
         verdicts: the file the seal's checked verdicts are appended to (the grader's alone).
         hide: folders the kernel sees empty (the course, the teacher's notebooks, ...).
         test_calls: each test cell's statement (``check_x(answer).require()``): the seal's only callers of require().
+        checks: the modules the test cells import their checks from: what the seal snapshots.
+        seed: the learner's seed of hidden cases (from the teacher's, ``course/grade.py``).
         memory_bytes: the address space a kernel may have (RLIMIT_AS): past it, a ``MemoryError``.
         processes: processes and threads the job's user may have (RLIMIT_NPROC).
         cpu_seconds: CPU time a kernel may use (RLIMIT_CPU).
@@ -70,6 +72,8 @@ class Job:
     verdicts: str
     hide: list[str]
     test_calls: list[str]
+    checks: list[str] = dataclasses.field(default_factory=list)
+    seed: str = ""
     memory_bytes: int = 4 << 30
     processes: int = 256
     cpu_seconds: int = 600
@@ -106,8 +110,9 @@ def cgroups(job: Job) -> list[Path]:
     return made
 
 
-def sandbox_command(job: Job, kernel: list[str], keep: list[str]) -> list[str]:
-    """``kernel`` wrapped: namespaces, hidden folders, cgroups, the job's user and limits (run as root)."""
+def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[Path] = ()) -> list[str]:
+    """``kernel`` wrapped: namespaces, hidden folders (``keep`` bound back), the cgroups ``groups``, the job's
+    user and limits (run as root)."""
     script = [
         "set -e",
         "ip link set lo up",
@@ -122,7 +127,7 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str]) -> list[str]:
         script += [f"mkdir -p '{path}'", f"mount --move {held}/{k} '{path}'"]
     for path in ("/tmp", "/var/tmp", "/dev/shm"):
         script.append(f"mount -t tmpfs -o mode=1777,size=2g tmpfs {path}")
-    for group in cgroups(job):
+    for group in groups:
         script.append(f"echo $$ > {group}/cgroup.procs")
     script.append('exec "$@"')
     return [
@@ -151,9 +156,13 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str]) -> list[str]:
 
 
 def kept_paths(hide: list[str]) -> list[str]:
-    """What a hidden folder holds that the kernel needs: the Python installation (root's pyenv, say)."""
+    """What a hidden folder holds that the kernel needs: the Python installation (root's pyenv, say), the
+    environment, and the library's own folders of a clone in a home folder (never its notebooks or course)."""
+    repository = Path(__file__).resolve().parents[2]
+    needed = {os.path.realpath(sys.base_prefix), os.path.realpath(sys.prefix)}
+    needed |= {str(repository / p) for p in ("tutorial", "project", "model") if (repository / p).is_dir()}
     keep = []
-    for path in {os.path.realpath(sys.base_prefix), os.path.realpath(sys.prefix)}:
+    for path in needed:
         if any(path.startswith(h.rstrip("/") + "/") for h in hide):
             keep.append(path)
     return sorted(keep)
@@ -192,7 +201,7 @@ class SandboxedKernelManager(AsyncKernelManager):
         kw["env"]["RTT_SEAL_FDS"] = f"{self._key_read},{self._verdict_write}"
         # ipykernel's own launcher's arguments (the connection file, nbgrader's history in memory), sealed first
         kernel = [sys.executable, "-I", "-m", "tutorial.exercises.sealed_kernel", *cmd[cmd.index("-f") :]]
-        return sandbox_command(job, kernel, kept_paths(job.hide)), kw
+        return sandbox_command(job, kernel, kept_paths(job.hide), cgroups(job)), kw
 
     async def _async_launch_kernel(self, kernel_cmd, **kw):
         try:
@@ -201,7 +210,8 @@ class SandboxedKernelManager(AsyncKernelManager):
             os.close(self._key_read)
             os.close(self._verdict_write)
         with os.fdopen(self._key_write, "w") as out:
-            json.dump({"key": self._key.hex(), "test_calls": self._job.test_calls, "hidden": self._job.hide}, out)
+            given = {"key": self._key.hex(), "test_calls": self._job.test_calls, "hidden": self._job.hide}
+            json.dump({**given, "checks": self._job.checks, "seed": self._job.seed}, out)
         reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
         reader.start()
 

@@ -29,9 +29,12 @@ signed verdicts, not from the cell's output:
   grader's; ``course/sandbox.py`` reads and checks it.
 
 What the seal does not stop: code that changes a check's objects *and*
-puts them back within one call from the check (the snapshot is compared
-at the check's start and end), and frames reached through a library
-function that walks the stack for its caller.  The sandbox (``course/sandbox.py``)
+puts them back within one call from the check, or from a thread of its
+own while the check runs (the snapshot is compared at the check's start
+and end), and frames reached through a library function that walks the
+stack (``traceback.walk_stack``), which can read a check's expected values.
+The hook itself never calls an answer's code (no ``str()``, no library
+function an answer could replace), so nothing runs unwatched inside it.  The sandbox (``course/sandbox.py``)
 bounds what such code could reach.  Main thread only: ``install`` runs once,
 before the kernel starts.
 """
@@ -57,31 +60,44 @@ NOT_COMPARED = frozenset(
 )
 
 
-def trusted_modules() -> list[types.ModuleType]:
-    """Every module of the ``tutorial.exercises`` package, imported (with what they import): what checks run."""
+def trusted_modules(checks: list[str] | None = None) -> list[types.ModuleType]:
+    """The check modules ``checks`` (default: every module of ``tutorial.exercises``) and the grader, imported
+    with what they import; then every ``tutorial`` module imported so far: what the checks run."""
     import tutorial.exercises as package
 
-    for info in pkgutil.iter_modules(package.__path__):
-        if info.name not in ("seal", "sealed_kernel"):
-            importlib.import_module(f"tutorial.exercises.{info.name}")
+    if checks is None:
+        checks = [f"tutorial.exercises.{i.name}" for i in pkgutil.iter_modules(package.__path__)]
+    for name in ["tutorial.exercises.grader", *checks]:
+        if name.rsplit(".", 1)[-1] not in ("seal", "sealed_kernel"):
+            importlib.import_module(name)
     return [m for name, m in sorted(sys.modules.items()) if m is not None and name.split(".")[0] == "tutorial"]
 
 
-def install(key: bytes, fd: int, test_calls: list[str], hidden: list[str] = ()) -> None:
+def install(
+    key: bytes,
+    fd: int,
+    test_calls: list[str],
+    hidden: list[str] = (),
+    checks: list[str] | None = None,
+    seed: str = "",
+) -> None:
     """Seal this process: snapshot the teacher's code and add the audit hook that signs verdicts on ``fd``.
 
     ``key``: the HMAC key (the grader's; never stored where Python code can read it); ``fd``: the pipe's
     write end; ``test_calls``: each test cell's last line as nbgrader gives it (``check_x(answer).require()``);
-    ``hidden``: folders the sandbox hides (the course's, ...): an answer opening a path there is noted.
+    ``hidden``: folders the sandbox hides (the course's, ...): an answer opening a path there is noted;
+    ``checks``: the modules the test cells import their checks from (default: all of them); ``seed``: this
+    learner's seed of hidden cases, given only to a teacher's check (``grader.hidden_random``).
 
     Raises:
         RuntimeError: called twice in one process (the second audit hook is refused).
     """
     import _hashlib
+    import _thread
 
     from tutorial.exercises import grader
 
-    modules = trusted_modules()
+    modules = trusted_modules(checks)
     package = os.path.dirname(os.path.dirname(os.path.realpath(grader.__file__)))  # tutorial/
     roots = tuple(os.path.realpath(p) + os.sep for p in {sys.prefix, sys.base_prefix, package})
     repository = os.path.dirname(package)
@@ -91,7 +107,7 @@ def install(key: bytes, fd: int, test_calls: list[str], hidden: list[str] = ()) 
         "__builtins__": dict(builtins.__dict__),
         "types": types,
         "getcwd": os.getcwd,
-        "abspath": os.path.abspath,
+        "get_ident": _thread.get_ident,
         **{name: globals()[name] for name in ("BEGIN", "VERDICT", "NOTE", "NOT_COMPARED", "NOTED")},
         **{name: globals()[name] for name in ("REFUSED_IN_CHECK", "FRAME_ATTRIBUTES")},
     }
@@ -104,6 +120,7 @@ def install(key: bytes, fd: int, test_calls: list[str], hidden: list[str] = ()) 
         roots,
         readable,
         hidden,
+        seed,
         calls,
         grader,
         builtins.__dict__,
@@ -114,7 +131,9 @@ def install(key: bytes, fd: int, test_calls: list[str], hidden: list[str] = ()) 
     sys.addaudithook(hook)
 
 
-def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin_names, hmac_digest, write, getframe):  # noqa: C901
+def _make_hook(
+    key, fd, modules, roots, readable, hidden, seed, calls, grader, builtin_names, hmac_digest, write, getframe
+):  # noqa: C901
     """The audit hook, its state in closures only (made with private globals by :func:`install`)."""
     trusted: dict[int, object] = {}  # id -> object (kept alive, so an id is never reused)
     snapshot: list[tuple] = []  # (where, namespace, name, object): compared by identity
@@ -184,8 +203,9 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
     }
     grade_code, require_code = grader.grade.__code__, grader.Result.require.__code__
     result_type = grader.Result
-    state = {"busy": False, "checks": 0, "refused": [], "results": {}, "number": ""}
+    state = {"checks": 0, "refused": [], "results": {}, "number": ""}
     suspecting = {grader._suspect.__code__}
+    seed_code = grader.hidden_random.__code__
     missing = object()
 
     def changed(check=None):
@@ -222,6 +242,16 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
             return False
         return not name.startswith(roots)
 
+    def absolute(path):
+        """``path`` made absolute and normal here, never by a library function an answer could replace."""
+        parts = []
+        for part in (path if path.startswith("/") else getcwd() + "/" + path).split("/"):  # noqa: F821
+            if part == "..":
+                parts = parts[:-1]
+            elif part and part != ".":
+                parts.append(part)
+        return "/" + "/".join(parts)
+
     def learner_near(frame, depth=6):
         """Whether answer code called this within ``depth`` frames (through IPython's open(), socket.py, ...)."""
         while frame is not None and depth > 0:
@@ -231,7 +261,9 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
         return False
 
     def number_of(exercise):
-        words = str(exercise).split()
+        if type(exercise) is not str:
+            return "?"  # never str() of an answer's own object: its __str__ would run inside the hook
+        words = exercise.split()
         return words[1].rstrip(",") if len(words) > 1 and words[0] == "Exercise" else "?"
 
     def same_call(code):
@@ -249,24 +281,30 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
         send(NOTE, "refused", what, here())
         raise RuntimeError(f"the grader's sandbox refused: {what}")
 
+    busy = set()  # the threads inside the hook: what it does itself raises events, which it lets pass
+
     def hook(event, args):
-        if state["busy"]:
-            return
         if not (event.startswith("rtt.") or event in WATCHED or event.startswith("ctypes.")):
             return
-        state["busy"] = True
+        me = get_ident()  # noqa: F821 - a private global
+        if me in busy:
+            return
+        busy.add(me)
         try:
             act(event, args)
         finally:
-            state["busy"] = False
+            busy.discard(me)
 
     def act(event, args):  # noqa: C901 - one branch per event
-        caller = getframe(2)  # 0: act, 1: hook, 2: the code that raised the event
+        try:
+            caller = getframe(2)  # 0: act, 1: hook, 2: the code that raised the event
+        except ValueError:
+            return  # raised from no Python code at all: nobody's answer
         if event == "rtt.check_begin":
             if caller.f_code is grade_code:
                 state["checks"] += 1
                 state["refused"] = []
-                state["number"] = number_of(args[0]) if type(args[0]) is str else "?"
+                state["number"] = number_of(args[0])
                 outer = caller.f_back
                 state["begin_changes"] = changed(id(outer.f_code) if outer is not None else None)
                 send(BEGIN, number_of(args[0]))
@@ -297,6 +335,11 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
                 reasons.append("require() was not called by the test cell's statement")
             reasons = list(dict.fromkeys(reasons))
             send(VERDICT, number, int(passed), int(not reasons), "; ".join(reasons[:3]))
+        elif event == "rtt.seed":
+            outer = caller.f_back
+            if seed and caller.f_code is seed_code and outer is not None and id(outer.f_code) in check_codes:
+                if type(args[0]) is list:
+                    args[0].append(seed)
         elif event == "rtt.suspect":
             if caller.f_code in suspecting:
                 send(NOTE, "tampering", f"an answer returned {args[0]}", here())
@@ -306,14 +349,14 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
             if id(args[0]) in trusted:
                 refuse(f"changing {getattr(args[0], '__qualname__', '?')}.{args[1]}")
         elif event in ("compile", "code.__new__"):
-            filename = str(args[1])
+            filename = args[1] if type(args[1]) is str else ""
             if learner(caller) and (filename.startswith(roots) or filename.startswith("<frozen")):
                 refuse(f"code claiming to be the library's ({filename})")
         elif event == "open":
             path = args[0]
             if type(path) is not str:
                 return  # a file descriptor, or bytes: not an answer's way to a path here
-            path = abspath(path)  # noqa: F821 - a private global
+            path = absolute(path)
             if "/proc/" in path and path.endswith("/mem"):
                 refuse(f"opening {path}")
             allowed = ALLOWED + roots + readable + (getcwd() + "/",)  # noqa: F821 - a private global
@@ -326,9 +369,11 @@ def _make_hook(key, fd, modules, roots, readable, hidden, calls, grader, builtin
             if learner_near(caller):
                 send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
         elif state["checks"] > 0:
-            if event in REFUSED_IN_CHECK:
+            if event in REFUSED_IN_CHECK and learner_near(caller, 3):
                 refuse(f"{event} during a check")
-            elif event == "sys._getframe" and (learner(args[0]) or learner(caller)):
+            elif event == "sys._getframe" and (
+                learner(caller) or (learner(args[0]) and caller.f_back is not None and learner(caller.f_back))
+            ):  # the answer's own call, or a library function's it called directly (inspect.currentframe())
                 refuse("reading frames during a check")
             elif event == "object.__getattr__" and args[1] in FRAME_ATTRIBUTES and learner(caller):
                 refuse(f"reading {args[1]} during a check")

@@ -1,10 +1,11 @@
 """``python -I -m tutorial.exercises.sealed_kernel -f CONNECTION_FILE``: an IPython kernel, sealed before it starts.
 
 :class:`tutorial.exercises.sandbox.SandboxedKernelManager` starts it with
-``RTT_SEAL_FDS=R,W``: the grader writes the seal's key and the test cells'
-statements (JSON) to ``R`` and reads the signed verdicts from ``W``.  ``-I``
-keeps the submission's folder off ``sys.path`` while the teacher's modules
-are imported (a ``tutorial/`` folder there would otherwise shadow them).
+``RTT_SEAL_FDS=R,W``: the grader writes to ``R`` (JSON) the seal's key, the
+test cells' statements, the folders it hides, the check modules and the
+learner's seed of hidden cases, and reads the signed verdicts from ``W``.
+``-I`` keeps the submission's folder off ``sys.path`` while the teacher's
+modules are imported (a ``tutorial/`` folder there would otherwise shadow them).
 """
 
 import json
@@ -17,7 +18,9 @@ def main() -> None:
     key_fd, verdict_fd = (int(fd) for fd in os.environ.pop("RTT_SEAL_FDS").split(","))
     with os.fdopen(key_fd, "rb") as pipe:
         given = json.loads(pipe.read())
-    seal.install(bytes.fromhex(given["key"]), verdict_fd, given["test_calls"], given["hidden"])
+    seal.install(
+        bytes.fromhex(given["key"]), verdict_fd, given["test_calls"], given["hidden"], given["checks"], given["seed"]
+    )
     del given
     from ipykernel.kernelapp import launch_new_instance
 

@@ -7,9 +7,20 @@ Exercise 1.2, count the shots: a ``RttTankController`` subclass whose
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_numbers, grade, same_numbers, same_value, show
+from tutorial.exercises.grader import (
+    Case,
+    CaseFailed,
+    Result,
+    expect_numbers,
+    grade,
+    hidden_random,
+    same_numbers,
+    same_value,
+    show,
+)
 from tutorial.interfaces import joy
 
 DPAD_SPEED = 1.0  # m/s of both tracks for D-pad up
@@ -74,11 +85,32 @@ def check_dpad_steering(func) -> Result:
         ("left stick up, D-pad released", _axes(lv=1.0), (0.0, 0.0), "only axes 4 and 5 count here."),
     ]
 
-    def case(label, axes, expected, hint):
-        call = f"dpad_track_velocities({show(axes)}) ({label})"
-        return Case(call, lambda: expect_numbers(call, func(list(axes)), expected, hint=hint), hint)
+    def case(label, axes, expected, hint, hidden=False):
+        call = label if hidden else f"dpad_track_velocities({show(axes)}) ({label})"
+        return Case(call, lambda: expect_numbers(call, func(list(axes)), expected, hint=hint), hint, hidden)
 
-    return grade("Exercise 1.1, steer with the D-pad", [case(*row) for row in table])
+    cases = [case(*row) for row in table]
+    rng = hidden_random("1.1")  # while grading: this learner's own cases, drawn by the same rules
+    for _ in range(24 if rng else 0):
+        axes = [rng.uniform(-1.0, 1.0) for _ in range(joy.NUM_AXES)]  # every stick moved
+        dh, dv = rng.choice((-1.0, 0.0, 1.0)), rng.choice((-1.0, 0.0, 1.0))
+        axes[joy.DPAD_H], axes[joy.DPAD_V] = dh, dv
+        label, expected = "a D-pad direction (or none) with the sticks moved", _dpad(dh, dv)
+        if rng.random() < 0.25:  # a non-finite D-pad axis counts as 0
+            bad = rng.choice((joy.DPAD_H, joy.DPAD_V))
+            axes[bad] = rng.choice((math.nan, math.inf, -math.inf))
+            label = "a D-pad axis NaN or infinite, the other pressed"
+            expected = _dpad(0.0 if bad == joy.DPAD_H else dh, 0.0 if bad == joy.DPAD_V else dv)
+        elif rng.random() < 0.2:  # a message too short for the D-pad's axes
+            axes = axes[: rng.randrange(0, joy.DPAD_H + 1)]
+            label, expected = "a Joy too short for the D-pad's axes", (0.0, 0.0)
+        cases.append(case(label, axes, expected, "follow each rule of the statement, for every input.", True))
+    return grade("Exercise 1.1, steer with the D-pad", cases)
+
+
+def _dpad(dh: float, dv: float) -> tuple[float, float]:
+    """The statement's rules: (left, right) in m/s for D-pad axes ``dh`` (left +1) and ``dv`` (up +1)."""
+    return DPAD_SPEED * dv - DPAD_TURN * dh, DPAD_SPEED * dv + DPAD_TURN * dh
 
 
 def _joy(buttons, axes=None) -> SimpleNamespace:
@@ -128,8 +160,8 @@ def check_shot_counter(cls) -> Result:
         ("only B pressed", [B, B, NONE, B], 0, "A is button 0 (joy.BUTTON_A); B is button 1."),
     ]
 
-    def count(label, presses, expected, hint):
-        call = f"{cls.__name__}().on_joy() with buttons {_runs(presses)} ({label})"
+    def count(label, presses, expected, hint, hidden=False):
+        call = label if hidden else f"{cls.__name__}().on_joy() with buttons {_runs(presses)} ({label})"
 
         def run():
             controller = cls()
@@ -139,7 +171,7 @@ def check_shot_counter(cls) -> Result:
             if not same_value(shots, expected):
                 raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.", hint)
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden)
 
     def still_drives():
         controller = cls()
@@ -182,9 +214,26 @@ def check_shot_counter(cls) -> Result:
             )
 
     cases = [count(*row) for row in sequences]
+    rng = hidden_random("1.2")  # while grading: this learner's own sequences, counted by the statement's rule
+    for _ in range(12 if rng else 0):
+        presses = [rng.choice((A, A, B, NONE, NONE, A[:1], [], [1, 1] + NONE[2:])) for _ in range(rng.randrange(3, 40))]
+        label = "a long random sequence of A, B, both, released and short Joys"
+        cases.append(
+            count(label, presses, _shots(presses), "a press is each change of A from released to pressed.", True)
+        )
     cases.append(Case(f"{cls.__name__}: on_joy(a Joy with the left stick up)", still_drives))
     cases.append(Case(f"{cls.__name__}: what on_joy() remembers, under self._lock", under_the_lock))
     return grade("Exercise 1.2, count the shots", cases)
+
+
+def _shots(presses) -> int:
+    """The statement's rule: changes of button A from released to pressed (a too short Joy reads released)."""
+    shots, down = 0, False
+    for buttons in presses:
+        now = len(buttons) > joy.BUTTON_A and buttons[joy.BUTTON_A] == 1
+        shots += now and not down
+        down = now
+    return shots
 
 
 class _WatchedLock:

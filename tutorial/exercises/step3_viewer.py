@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, same_numbers, same_value, show
 
 TANK = ["TURRET_Y", "TURRET_P"]
 
@@ -101,28 +101,72 @@ def check_own_matcher(func) -> Result:
         "(collections.Counter), do not pair them off.",
     }
 
-    def case(label, joints, names, positions):
-        call = f"my_match({'crane' if joints is crane else 'tank'} joints, {show(names)}, {show(positions)}) ({label})"
+    def case(label, joints, names, positions, hidden=False):
+        who = "crane" if joints is crane else "tank"
+        call = label if hidden else f"my_match({who} joints, {show(names)}, {show(positions)}) ({label})"
+        hint = "follow each rule of the statement, for every message." if hidden else hints.get(label, "")
 
         def run():
             expected = match_joint_state(joints, names, positions).applied
             got = func(joints, list(names), list(positions))
-            if (
-                not isinstance(got, dict)
-                or set(got) != set(expected)
-                or any(not _same(got[k], expected[k]) for k in expected)
-            ):
-                raise CaseFailed(
-                    f"{call} returned {_show_dict(got)}, expected {_show_dict(expected)}.", hints.get(label, "")
+            if not _same_applied(got, expected):
+                raise CaseFailed(f"{call} returned {_show_dict(got)}, expected {_show_dict(expected)}.", hint)
+
+        return Case(call, run, hint, hidden)
+
+    cases = [case(*row) for row in rows]
+    rng = hidden_random("3.2")  # while grading: this learner's own messages, judged by the library's matcher
+    for _ in range(30 if rng else 0):
+        joints = rng.choice((tank, crane))
+        names, positions = _random_message(rng, joints)
+        cases.append(
+            case(
+                "a random message: names known, unknown and repeated, values in, near and out of range",
+                joints,
+                names,
+                positions,
+                True,
+            )
+        )
+    return grade("Exercise 3.2, your own joint matcher", cases)
+
+
+def _random_message(rng, joints) -> tuple[list[str], list[float]]:
+    """A message for ``joints`` by the statement's rules: any order, unknown and repeated names, values in
+    range, within and past the tolerance, non-finite; sometimes a position or a name short."""
+    names, positions = [], []
+    for _ in range(rng.randrange(0, 6)):
+        info = rng.choice(joints)
+        names.append(rng.choice([info.name] * 4 + ["GUN", "TURRET_Y", "SLEW"]))
+        low, high = (info.lower, info.upper) if info.limited else (-10.0, 10.0)
+        tolerance = 0.01 if info.kind == "slide" else 0.05
+        positions.append(
+            rng.choice(
+                (
+                    rng.uniform(low, high),
+                    high + rng.uniform(0.0, 0.9) * tolerance,
+                    low - rng.uniform(1.1, 3.0) * tolerance,
+                    rng.choice((math.nan, math.inf, -math.inf, 1e300)),
                 )
+            )
+        )
+    if names and rng.random() < 0.2:
+        (positions if rng.random() < 0.5 else names).pop()
+    return names, positions
 
-        return Case(call, run, hints.get(label, ""))
 
-    return grade("Exercise 3.2, your own joint matcher", [case(*row) for row in rows])
+def _same_applied(got, expected: dict) -> bool:
+    """``got`` is a dict of exactly ``expected``'s names (str), each value the same number (exact types)."""
+    if type(got) is not dict or len(got) != len(expected) or not all(type(k) is str for k in got):
+        return False
+    return all(k in got and same_numbers(got[k], v, 1e-12) for k, v in expected.items())
 
 
-def _same(a, b) -> bool:
-    return isinstance(a, (int, float)) and not isinstance(a, bool) and math.isfinite(a) and abs(a - b) <= 1e-12
+def _same_counts(got, expected: dict) -> bool:
+    """``got`` is a dict of exactly ``expected``'s reasons (str), each the same count (exact types)."""
+    if type(got) is not dict or len(got) != len(expected) or not all(type(k) is str for k in got):
+        return False
+    return all(k in got and same_value(got[k], v) for k, v in expected.items())
 
 
 def _show_dict(d) -> str:
@@ -149,12 +193,12 @@ def check_wrong_model(cls) -> Result:
         msg.name, msg.position = list(names), [float(p) for p in positions]
         return msg
 
-    def run_messages(messages):
-        """Configure a fresh controller on a fresh tank, apply each message on this thread."""
+    def run_messages(messages, kind=cls):
+        """Configure a fresh controller (``kind``) on a fresh tank, apply each message on this thread."""
         body = _tank()
         node = rclpy.create_node("exercise_check_wrong_model")
         try:
-            controller = cls()
+            controller = kind()
             config = ControllerConfig(name="Strict", body=body, node=node)
             if not controller.configure(config):
                 raise CaseFailed(
@@ -169,14 +213,15 @@ def check_wrong_model(cls) -> Result:
             node.destroy_node()
         return body, summary
 
-    def expect(label, messages, applied, rejected, positions, hint=""):
+    def expect(label, messages, applied, rejected, positions, hint="", hidden=False):
         sent = "; ".join(f"{show(list(m.name))} {show(list(m.position))}" for m in messages)
-        call = f"{cls.__name__}.update_joint_state() for {sent} ({label})"
+        call = label if hidden else f"{cls.__name__}.update_joint_state() for {sent} ({label})"
 
         def run():
             body, summary = run_messages(messages)
             got = {k: round(v, 9) for k, v in body.joint_positions().items()}
-            if summary.get("applied") != applied or summary.get("rejected") != rejected:
+            summary = summary if type(summary) is dict else {}
+            if not (same_value(summary.get("applied"), applied) and _same_counts(summary.get("rejected"), rejected)):
                 raise CaseFailed(
                     f"{call} gave applied={summary.get('applied')!r}, rejected={summary.get('rejected')!r}"
                     f"; expected applied={applied}, rejected={rejected}.",
@@ -185,9 +230,37 @@ def check_wrong_model(cls) -> Result:
             if got != positions:
                 raise CaseFailed(f"{call} left the tank at {got}, expected {positions}.", hint)
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden)
+
+    def hidden_cases(rng):
+        """Random runs of messages, the tank's, the crane's and mixed ones, judged by the lesson's subscriber
+        (what it applies and counts) plus the statement's rule (another model's message is refused whole)."""
+        from tutorial.controllers.joint_state_subscriber import RttJointStateSubscriber
+
+        for _ in range(8):
+            messages = []
+            for _ in range(rng.randrange(1, 5)):
+                pool = rng.choice((["TURRET_Y", "TURRET_P"], ["SLEW", "LUFF", "TROLLEY"], ["TURRET_P", "GUN"]))
+                names = [rng.choice(pool) for _ in range(rng.randrange(0, 4))]
+                names = list(dict.fromkeys(names))  # each name once: the matcher's rules are 3.2's
+                messages.append(message(names, [rng.choice((rng.uniform(-0.1, 0.7), math.nan)) for _ in names]))
+            ours = [m for m in messages if m.name and all(n in TANK for n in m.name)]
+            refused = len(messages) - len(ours)
+            body, summary = run_messages(ours, RttJointStateSubscriber)
+            rejected = dict(summary["rejected"], **({"wrong_model": refused} if refused else {}))
+            positions = {k: round(v, 9) for k, v in body.joint_positions().items()}
+            yield expect(
+                "a random run of the tank's, the crane's and mixed messages",
+                messages,
+                summary["applied"],
+                dict(sorted(rejected.items())),
+                positions,
+                "follow each rule of the statement, for every message, in order.",
+                True,
+            )
 
     zero = {"TURRET_Y": 0.0, "TURRET_P": 0.0}
+    rng = hidden_random("3.1")  # while grading: this learner's own runs of messages
     return grade(
         "Exercise 3.1, refuse another model's message",
         [
@@ -265,5 +338,6 @@ def check_wrong_model(cls) -> Result:
                 {"TURRET_Y": 0.4, "TURRET_P": 0.1},
                 "after refusing one message, the next good one is applied.",
             ),
+            *(hidden_cases(rng) if rng else ()),
         ],
     )

@@ -37,13 +37,16 @@ def init_ros() -> None:
     """Initialise rclpy once per kernel, without its signal handlers (kernel thread).
 
     rclpy would otherwise take over SIGINT and shut ROS down when you press
-    the notebook's "interrupt" button.  Calling it again does nothing.
+    the notebook's "interrupt" button.  Calling it again does nothing.  On a class's hub it warns (stderr)
+    when ``ROS_DOMAIN_ID`` is not the learner's own domain (:func:`tutorial.ros.env.assigned_domain_warning`).
     """
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
     ros_env.use_localhost_by_default()
     if not rclpy.ok():
+        # a domain set by hand since the kernel started (a learner's shutdown() and init again) is said here
+        ros_env.warn_if_not_assigned_domain()
         rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
 
 

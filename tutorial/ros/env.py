@@ -162,7 +162,8 @@ def assigned_domain_warning(environ: Mapping[str, str] | None = None) -> str | N
 
 
 def warn_if_not_assigned_domain() -> None:
-    """At import: print :func:`assigned_domain_warning`'s warning, if any, once (main thread)."""
+    """Print :func:`assigned_domain_warning`'s warning, if any (at import, and before rclpy starts in a
+    notebook: :func:`tutorial.notebook.session.init_ros`; main thread)."""
     message = assigned_domain_warning()
     if message:
         print(f"rtt: WARNING: {message}", file=sys.stderr, flush=True)
