@@ -131,10 +131,7 @@ def grade(
 def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: list[int], boxes) -> Path:
     failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
     flagged: list[str] = []
-    private = [course / p for p in ("source", "submitted", "autograded", "feedback", "gradebook.db")]
-    for path in private:  # the teacher's alone (a learner's server, or a sandbox, never reads them)
-        if path.exists():
-            os.chmod(path, 0o700 if path.is_dir() else 0o600)
+    keep_private(course)
     for assignment in assignments:
         if collect:
             nbgrader(course, "collect", assignment, "--update")
@@ -192,11 +189,24 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
     given = sorted(set(assignments) | set(released(course) if collect else ()))
     nbgrader(course, "export", "--to", str(csv), *(f"--assignment={name}" for name in given))
     flagged.extend(add_flags_column(course, csv))
+    keep_private(course)  # what grading made, too (autograded/, feedback/, grades.csv)
     if flagged:
         print(f"{len(flagged)} flagged submission(s) (the flags column of {csv.name}):", *flagged, sep="\n  ")
     if failed:
         raise GradingError(csv, failed)
     return csv
+
+
+def keep_private(course: Path) -> None:
+    """The course's folders and files of solutions, submissions and grades: the teacher's alone (0700, 0600).
+
+    A learner's server on the same machine, or a graded kernel, never reads them; the exchange and the
+    release, which learners read, are left as they are.
+    """
+    for name in ("source", "submitted", "autograded", "feedback", "gradebook.db", "grades.csv", "flags.json"):
+        path = course / name
+        if path.exists():
+            os.chmod(path, 0o700 if path.is_dir() else 0o600)
 
 
 class GradingError(RuntimeError):
