@@ -46,6 +46,7 @@ from sandboxing import (  # noqa: E402
     add_flags_column,
     apply,
     clear,
+    course_seed,
     judge,
     learner_seed,
     record_flags,
@@ -132,6 +133,8 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
     failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
     flagged: list[str] = []
     keep_private(course)
+    if boxes:
+        course_seed(course)  # made once, before the worker threads read it
     for assignment in assignments:
         if collect:
             nbgrader(course, "collect", assignment, "--update")

@@ -25,6 +25,7 @@ the check), and ``make grade``'s summary.  Runs in the grader's process, as root
 
 from __future__ import annotations
 
+import ast
 import contextlib
 import csv
 import hmac
@@ -35,6 +36,7 @@ import re
 import secrets
 import shutil
 import subprocess
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -59,6 +61,13 @@ class Sandboxes:
     users: list[Job] = field(default_factory=list)
 
     def __enter__(self) -> Sandboxes:
+        try:
+            return self._make()
+        except BaseException:
+            self.close()  # the users made so far, and the folder
+            raise
+
+    def _make(self) -> Sandboxes:
         if os.geteuid() != 0 or not shutil.which("unshare") or not shutil.which("setpriv"):
             raise SandboxError(
                 "grading runs each submission as a user of its own, in a namespace of its own: "
@@ -67,9 +76,13 @@ class Sandboxes:
             )
         JOBS.mkdir(parents=True, exist_ok=True)
         os.chmod(JOBS, 0o711)
+        remove_stale_users()
         self.folder = JOBS / secrets.token_hex(4)
         self.folder.mkdir(mode=0o711)
-        hide = sorted({str(self.course), *(str(ROOT / f) for f in TEACHERS_ONLY), "/home", "/root", "/srv"})
+        hide = {str(self.course), *(str(ROOT / f) for f in TEACHERS_ONLY), "/home", "/root", "/srv"}
+        if os.environ.get("RTT_NBGRADER_EXCHANGE"):  # the learners' exchange, wherever the course keeps it
+            hide.add(os.environ["RTT_NBGRADER_EXCHANGE"])
+        hide = sorted(hide)
         for k in range(self.jobs):
             name = f"rttgrade{self.folder.name[:5]}{k}"
             subprocess.run(
@@ -100,9 +113,22 @@ class Sandboxes:
         shutil.rmtree(getattr(self, "folder", JOBS / "none"), ignore_errors=True)
 
 
+def remove_stale_users() -> None:
+    """Grading users whose run is gone (a grading killed before it removed them): removed, with their processes."""
+    alive = {p.name[:5] for p in JOBS.iterdir()} if JOBS.is_dir() else set()
+    for entry in pwd.getpwall():
+        name = entry.pw_name
+        if name.startswith("rttgrade") and name[8:13] not in alive:
+            subprocess.run(["pkill", "-KILL", "-u", name], capture_output=True, timeout=30, check=False)
+            subprocess.run(["userdel", name], capture_output=True, timeout=30, check=False)
+
+
 def clear(job: Job) -> None:
     """Everything the job's user still runs, killed (a fork bomb's children, say); its kernels' folders removed."""
-    subprocess.run(["pkill", "-KILL", "-u", job.user], capture_output=True, timeout=30, check=False)
+    for _ in range(5):  # a fork bomb may fork between two passes; pgrep answers 1 once nothing is left
+        subprocess.run(["pkill", "-KILL", "-u", job.user], capture_output=True, timeout=30, check=False)
+        if subprocess.run(["pgrep", "-u", job.user], capture_output=True, timeout=30).returncode == 1:
+            break
     for group in (Path("/sys/fs/cgroup") / c / f"rtt-grade-{job.user}" for c in ("memory", "pids")):
         with contextlib.suppress(OSError):
             for pid in (group / "cgroup.procs").read_text().split():
@@ -115,25 +141,36 @@ def clear(job: Job) -> None:
 
 def test_calls(course: Path, assignment: str) -> tuple[list[str], list[str]]:
     """The statement each test cell of ``assignment`` ends with (``check_x(answer).require()``), and the modules
-    they import their checks from, from the assignment's source."""
+    they import their checks from, from the assignment's source (parsed: comments and layout do not count).
+
+    Raises:
+        SyntaxError: a test cell of the source is not Python.
+    """
     notebook = json.loads((course / "source" / assignment / f"{assignment}.ipynb").read_text())
     calls, modules = [], []
     for cell in notebook["cells"]:
         if cell["metadata"].get("nbgrader", {}).get("grade"):
-            text = "".join(cell["source"])
-            calls.append([line for line in text.splitlines() if line.strip()][-1].strip())
-            modules += re.findall(r"^from (tutorial\.exercises\.\w+) import", text, re.M)
-    return calls, sorted(set(modules))
+            tree = ast.parse("".join(cell["source"]))
+            calls.append(ast.unparse(tree.body[-1]))
+            modules += [n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module]
+    return calls, sorted({m for m in modules if m.startswith("tutorial.exercises.")})
+
+
+def course_seed(course: Path) -> bytes:
+    """The course's own seed of hidden cases, ``.grading_seed`` (made once, 0600 from the start: the teacher's
+    alone).  Call it before grading's threads start: two makers at once would draw two seeds."""
+    path = course / ".grading_seed"
+    with contextlib.suppress(FileExistsError):
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as out:
+            out.write(secrets.token_hex(16) + "\n")
+    return path.read_text().strip().encode()
 
 
 def learner_seed(course: Path, assignment: str, learner: str) -> str:
-    """The seed of ``learner``'s hidden cases of ``assignment``: drawn from the course's own seed (made once,
-    in ``.grading_seed``, the teacher's alone), so a regrade draws the same cases and another learner others."""
-    path = course / ".grading_seed"
-    if not path.is_file():
-        path.write_text(secrets.token_hex(16) + "\n")
-        os.chmod(path, 0o600)
-    key = path.read_text().strip().encode()
+    """The seed of ``learner``'s hidden cases of ``assignment``, from :func:`course_seed`: a regrade draws
+    the same cases, another learner others."""
+    key = course_seed(course)
     return hmac.new(key, f"{assignment}/{learner}".encode(), "sha256").hexdigest()[:16]
 
 
@@ -234,8 +271,19 @@ def say_in_feedback(autograded: Path, judged: dict[str, tuple[bool, list[str]]])
     autograded.write_text(json.dumps(notebook))
 
 
+_FLAGS_LOCK = threading.Lock()  # grading's worker threads each record their learners' flags in one file
+
+
 def record_flags(course: Path, assignment: str, learner: str, judged: dict[str, tuple[bool, list[str]]]) -> None:
-    """``flags.json`` in the course: each (assignment, learner)'s flags, as ``1.1: tampering; 1.2: timeout``."""
+    """``flags.json`` in the course: each (assignment, learner)'s flags, as ``1.1: tampering; 1.2: timeout``.
+
+    Any thread (the file is read, changed and written under a lock).
+    """
+    with _FLAGS_LOCK:
+        _record_flags(course, assignment, learner, judged)
+
+
+def _record_flags(course: Path, assignment: str, learner: str, judged: dict[str, tuple[bool, list[str]]]) -> None:
     path = course / "flags.json"
     kept = json.loads(path.read_text()) if path.is_file() else {}
     kept[f"{assignment}/{learner}"] = "; ".join(f"{ex}: {', '.join(f)}" for ex, (_, f) in sorted(judged.items()) if f)

@@ -393,6 +393,20 @@ CHEATS = {
         "over a limit",
     ),
     "endless": ("1.1", "while True:\n    pass\n", "timeout"),
+    "memory-through-a-link": (  # the seal's key is in the kernel's memory
+        "1.1",
+        "import os\ntry:\n    os.symlink('/proc/self/mem', 'memory')\n    open('memory', 'rb').read(1)\n"
+        "except Exception:\n    pass\n" + STUB_1_1,
+        "tampering",
+    ),
+    "memory-from-a-child": (  # a process the seal does not watch: the kernel is not dumpable
+        "1.1",
+        "import subprocess, sys\n"
+        "said = subprocess.run([sys.executable, '-c', 'import os; open(f\"/proc/{os.getppid()}/mem\", \"rb\")'],\n"
+        "                      capture_output=True, text=True)\n"
+        "print('the kernel memory refused to a child:', 'Permission denied' in said.stderr)\n" + STUB_1_1,
+        "processes",
+    ),
     # not cheats: answers written for the visible cases alone, which the hidden cases fail (no flag)
     "visible-only-1.1": (
         "1.1",
@@ -484,6 +498,9 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
             wrong.append(f"{cheat}: flags {row['flags']!r}, expected {flag!r} on {target}")
         if flags.get(other):
             wrong.append(f"{cheat}: the honest exercise {other} was flagged {flags[other]!r}")
+    if "memory-from-a-child" in which:  # the child really was refused (not merely failing otherwise)
+        graded = course / "autograded" / "cheat-memory-from-a-child" / name / f"{name}.ipynb"
+        assert "the kernel memory refused to a child: True" in graded.read_text()
     assert not wrong, "\n".join(wrong)
     assert (course / "gradebook.db").read_bytes() != gradebook_before  # the grader wrote it, nobody else could
     feedback = (course / "feedback" / f"cheat-{which[0]}" / name / f"{name}.html").read_text()

@@ -108,9 +108,83 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
     assert not any(p.endswith(("notebooks", "course", "book")) for p in kept), kept
     job = Job("u", 1234, 1234, "/var/lib/rtt-grading/x/u", "/v", [str(root / "course")], ["c(a).require()"])
     command = sandbox_command(job, ["python", "-m", "k"], kept)
-    assert command[:4] == ["unshare", "--mount", "--net", "--"], command
+    assert command[:5] == ["unshare", "--mount", "--net", "--ipc", "--"], command
     assert "--no-new-privs" in command and "--reuid=1234" in command and command[-3:] == ["python", "-m", "k"]
     assert f"--as={4 << 30}" in command and "--nproc=256" in command and "--cpu=600" in command
-    script = command[6]
-    assert f"mount -t tmpfs -o mode=755,size=1m tmpfs '{root / 'course'}'" in script, script
+    script = command[7]
+    assert f"mount -t tmpfs -o mode=755,size=1m tmpfs {root / 'course'}" in script, script
     assert "ip link set lo up" in script and "mount -t tmpfs -o mode=1777,size=2g tmpfs /dev/shm" in script
+
+
+ATTACKS = textwrap.dedent(
+    """
+    import gc, os, sys, types
+    from tutorial.exercises import seal
+    seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+    import tutorial.exercises.grader as g
+    import tutorial.exercises.step1_tank_controller as s
+
+    def cell(text):
+        exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
+
+    def said(what, run):
+        try:
+            run()
+            print(what, "allowed", file=sys.stderr)
+        except RuntimeError as e:
+            print(what, "refused" if "sandbox refused" in str(e) else e, file=sys.stderr)
+            return e
+
+    def dpad_track_velocities(axes):
+        return 0.0, 0.0  # wrong
+
+    # 1. the teacher's code in functions of the answer's own, with globals of its own, swapped in by sys.modules
+    fake_grade = types.FunctionType(g.grade.__code__, dict(vars(g), _run_cases=lambda e, c: g.Result(e, True, "ok")))
+    fake_check = types.FunctionType(s.check_dpad_steering.__code__, dict(vars(s), grade=fake_grade))
+    fake = types.ModuleType(s.__name__)
+    vars(fake).update(vars(s))
+    fake.check_dpad_steering = fake_check
+    sys.modules[s.__name__] = fake
+    cell("from tutorial.exercises.step1_tank_controller import check_dpad_steering")
+    cell("check_dpad_steering(dpad_track_velocities).require()")
+    sys.modules[s.__name__] = s
+    # 2. the garbage collector's object lists, outside a check
+    said("gc", lambda: exec(compile("gc.get_objects()", "/tmp/ipykernel_0/cell.py", "exec")))
+    # 3. an answer's object given to the hook, to run inside it
+    class Evil:
+        def __str__(self):
+            print("EVIL RAN", file=sys.stderr)
+            return "x"
+        __format__ = __repr__ = lambda self, *a: self.__str__()
+        def __hash__(self):
+            print("EVIL RAN", file=sys.stderr)
+            return 1
+    said("evil", lambda: sys.audit("object.__setattr__", g.Result, Evil(), None))
+    sys.audit("object.__getattr__", Evil(), Evil())
+    sys.audit("rtt.suspect", Evil())
+    # 4. a second hook (CPython drops it silently when a hook refuses), and a refusal's traceback, to the
+    # hook's own frames
+    sys.addaudithook(lambda event, args: print("SECOND HOOK", file=sys.stderr))
+    open(os.devnull).close()
+    error = said("hook", lambda: exec(compile("gc.get_referrers(g)", "/tmp/ipykernel_0/cell.py", "exec")))
+    def walk():
+        tb = error.__traceback__
+        while tb is not None:
+            tb.tb_frame
+            tb = tb.tb_next
+    said("traceback", walk)
+    # 5. a tracer, which would see the hook's frames
+    said("settrace", lambda: sys.settrace(lambda *a: None))
+    """
+)
+
+
+def test_the_seal_withstands_the_attacks_a_review_found():
+    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    done = subprocess.run([sys.executable, "-c", ATTACKS], capture_output=True, text=True, timeout=120, env=env)
+    assert done.returncode == 0, done.stderr
+    verdicts = [line for line in signed_lines(done.stdout) if line[0] == "verdict"]
+    assert all(v[2:4] != ["1", "1"] for v in verdicts), verdicts  # no signed pass for the wrong answer
+    for what in ("gc", "evil", "hook", "traceback", "settrace"):
+        assert f"{what} refused" in done.stderr, (what, done.stderr)
+    assert "EVIL RAN" not in done.stderr and "SECOND HOOK" not in done.stderr, done.stderr

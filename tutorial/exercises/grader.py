@@ -120,6 +120,7 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
         sys.audit("rtt.result", result)
         return result
     finally:
+        sys.audit("rtt.check_end", exercise)  # also when a cell's timeout interrupted the check
         logger.removeHandler(quiet)
         logger.propagate = propagate
 

@@ -30,11 +30,13 @@ nbgrader's process, on its event loop's thread; its pipe reader on a thread of i
 
 from __future__ import annotations
 
+import asyncio
 import dataclasses
 import hmac
 import json
 import os
 import secrets
+import shlex
 import shutil
 import sys
 import threading
@@ -118,22 +120,24 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[P
         "ip link set lo up",
         "mount --make-rprivate /",
     ]
+    q = shlex.quote
     held = Path(job.folder) / ".keep"
     for k, path in enumerate(keep):
-        script += [f"mkdir -p {held}/{k}", f"mount --bind '{path}' {held}/{k}"]
+        script += [f"mkdir -p {q(f'{held}/{k}')}", f"mount --bind {q(path)} {q(f'{held}/{k}')}"]
     for path in job.hide:
-        script.append(f"[ -d '{path}' ] && mount -t tmpfs -o mode=755,size=1m tmpfs '{path}' || true")
+        script.append(f"if [ -d {q(path)} ]; then mount -t tmpfs -o mode=755,size=1m tmpfs {q(path)}; fi")
     for k, path in enumerate(keep):
-        script += [f"mkdir -p '{path}'", f"mount --move {held}/{k} '{path}'"]
+        script += [f"mkdir -p {q(path)}", f"mount --move {q(f'{held}/{k}')} {q(path)}"]
     for path in ("/tmp", "/var/tmp", "/dev/shm"):
         script.append(f"mount -t tmpfs -o mode=1777,size=2g tmpfs {path}")
     for group in groups:
-        script.append(f"echo $$ > {group}/cgroup.procs")
+        script.append(f"echo $$ > {q(str(group / 'cgroup.procs'))}")
     script.append('exec "$@"')
     return [
         "unshare",
         "--mount",
         "--net",
+        "--ipc",
         "--",
         "/bin/sh",
         "-c",
@@ -179,12 +183,11 @@ class SandboxedKernelManager(AsyncKernelManager):
         here = Path(job.folder) / secrets.token_hex(6)
         work, ipc = here / "work", here / "ipc"
         source = Path(kw.get("cwd") or os.getcwd())
-        shutil.copytree(source, work, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
+        # links copied as links (root must not follow a submission's link), then given to the job's user
+        shutil.copytree(source, work, symlinks=True, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
         ipc.mkdir()
-        for path in (here, work, ipc):
-            os.chown(path, job.uid, job.gid)
-        for path in work.rglob("*"):
-            os.chown(path, job.uid, job.gid)
+        for path in (here, work, ipc, *work.rglob("*")):
+            os.lchown(path, job.uid, job.gid)
         os.chmod(here, 0o700)
         self.transport = "ipc"
         self.ip = str(ipc / "kernel")
@@ -212,19 +215,32 @@ class SandboxedKernelManager(AsyncKernelManager):
         with os.fdopen(self._key_write, "w") as out:
             given = {"key": self._key.hex(), "test_calls": self._job.test_calls, "hidden": self._job.hide}
             json.dump({**given, "checks": self._job.checks, "seed": self._job.seed}, out)
-        reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
-        reader.start()
+        self._reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
+        self._reader.start()
+
+    async def _async_shutdown_kernel(self, now: bool = False, restart: bool = False):
+        await super()._async_shutdown_kernel(now=now, restart=restart)
+        reader = getattr(self, "_reader", None)
+        if reader is not None:  # every line the kernel wrote is in the verdict file before nbgrader goes on
+            await asyncio.get_running_loop().run_in_executor(None, reader.join, 10.0)
+
+    shutdown_kernel = _async_shutdown_kernel  # what nbclient calls (the base class binds its own function)
 
     def _read_verdicts(self) -> None:
-        """Each signed line of the seal's pipe, checked, appended to the job's verdict file (the rest dropped)."""
-        with os.fdopen(self._verdict_read, "rb") as pipe, open(self._job.verdicts, "a", encoding="utf-8") as out:
+        """The seal's pipe, line by line, to the job's verdict file (its reader thread, until the pipe closes).
+
+        A signed line goes as it is, without its signature; any other (bytes an answer wrote on the pipe) as
+        a note of tampering.
+        """
+        fd = os.open(self._job.verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
+        with os.fdopen(self._verdict_read, "rb") as pipe, os.fdopen(fd, "a", encoding="utf-8") as out:
             for raw in pipe:
                 line = raw.decode("utf-8", "replace").rstrip("\n")
                 body, _, mac = line.rpartition("\t")
                 good = hmac.new(self._key, body.encode(), "sha256").hexdigest()
-                if hmac.compare_digest(mac, good):
-                    out.write(body + "\n")
-                    out.flush()
+                ok = hmac.compare_digest(mac.encode(), good.encode())
+                out.write((body if ok else "note\ttampering\tan unsigned line on the seal's pipe\t") + "\n")
+                out.flush()
 
 
 class SandboxedExecute(Execute):

@@ -4,8 +4,8 @@ nbgrader grades a test cell by whether it raised, in the same Python
 process as the learner's answer, so one line of an answer (rebinding a
 check, patching ``Result.require``, silencing IPython's traceback) could
 turn a failing check into full points.  When ``course/grade.py`` grades,
-each submission's kernel starts sealed (:mod:`tutorial.exercises.sealed_kernel`),
-before any cell runs, and the grade of a check cell comes from the seal's
+each submission's kernel starts sealed (:mod:`tutorial.exercises.sealed_kernel`,
+started by :mod:`tutorial.exercises.sandbox`) before any cell runs, and the grade of a check cell comes from the seal's
 signed verdicts, not from the cell's output:
 
 * :func:`install` snapshots the teacher's code: every ``tutorial`` module's
@@ -13,7 +13,8 @@ signed verdicts, not from the cell's output:
   ``builtins``; and an audit hook (PEP 578: it cannot be removed) with
   private builtins and no name any Python code can reach.
 * ``grade()`` announces each check (``rtt.check_begin``) and its result
-  (``rtt.result``); the hook takes them only from the teacher's ``grade``,
+  (``rtt.result``); the hook takes them only from the teacher's ``grade``
+  (its code, with its module's real globals),
   called by one of the teacher's check functions.  ``Result.require()``
   asks for the verdict (``rtt.verdict``), taken only from the teacher's
   ``require`` called by a statement compiled exactly like the test cell's
@@ -26,7 +27,7 @@ signed verdicts, not from the cell's output:
   processes and files outside its folder.
 * Each verdict (``begin``, ``verdict``, ``note``) goes out as a line signed with
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
-  grader's; ``course/sandbox.py`` reads and checks it.
+  grader's; :mod:`tutorial.exercises.sandbox` reads and checks it.
 
 What the seal does not stop: code that changes a check's objects *and*
 puts them back within one call from the check, or from a thread of its
@@ -34,15 +35,18 @@ own while the check runs (the snapshot is compared at the check's start
 and end), and frames reached through a library function that walks the
 stack (``traceback.walk_stack``), which can read a check's expected values.
 The hook itself never calls an answer's code (no ``str()``, no library
-function an answer could replace), so nothing runs unwatched inside it.  The sandbox (``course/sandbox.py``)
+function an answer could replace), so nothing runs unwatched inside it.  The sandbox (:mod:`tutorial.exercises.sandbox`)
 bounds what such code could reach.  Main thread only: ``install`` runs once,
 before the kernel starts.
 """
 
 from __future__ import annotations
 
+import ast
 import builtins
 import importlib
+import importlib.util
+import inspect
 import os
 import pkgutil
 import sys
@@ -50,9 +54,6 @@ import types
 
 # What a verdict line carries: the fields below, tab-separated, then the HMAC-SHA256 of the line so far.
 BEGIN, VERDICT, NOTE = "begin", "verdict", "note"
-REFUSED_IN_CHECK = frozenset(
-    {"sys._current_frames", "gc.get_objects", "gc.get_referrers", "gc.get_referents", "sys.settrace", "sys.setprofile"}
-)
 FRAME_ATTRIBUTES = frozenset({"tb_frame", "gi_frame", "cr_frame", "ag_frame"})
 NOTED = frozenset({"socket.connect", "socket.sendto", "os.fork", "os.forkpty", "subprocess.Popen", "os.posix_spawn"})
 NOT_COMPARED = frozenset(
@@ -67,10 +68,37 @@ def trusted_modules(checks: list[str] | None = None) -> list[types.ModuleType]:
 
     if checks is None:
         checks = [f"tutorial.exercises.{i.name}" for i in pkgutil.iter_modules(package.__path__)]
-    for name in ["tutorial.exercises.grader", *checks]:
-        if name.rsplit(".", 1)[-1] not in ("seal", "sealed_kernel"):
-            importlib.import_module(name)
+    wanted, done = ["tutorial.exercises.grader", *checks], set()
+    while wanted:  # each module, and the tutorial modules it imports anywhere (inside a check, lazily) too
+        name = wanted.pop()
+        if name in done or name.rsplit(".", 1)[-1] in ("seal", "sealed_kernel"):
+            continue
+        done.add(name)
+        module = importlib.import_module(name)
+        if name.startswith("tutorial.exercises"):
+            wanted += _tutorial_imports(module)
     return [m for name, m in sorted(sys.modules.items()) if m is not None and name.split(".")[0] == "tutorial"]
+
+
+def _tutorial_imports(module: types.ModuleType) -> list[str]:
+    """The ``tutorial`` modules ``module``'s source imports, at its top or inside a function."""
+    tree = ast.parse(inspect.getsource(module))
+    names = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("tutorial"):
+            names.append(node.module)
+            names += [f"{node.module}.{a.name}" for a in node.names if _find(f"{node.module}.{a.name}")]
+        elif isinstance(node, ast.Import):
+            names += [a.name for a in node.names if a.name.startswith("tutorial")]
+    return names
+
+
+def _find(name: str) -> bool:
+    """Whether ``name`` is a module (``from package import name`` may also import a module)."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
 
 
 def install(
@@ -107,9 +135,13 @@ def install(
         "__builtins__": dict(builtins.__dict__),
         "types": types,
         "getcwd": os.getcwd,
+        "lstat": os.lstat,
+        "readlink": os.readlink,
         "get_ident": _thread.get_ident,
         **{name: globals()[name] for name in ("BEGIN", "VERDICT", "NOTE", "NOT_COMPARED", "NOTED")},
-        **{name: globals()[name] for name in ("REFUSED_IN_CHECK", "FRAME_ATTRIBUTES")},
+        "FRAME_ATTRIBUTES": FRAME_ATTRIBUTES,
+        "_make_hook_code": _make_hook.__code__,
+        "loaded": sys.modules,  # the import system's own dict (rebinding sys.modules does not change it)
     }
     make = types.FunctionType(_make_hook.__code__, private, "_make_hook")
     hidden = tuple(h.rstrip("/") + "/" for h in hidden)
@@ -195,13 +227,23 @@ def _make_hook(
         if name not in NOT_COMPARED:
             snapshot.append(("builtins", builtin_names, name, value))
     check_codes = {  # each check's code -> (its module, the module's names it uses)
-        id(f.__code__): (f.__code__, m.__name__, uses(f.__code__, m.__dict__))
+        id(f.__code__): (f.__code__, m.__name__, uses(f.__code__, m.__dict__), m.__dict__)
         for m in modules
         if m.__name__ in check_modules
         for n, f in m.__dict__.items()
         if n.startswith("check_") and isinstance(f, types.FunctionType)
     }
     grade_code, require_code = grader.grade.__code__, grader.Result.require.__code__
+    grader_globals = grader.__dict__
+    frame_type = type(getframe(0))
+    hook_codes = set()  # every code object of this function's: the hook's frames, never an answer's to read
+    stack = [_make_hook_code]  # noqa: F821 - a private global
+    while stack:
+        code = stack.pop()
+        hook_codes.add(code)
+        stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
+    modules_now = [(m.__name__, m) for m in modules]
+    frame_holders = (types.TracebackType, types.GeneratorType, types.CoroutineType, types.AsyncGeneratorType)
     result_type = grader.Result
     state = {"checks": 0, "refused": [], "results": {}, "number": ""}
     suspecting = {grader._suspect.__code__}
@@ -210,8 +252,8 @@ def _make_hook(
 
     def changed(check=None):
         """What differs from the snapshot; of the check modules, only what ``check`` (a code id) uses."""
-        module, used = check_codes[check][1:] if check in check_codes else (None, ())
-        out = []
+        module, used = check_codes[check][1:3] if check in check_codes else (None, ())
+        out = [f"{name} was replaced in sys.modules" for name, m in modules_now if loaded.get(name) is not m]  # noqa: F821
         for where, space, name, value in snapshot:
             if where in check_modules and (where != module or name not in used):
                 continue  # another check's module, or a name this check does not use
@@ -236,6 +278,10 @@ def _make_hook(
         except OSError:
             pass  # the pipe closed or taken over by the answer: no verdict reaches the grader, which gives 0
 
+    def learner_code(code):
+        name = code.co_filename
+        return not name.startswith("<frozen ") and not name.startswith(roots)
+
     def learner(frame):
         name = frame.f_code.co_filename
         if name.startswith("<frozen "):
@@ -251,6 +297,20 @@ def _make_hook(
             elif part and part != ".":
                 parts.append(part)
         return "/" + "/".join(parts)
+
+    def reaches_memory(path):
+        """Whether ``path`` is a process's memory (``.../mem``), itself or through symbolic links."""
+        for _ in range(10):
+            if path.endswith("/mem"):
+                return True
+            try:
+                if lstat(path).st_mode & 0o170000 != 0o120000:  # noqa: F821 - a private global
+                    return False
+                target = readlink(path)  # noqa: F821 - a private global
+            except OSError:
+                return False
+            path = absolute(target if target.startswith("/") else path.rsplit("/", 1)[0] + "/" + target)
+        return True  # a chain of links this long is not a file an answer needs
 
     def learner_near(frame, depth=6):
         """Whether answer code called this within ``depth`` frames (through IPython's open(), socket.py, ...)."""
@@ -276,10 +336,13 @@ def _make_hook(
         """The exercise whose check is running, or "" (then the grader gives a note to the next check)."""
         return state["number"] if state["checks"] else ""
 
+    class Refused(Exception):  # noqa: N818 - what act() says to refuse; the hook raises the RuntimeError
+        pass
+
     def refuse(what):
         state["refused"].append(what)
         send(NOTE, "refused", what, here())
-        raise RuntimeError(f"the grader's sandbox refused: {what}")
+        raise Refused(what)
 
     busy = set()  # the threads inside the hook: what it does itself raises events, which it lets pass
 
@@ -290,10 +353,21 @@ def _make_hook(
         if me in busy:
             return
         busy.add(me)
+        why = None
         try:
             act(event, args)
+        except Refused as refused:
+            why = refused.args[0]
+        except Exception:  # noqa: BLE001, S110 - an event raised by hand with odd arguments: nothing to do
+            pass
         finally:
             busy.discard(me)
+        if why is not None:  # raised here, its traceback holds no frame of act(); the hook's own is refused
+            raise RuntimeError(f"the grader's sandbox refused: {why}")
+
+    def ours(frame):
+        """Whether ``frame`` (a check's, or the teacher's grader's) runs with the real module's globals."""
+        return frame is not None and frame.f_globals is grader_globals
 
     def act(event, args):  # noqa: C901 - one branch per event
         try:
@@ -301,32 +375,32 @@ def _make_hook(
         except ValueError:
             return  # raised from no Python code at all: nobody's answer
         if event == "rtt.check_begin":
-            if caller.f_code is grade_code:
+            if caller.f_code is grade_code and ours(caller):
                 state["checks"] += 1
                 state["refused"] = []
                 state["number"] = number_of(args[0])
-                outer = caller.f_back
-                state["begin_changes"] = changed(id(outer.f_code) if outer is not None else None)
+                state["begin_changes"] = changed(genuine_check(caller.f_back))
                 send(BEGIN, number_of(args[0]))
+        elif event == "rtt.check_end":
+            if caller.f_code is grade_code and ours(caller):
+                state["checks"] = max(0, state["checks"] - 1)  # also after an interrupt (a cell's timeout)
         elif event == "rtt.result":
             result = args[0]
-            if caller.f_code is grade_code and type(result) is result_type:
-                outer = caller.f_back
-                genuine = outer is not None and id(outer.f_code) in check_codes
-                check = id(outer.f_code) if genuine else None
+            if caller.f_code is grade_code and ours(caller) and type(result) is result_type:
+                check = genuine_check(caller.f_back)
                 reasons = list(state.get("begin_changes", [])) + changed(check) + list(state["refused"])
-                if not genuine:
+                if check is None:
                     reasons.append("grade() was not called by one of the teacher's checks")
-                record = (result, number_of(result.exercise), bool(result.passed), reasons, check)
+                fields = result.__dict__
+                passed = dict.get(fields, "passed") is True  # an identity: no method of an answer's object
+                record = (result, number_of(dict.get(fields, "exercise")), passed, reasons, check)
                 state["results"][id(result)] = record
-                state["checks"] = max(0, state["checks"] - 1)
         elif event == "rtt.verdict":
             result = args[0]
             record = state["results"].get(id(result))
-            if caller.f_code is not require_code or record is None:
-                exercise = result.__dict__.get("exercise") if type(result) is result_type else None
-                said = number_of(exercise) if type(exercise) is str else "?"  # never an answer's own str
-                send(NOTE, "tampering", "a verdict not made by the teacher's check and require()", said)
+            if caller.f_code is not require_code or not ours(caller) or record is None:
+                exercise = dict.get(result.__dict__, "exercise") if type(result) is result_type else None
+                send(NOTE, "tampering", "a verdict not made by the teacher's check and require()", number_of(exercise))
                 return
             _, number, passed, reasons, check = record
             statement = caller.f_back
@@ -336,18 +410,24 @@ def _make_hook(
             reasons = list(dict.fromkeys(reasons))
             send(VERDICT, number, int(passed), int(not reasons), "; ".join(reasons[:3]))
         elif event == "rtt.seed":
-            outer = caller.f_back
-            if seed and caller.f_code is seed_code and outer is not None and id(outer.f_code) in check_codes:
+            if seed and caller.f_code is seed_code and ours(caller) and genuine_check(caller.f_back) is not None:
                 if type(args[0]) is list:
-                    args[0].append(seed)
+                    list.append(args[0], seed)
         elif event == "rtt.suspect":
-            if caller.f_code in suspecting:
-                send(NOTE, "tampering", f"an answer returned {args[0]}", here())
+            if caller.f_code in suspecting and ours(caller) and type(args[0]) is str:
+                send(NOTE, "tampering", "an answer returned " + args[0], here())
         elif event == "sys.addaudithook":
-            refuse("a second audit hook")
+            refuse(event)
+        elif event in ("sys._current_frames", "sys.settrace", "sys.setprofile"):
+            # a way to the frames of this hook (another thread's, a tracer's): the answer's own call, or a thread
+            # started with the answer's tracer (threading.settrace, set by the thread's bootstrap)
+            hooks = [dict.get(caller.f_globals, n) for n in ("_trace_hook", "_profile_hook")]
+            if learner_near(caller) or any(type(f) is types.FunctionType and learner_code(f.__code__) for f in hooks):
+                refuse(event)
         elif event in ("object.__setattr__", "object.__delattr__"):
             if id(args[0]) in trusted:
-                refuse(f"changing {getattr(args[0], '__qualname__', '?')}.{args[1]}")
+                attribute = args[1] if type(args[1]) is str else "?"
+                refuse(f"changing {getattr(args[0], '__qualname__', '?')}.{attribute}")
         elif event in ("compile", "code.__new__"):
             filename = args[1] if type(args[1]) is str else ""
             if learner(caller) and (filename.startswith(roots) or filename.startswith("<frozen")):
@@ -357,31 +437,43 @@ def _make_hook(
             if type(path) is not str:
                 return  # a file descriptor, or bytes: not an answer's way to a path here
             path = absolute(path)
-            if "/proc/" in path and path.endswith("/mem"):
+            if reaches_memory(path):
                 refuse(f"opening {path}")
             allowed = ALLOWED + roots + readable + (getcwd() + "/",)  # noqa: F821 - a private global
             outside = not path.startswith(allowed) or (path.startswith(hidden) and not path.startswith(roots))
             if outside and learner_near(caller):
                 send(NOTE, "outside", f"opened {path}", here())
+        elif event in ("os.symlink", "os.link") and type(args[0]) is str and "/proc/" in absolute(args[0]):
+            refuse(f"a link to {args[0]}")
         elif event.startswith("ctypes.") and learner(caller):
             refuse(event)  # raw memory: the seal's key, or any object
+        elif event in ("gc.get_objects", "gc.get_referrers", "gc.get_referents") and learner_near(caller):
+            refuse(event)  # every object, the hook's closures among them
+        elif event == "object.__getattr__" and type(args[0]) in frame_holders and args[1] in FRAME_ATTRIBUTES:
+            frame = getattr(args[0], args[1], None)  # read here, where the hook lets its own events pass
+            if type(frame) is frame_type and frame.f_code in hook_codes:
+                refuse("reading the grader's own frames")
+            if state["checks"] > 0 and learner(caller):
+                refuse(f"reading {args[1]} during a check")
         elif event in NOTED:
             if learner_near(caller):
                 send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
-        elif state["checks"] > 0:
-            if event in REFUSED_IN_CHECK and learner_near(caller, 3):
-                refuse(f"{event} during a check")
-            elif event == "sys._getframe" and (
-                learner(caller) or (learner(args[0]) and caller.f_back is not None and learner(caller.f_back))
-            ):  # the answer's own call, or a library function's it called directly (inspect.currentframe())
-                refuse("reading frames during a check")
-            elif event == "object.__getattr__" and args[1] in FRAME_ATTRIBUTES and learner(caller):
-                refuse(f"reading {args[1]} during a check")
+        elif event == "sys._getframe" and state["checks"] > 0 and type(args[0]) is frame_type:
+            if learner(caller) or (learner(args[0]) and caller.f_back is not None and learner(caller.f_back)):
+                refuse("reading frames during a check")  # the answer's own call, or inspect.currentframe()'s
+
+    def genuine_check(frame):
+        """The id of the teacher's check whose code ``frame`` runs with its module's real globals, or None."""
+        if frame is None or id(frame.f_code) not in check_codes:
+            return None
+        return id(frame.f_code) if frame.f_globals is check_codes[id(frame.f_code)][3] else None
 
     WATCHED = (
-        REFUSED_IN_CHECK
-        | NOTED
-        | {"sys.addaudithook", "object.__setattr__", "object.__delattr__", "compile", "code.__new__", "open"}
+        NOTED
+        | {"sys.addaudithook", "sys._current_frames", "sys.settrace", "sys.setprofile"}
+        | {"gc.get_objects", "gc.get_referrers", "gc.get_referents"}
+        | {"object.__setattr__", "object.__delattr__", "compile", "code.__new__", "open"}
+        | {"os.symlink", "os.link"}
         | {"sys._getframe", "object.__getattr__"}
     )
     ALLOWED = ("/tmp/", "/dev/", "/proc/self/", "/sys/", "/etc/", "/usr/", "/lib", "/run/")

@@ -8,13 +8,19 @@ learner's seed of hidden cases, and reads the signed verdicts from ``W``.
 modules are imported (a ``tutorial/`` folder there would otherwise shadow them).
 """
 
+import ctypes
 import json
 import os
 
 from tutorial.exercises import seal
 
+PR_SET_DUMPABLE = 4  # Linux's prctl(2) option
+
 
 def main() -> None:
+    # Not dumpable: another process of the same user (a subprocess of an answer, which the seal does not
+    # watch) can then neither ptrace this kernel nor read its memory (/proc/PID/mem), where the key lives.
+    ctypes.CDLL(None).prctl(PR_SET_DUMPABLE, 0, 0, 0, 0)
     key_fd, verdict_fd = (int(fd) for fd in os.environ.pop("RTT_SEAL_FDS").split(","))
     with os.fdopen(key_fd, "rb") as pipe:
         given = json.loads(pipe.read())
