@@ -8,7 +8,8 @@ the release, as a learner's would:
   them only with the checks edited, below);
 - the worked solutions pasted in: full points;
 - each wrong answer of tests/test_exercises.py ``MISTAKES`` (the solution
-  with one mistake): it loses exactly its own exercise's points, no other;
+  with one mistake): it loses exactly its own exercise's points, no other
+  (``make test-grade``; in ``make test`` a cheat stands for it);
 - a check cell edited to pass always: graded with the original check
   (nbgrader restores read-only test cells), so the stubs still get 0;
 - an answer that never returns: interrupted by the cell timeout, 0 for that
@@ -20,7 +21,7 @@ with nbgrader's own commands: release, fetch and submit through the
 exchange, then collect, autograde, feedback, export; and a submission that
 is not a notebook is named as ungradable while the others are graded.
 
-``make test`` grades notebook 01's assignment (one wrong answer);
+``make test`` grades notebook 01's assignment (one cheat among them), and checks its release;
 ``make test-grade`` all nine, with every wrong answer.
 """
 
@@ -95,7 +96,7 @@ def exercises_of(name: str) -> list[str]:
 def submissions(course: Path, name: str, every_mistake: bool = True) -> dict[str, tuple[dict, dict[str, float]]]:
     """The fake submissions of ``name``: each one's notebook and the points each exercise must get.
 
-    ``every_mistake``: every wrong answer of ``MISTAKES``, and the stubs alone; else the first wrong answer only.
+    ``every_mistake``: every wrong answer of ``MISTAKES``, and the stubs alone; else neither.
     """
     solved = solution_of(course, name)
     numbers = exercises_of(name)
@@ -117,11 +118,9 @@ def submissions(course: Path, name: str, every_mistake: bool = True) -> dict[str
     loop = r"\1def \2(\3)\4:\n\1    while True:\n\1        pass\n"
     endless = re.sub(r"^(\s*)def (\w+)\((.*)\)(.*):\n", loop, solved[gid], flags=re.M)
     out["endless"] = (submission(course, name, dict(solved, **{gid: endless})), dict(full, **{first: 0.0}))
-    taken = set()
     for k, (number, right, wrong, _) in enumerate(MISTAKES):
-        if number not in numbers or (not every_mistake and taken):
+        if number not in numbers or not every_mistake:  # make test: its cheat stands for a wrong answer
             continue
-        taken.add(number)
         key = f"exercise_{number.replace('.', '_')}"
         assert right in solved[key], f"the solution of {number} no longer has {right!r}"
         answers = dict(solved, **{key: solved[key].replace(right, wrong)})
@@ -144,6 +143,7 @@ def grade_all(
     assignments.make(course, release=False)
     for name in names:
         assignments.nbgrader(course, "generate_assignment", name, "--force")
+        release_shows_the_notebooks_stubs_and_no_solution(course, name)
     if exchange:  # made and not given to the class yet: the grades' CSV must have no rows for it (read as zeros)
         from nbgrader.api import Gradebook
 
@@ -226,11 +226,8 @@ def grade_all(
         assert f"Score: {mine} / {total}" in fetched[0].read_text(), "the fetched feedback is not the learner's"
 
 
-def test_the_release_shows_the_notebooks_stubs_and_no_solution(tmp_path):
-    course = tmp_path / "course"
-    assignments.make(course, release=False)
-    name = IN_MAKE_TEST[0]
-    assignments.nbgrader(course, "generate_assignment", name, "--force")
+def release_shows_the_notebooks_stubs_and_no_solution(course: Path, name: str) -> None:
+    """The release of ``name`` (made in ``course``): the notebook's own stubs, read-only checks, no solution."""
     teacher = json.loads((ROOT / "notebooks" / f"{name}.ipynb").read_text())["cells"]
     release = cells_of(course, name)
     stubs = [c for c in release if (grade_id(c) or "").startswith("exercise_")]

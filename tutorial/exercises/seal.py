@@ -34,10 +34,14 @@ puts them back within one call from the check, or from a thread of its
 own while the check runs (the snapshot is compared at the check's start
 and end), and frames reached through a library function that walks the
 stack (``traceback.walk_stack``), which can read a check's expected values.
-The hook itself never calls an answer's code (no ``str()``, no library
-function an answer could replace), so nothing runs unwatched inside it.  The sandbox (:mod:`tutorial.exercises.sandbox`)
-bounds what such code could reach.  Main thread only: ``install`` runs once,
-before the kernel starts.
+The sandbox (:mod:`tutorial.exercises.sandbox`) bounds what such code could
+reach.  The hook itself never calls an answer's code (no ``str()``, no
+library function an answer could replace), so nothing runs unwatched inside it.
+
+The module is over 400 lines and still one job: the hook and all it keeps
+are closures of one function (:func:`_make_hook`), which no other module,
+and no answer, can reach.  Main thread only: ``install`` runs once, before
+the kernel starts.
 """
 
 from __future__ import annotations
