@@ -182,8 +182,13 @@ def number(grade_id: str) -> str:
 def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dict[str, tuple[bool, list[str]]]:
     """Each exercise of one graded notebook: (whether the seal let its points stand, its flags).
 
-    ``autograded``: the notebook nbgrader executed; ``verdicts``: the seal's checked lines; ``log``: what
-    nbgrader autograde printed; ``died``: the kernel died (nbgrader could not finish the notebook).
+    ``autograded``: the notebook nbgrader executed (none: nbgrader removed it, every exercise 0); ``verdicts``:
+    the seal's checked lines; ``log``: what nbgrader autograde printed; ``died``: the kernel died (nbgrader
+    could not finish the notebook).  An exercise's points stand only if the last check of it that began
+    ended with a signed pass, intact.  Any thread (it reads files and changes none).
+
+    Raises:
+        ValueError: ``autograded`` is not a notebook (JSON).
     """
     notebook = json.loads(autograded.read_text()) if autograded.is_file() else {"cells": []}
     exercises: dict[str, dict] = {}

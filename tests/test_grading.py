@@ -139,7 +139,11 @@ def grade_all(
     import getpass
 
     course, home, exchange_dir = tmp / "course", tmp / "learner", tmp / "exchange"
-    cheats = cheats if ROOT_USER else ()  # the sandbox, which catches them, needs root
+    if cheats and not ROOT_USER:  # said, not silently left out
+        import warnings
+
+        warnings.warn("the grading sandbox needs root: graded unsandboxed, without the cheats", stacklevel=2)
+        cheats = ()
     assignments.make(course, release=False)
     for name in names:
         assignments.nbgrader(course, "generate_assignment", name, "--force")

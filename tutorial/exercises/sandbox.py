@@ -91,7 +91,8 @@ class Job:
 
 
 def cgroups(job: Job) -> list[Path]:
-    """The job's memory and pids cgroups (cgroup v1), made with their limits; none where they cannot be."""
+    """The job's memory and pids cgroups (cgroup v1), made with their limits; none where they cannot be
+    (no cgroup v1, not root: the rlimits alone then bound the kernel).  Never raises; any thread."""
     made = []
     for controller, settings in (
         ("memory", {"memory.limit_in_bytes": job.cgroup_memory_bytes}),
@@ -114,7 +115,10 @@ def cgroups(job: Job) -> list[Path]:
 
 def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[Path] = ()) -> list[str]:
     """``kernel`` wrapped: namespaces, hidden folders (``keep`` bound back), the cgroups ``groups``, the job's
-    user and limits (run as root)."""
+    user and limits: the command to run as root (a list for ``subprocess``; every path shell-quoted).
+
+    Pure: it makes nothing; any thread.  The command fails (exit status 1, unshare's or mount's message on
+    stderr) where namespaces cannot be made."""
     script = [
         "set -e",
         "ip link set lo up",
