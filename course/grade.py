@@ -32,7 +32,6 @@ import argparse
 import contextlib
 import os
 import re
-import shutil
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -41,18 +40,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a package
 from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
-from sandboxing import (  # noqa: E402
-    Sandboxes,
-    add_flags_column,
-    apply,
-    clear,
-    course_seed,
-    judge,
-    learner_seed,
-    record_flags,
-    say_in_feedback,
-    test_calls,
-)
+from sandboxing import Sandboxes, add_flags_column, clear, course_seed, learner_seed, settle, test_calls  # noqa: E402
 
 
 def domains(text: str) -> list[int]:
@@ -131,7 +119,6 @@ def grade(
 
 def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: list[int], boxes) -> Path:
     failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
-    flagged: list[str] = []
     keep_private(course)
     if boxes:
         course_seed(course)  # made once, before the worker threads read it
@@ -139,8 +126,9 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
         if collect:
             nbgrader(course, "collect", assignment, "--update")
         who = learners(course, assignment)
+        calls, checks = test_calls(course, assignment) if boxes else ([], [])  # the seal's, for every learner
 
-        def worker(k: int, who=who, assignment=assignment) -> None:
+        def worker(k: int, who=who, assignment=assignment, calls=calls, checks=checks) -> None:
             """Learners k, k + jobs, ... one after another, in domain ids[k]: never two kernels in one domain.
 
             A submission nbgrader cannot grade (its kernel died, say) is named, and the others are graded.
@@ -152,7 +140,7 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
             for learner in who[k::jobs]:
                 log, died = "", False
                 if job:
-                    job.test_calls, job.checks = test_calls(course, assignment)
+                    job.test_calls, job.checks = calls, checks
                     job.seed = learner_seed(course, assignment, learner)
                     Path(job.verdicts).unlink(missing_ok=True)
                     env["RTT_SANDBOX"] = job.to_env()
@@ -164,18 +152,9 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
                 finally:
                     if job:
                         clear(job)
-                if job and not died and not Path(job.verdicts).exists():
-                    failed.append(f"{assignment}, {learner}: not graded in the sandbox (nbgrader's log: {log[-500:]})")
-                    continue
-                if job:
-                    notebook = course / "autograded" / learner / assignment / f"{assignment}.ipynb"
-                    judged = judge(notebook, Path(job.verdicts), log, died)
-                    if notebook.parent.is_dir():  # what the seal said, and why, for the teacher
-                        shutil.copyfile(job.verdicts, notebook.parent / "seal.txt")
-                    if notebook.is_file():
-                        apply(f"sqlite:///{course / 'gradebook.db'}", assignment, learner, judged)
-                        say_in_feedback(notebook, judged)
-                    record_flags(course, assignment, learner, judged)
+                problem = settle(course, assignment, learner, job, log, died) if job else None
+                if problem:
+                    failed.append(f"{assignment}, {learner}: {problem}")
 
         with ThreadPoolExecutor(max_workers=jobs) as pool:
             list(pool.map(worker, range(jobs)))  # list(): a worker's exception is raised here
@@ -191,7 +170,7 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
     csv = course / "grades.csv"
     given = sorted(set(assignments) | set(released(course) if collect else ()))
     nbgrader(course, "export", "--to", str(csv), *(f"--assignment={name}" for name in given))
-    flagged.extend(add_flags_column(course, csv))
+    flagged = add_flags_column(course, csv)
     keep_private(course)  # what grading made, too (autograded/, feedback/, grades.csv)
     if flagged:
         print(f"{len(flagged)} flagged submission(s) (the flags column of {csv.name}):", *flagged, sep="\n  ")

@@ -2,9 +2,10 @@
 
 ``grade.py`` grades each submission in a sandbox
 (:mod:`tutorial.exercises.sandbox`): :class:`Sandboxes` makes one Unix user
-per grading job and removes it afterwards.  After ``nbgrader autograde``,
-:func:`judge` reads what the kernel's seal (:mod:`tutorial.exercises.seal`)
-signed, nbgrader's own log and the autograded notebook, and decides each
+per grading job and removes it afterwards.  After each ``nbgrader autograde``,
+:func:`settle` has :func:`judge` read what the kernel's seal
+(:mod:`tutorial.exercises.seal`) signed, nbgrader's own log and the
+autograded notebook, and decide each
 exercise: its points stand only if nbgrader *and* the seal say it passed.
 Its flags say why not, or what else was seen:
 
@@ -174,6 +175,11 @@ def learner_seed(course: Path, assignment: str, learner: str) -> str:
     return hmac.new(key, f"{assignment}/{learner}".encode(), "sha256").hexdigest()[:16]
 
 
+def grade_id(cell: dict) -> str:
+    """The nbgrader grade id of a notebook cell, or ""."""
+    return cell["metadata"].get("nbgrader", {}).get("grade_id") or ""
+
+
 def number(grade_id: str) -> str:
     """``check_1_2`` or ``exercise_1_2`` as ``1.2``."""
     return grade_id.split("_", 1)[1].replace("_", ".")
@@ -194,11 +200,11 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
     exercises: dict[str, dict] = {}
     current = None
     for cell in notebook["cells"]:
-        grade_id = cell["metadata"].get("nbgrader", {}).get("grade_id") or ""
-        if grade_id.startswith(("exercise_", "check_")):
-            current = number(grade_id)
+        gid = grade_id(cell)
+        if gid.startswith(("exercise_", "check_")):
+            current = number(gid)
             exercises.setdefault(current, {"cells": [], "source": ""})
-            if grade_id.startswith("exercise_"):
+            if gid.startswith("exercise_"):
                 exercises[current]["source"] = "".join(cell["source"])
         if current and cell["cell_type"] == "code":
             exercises[current]["cells"].append(cell)
@@ -245,10 +251,33 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
             mine.append("tampering")
         if "NBGRADER" in found["source"]:
             mine.append("grader-aware")
-        if check_ok and not passed.get(ex, False) and "tampering" not in mine:
+        if check_ok and not passed.get(ex, False):  # the notebook passed what the seal did not see pass
             mine.append("tampering")
         out[ex] = (passed.get(ex, False), sorted(set(mine)))
     return out
+
+
+def settle(course: Path, assignment: str, learner: str, job: Job, log: str, died: bool) -> str | None:
+    """After ``nbgrader autograde`` of one submission in ``job``'s sandbox: its exercises judged
+    (:func:`judge`), the points the seal did not let stand taken back, its flags in the feedback and in
+    ``flags.json``, and the seal's lines kept beside the autograded notebook (``seal.txt``, why).
+
+    Returns:
+        None, or why the submission was not graded in the sandbox (no kernel of the sandbox ever ran).
+    Any thread (one per job).
+    """
+    verdicts = Path(job.verdicts)
+    if not died and not verdicts.exists():
+        return f"not graded in the sandbox (nbgrader's log: {log[-500:]})"
+    notebook = course / "autograded" / learner / assignment / f"{assignment}.ipynb"
+    judged = judge(notebook, verdicts, log, died)
+    if notebook.parent.is_dir() and verdicts.exists():  # what the seal said, and why, for the teacher
+        shutil.copyfile(verdicts, notebook.parent / "seal.txt")
+    if notebook.is_file():
+        apply(f"sqlite:///{course / 'gradebook.db'}", assignment, learner, judged)
+        say_in_feedback(notebook, judged)
+    record_flags(course, assignment, learner, judged)
+    return None
 
 
 def apply(gradebook_url: str, assignment: str, learner: str, judged: dict[str, tuple[bool, list[str]]]) -> None:
@@ -267,11 +296,11 @@ def say_in_feedback(autograded: Path, judged: dict[str, tuple[bool, list[str]]])
     """One line under each flagged check, in the autograded notebook the feedback is made from."""
     notebook = json.loads(autograded.read_text())
     for cell in notebook["cells"]:
-        grade_id = cell["metadata"].get("nbgrader", {}).get("grade_id") or ""
-        if grade_id.startswith("check_") and judged.get(number(grade_id), (True, []))[1]:
-            ok, mine = judged[number(grade_id)]
+        gid = grade_id(cell)
+        if gid.startswith("check_") and judged.get(number(gid), (True, []))[1]:
+            ok, mine = judged[number(gid)]
             points = "" if ok else " It gets 0 points."
-            line = f"The grader flagged exercise {number(grade_id)}: {', '.join(mine)}.{points}\n"
+            line = f"The grader flagged exercise {number(gid)}: {', '.join(mine)}.{points}\n"
             cell.setdefault("outputs", []).append({"output_type": "stream", "name": "stdout", "text": line})
     autograded.write_text(json.dumps(notebook))
 
@@ -284,16 +313,13 @@ def record_flags(course: Path, assignment: str, learner: str, judged: dict[str, 
 
     Any thread (the file is read, changed and written under a lock).
     """
-    with _FLAGS_LOCK:
-        _record_flags(course, assignment, learner, judged)
-
-
-def _record_flags(course: Path, assignment: str, learner: str, judged: dict[str, tuple[bool, list[str]]]) -> None:
     path = course / "flags.json"
-    kept = json.loads(path.read_text()) if path.is_file() else {}
-    kept[f"{assignment}/{learner}"] = "; ".join(f"{ex}: {', '.join(f)}" for ex, (_, f) in sorted(judged.items()) if f)
-    path.write_text(json.dumps(kept, indent=1, sort_keys=True) + "\n")
-    os.chmod(path, 0o600)
+    said = "; ".join(f"{ex}: {', '.join(f)}" for ex, (_, f) in sorted(judged.items()) if f)
+    with _FLAGS_LOCK:
+        kept = json.loads(path.read_text()) if path.is_file() else {}
+        kept[f"{assignment}/{learner}"] = said
+        path.write_text(json.dumps(kept, indent=1, sort_keys=True) + "\n")
+        os.chmod(path, 0o600)
 
 
 def add_flags_column(course: Path, csv_path: Path) -> list[str]:

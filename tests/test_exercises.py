@@ -664,15 +664,20 @@ VISIBLE_ONLY = {
 }
 
 
-@pytest.fixture
-def grading_seed(monkeypatch):
-    """The checks' hidden cases on, as the grading kernel's seal gives them (seeded: the same every run)."""
+def hidden_cases_on(monkeypatch, *modules: str) -> None:
+    """The hidden cases of the checks in ``modules`` on, as the grading kernel's seal gives them (seeded)."""
     import importlib
     import random
 
-    for module in ("step1_tank_controller", "step3_viewer"):
+    for module in modules:
         checks = importlib.import_module(f"tutorial.exercises.{module}")
         monkeypatch.setattr(checks, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
+
+
+@pytest.fixture
+def grading_seed(monkeypatch):
+    """The checks' hidden cases on, as while grading (the same every run)."""
+    hidden_cases_on(monkeypatch, "step1_tank_controller", "step3_viewer")
 
 
 @pytest.mark.parametrize("number", HIDDEN)
@@ -687,10 +692,7 @@ def test_an_answer_for_the_visible_cases_alone_fails_the_hidden_ones(ros, monkey
     ex = exercise(number)
     visible = grade(ex, ex["stub"], VISIBLE_ONLY[number])
     assert visible.passed, str(visible)  # a learner's own run: the visible cases alone
-    import random
-
-    module = __import__(f"tutorial.exercises.{ex['checks']}", fromlist=["x"])
-    monkeypatch.setattr(module, "hidden_random", lambda e: random.Random(f"test/{e}"))
+    hidden_cases_on(monkeypatch, ex["checks"])
     graded = grade(ex, ex["stub"], VISIBLE_ONLY[number])
     assert not graded.passed and "a hidden case failed: " in graded.message, str(graded)
     assert not any(c.isdigit() for c in graded.message.split("failed")[1]), graded.message  # no values

@@ -36,7 +36,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from test_exercises import MISTAKES
+from test_exercises import MISTAKES, VISIBLE_ONLY
 
 from conftest import ROOT
 
@@ -408,29 +408,10 @@ CHEATS = {
         "print('the kernel memory refused to a child:', 'Permission denied' in said.stderr)\n" + STUB_1_1,
         "processes",
     ),
-    # not cheats: answers written for the visible cases alone, which the hidden cases fail (no flag)
-    "visible-only-1.1": (
-        "1.1",
-        "TABLE = {(0, 0): (0.0, 0.0), (0, 1): (1.0, 1.0), (0, -1): (-1.0, -1.0), (1, 0): (-0.5, 0.5),\n"
-        "         (-1, 0): (0.5, -0.5), (1, 1): (0.5, 1.5), (-1, -1): (-0.5, -1.5), (1, -1): (-1.5, -0.5)}\n"
-        "def dpad_track_velocities(axes):\n"
-        "    if len(axes) < 6 or axes[0] != 0.0 or axes[5] != axes[5]:\n        return 0.0, 0.0\n"
-        "    return TABLE.get((axes[4], axes[5]), (0.0, 0.0))\n",
-        "",
-    ),
-    "visible-only-1.2": (
-        "1.2",
-        "class ShotCountingTankController(RttTankController):\n"
-        "    shots = 0\n    a_down = False\n"
-        "    def on_joy(self, msg):\n        super().on_joy(msg)\n"
-        "        down = len(msg.buttons) > 0 and msg.buttons[0] == 1\n"
-        "        with self._lock:\n"
-        "            if down and not self.a_down:\n                self.shots = min(self.shots + 1, 2)\n"
-        "            self.a_down = down\n"
-        "    def summary(self):\n        with self._lock:\n            shots = self.shots\n"
-        "        return {**super().summary(), 'shots': shots}\n",
-        "",
-    ),
+    # not cheats: answers written for the visible cases alone (tests/test_exercises.py), which the hidden
+    # cases fail (no flag)
+    "visible-only-1.1": ("1.1", VISIBLE_ONLY["1.1"], ""),
+    "visible-only-1.2": ("1.2", VISIBLE_ONLY["1.2"], ""),
     "grader-aware": (
         "1.1",
         "import os\nif os.environ.get('NBGRADER_EXECUTION'):\n"

@@ -216,9 +216,16 @@ class SandboxedKernelManager(AsyncKernelManager):
         finally:
             os.close(self._key_read)
             os.close(self._verdict_write)
+        job = self._job
+        given = {
+            "key": self._key.hex(),
+            "test_calls": job.test_calls,
+            "hidden": job.hide,
+            "checks": job.checks,
+            "seed": job.seed,
+        }
         with os.fdopen(self._key_write, "w") as out:
-            given = {"key": self._key.hex(), "test_calls": self._job.test_calls, "hidden": self._job.hide}
-            json.dump({**given, "checks": self._job.checks, "seed": self._job.seed}, out)
+            json.dump(given, out)
         self._reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
         self._reader.start()
 

@@ -19,12 +19,13 @@ signed verdicts, not from the cell's output:
   asks for the verdict (``rtt.verdict``), taken only from the teacher's
   ``require`` called by a statement compiled exactly like the test cell's
   call.  Each time the snapshot is compared, object by object.
-* During a check, the hook refuses what would let an answer read or change
-  the check from inside: frames of the answer's own code, the garbage
-  collector's object lists, tracing; it refuses at any time an answer's
-  ``ctypes`` (raw memory), a second audit hook, and changing the code or
-  defaults of the teacher's functions, and it notes (without refusing) an answer's connections,
-  processes and files outside its folder.
+* The hook refuses what would let an answer read or change the checks, or
+  the hook, from inside: during a check, frames of the answer's own code;
+  at any time, an answer's ``ctypes`` and ``/proc/*/mem`` (raw memory), the
+  garbage collector's object lists, tracers, other threads' frames, the
+  hook's own frames in a traceback, a second audit hook, and changing the
+  code or defaults of the teacher's functions.  It notes (without refusing)
+  an answer's connections, processes and files outside its folder.
 * Each verdict (``begin``, ``verdict``, ``note``) goes out as a line signed with
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
   grader's; :mod:`tutorial.exercises.sandbox` reads and checks it.
@@ -283,14 +284,12 @@ def _make_hook(
             pass  # the pipe closed or taken over by the answer: no verdict reaches the grader, which gives 0
 
     def learner_code(code):
+        """Whether ``code`` is an answer's: not the library's, the environment's or Python's own."""
         name = code.co_filename
         return not name.startswith("<frozen ") and not name.startswith(roots)
 
     def learner(frame):
-        name = frame.f_code.co_filename
-        if name.startswith("<frozen "):
-            return False
-        return not name.startswith(roots)
+        return learner_code(frame.f_code)
 
     def absolute(path):
         """``path`` made absolute and normal here, never by a library function an answer could replace."""
@@ -370,7 +369,7 @@ def _make_hook(
             raise RuntimeError(f"the grader's sandbox refused: {why}")
 
     def ours(frame):
-        """Whether ``frame`` (a check's, or the teacher's grader's) runs with the real module's globals."""
+        """Whether ``frame`` runs with the grader module's real globals (not a copy an answer made)."""
         return frame is not None and frame.f_globals is grader_globals
 
     def act(event, args):  # noqa: C901 - one branch per event

@@ -155,18 +155,21 @@ def _random_message(rng, joints) -> tuple[list[str], list[float]]:
     return names, positions
 
 
-def _same_applied(got, expected: dict) -> bool:
-    """``got`` is a dict of exactly ``expected``'s names (str), each value the same number (exact types)."""
+def _same_dict(got, expected: dict, same) -> bool:
+    """``got`` is a dict of exactly ``expected``'s names (str), each value ``same(value, expected's)``."""
     if type(got) is not dict or len(got) != len(expected) or not all(type(k) is str for k in got):
         return False
-    return all(k in got and same_numbers(got[k], v, 1e-12) for k, v in expected.items())
+    return all(k in got and same(got[k], v) for k, v in expected.items())
+
+
+def _same_applied(got, expected: dict) -> bool:
+    """What a matcher applies: each joint's position the same number (exact types)."""
+    return _same_dict(got, expected, lambda a, b: same_numbers(a, b, 1e-12))
 
 
 def _same_counts(got, expected: dict) -> bool:
-    """``got`` is a dict of exactly ``expected``'s reasons (str), each the same count (exact types)."""
-    if type(got) is not dict or len(got) != len(expected) or not all(type(k) is str for k in got):
-        return False
-    return all(k in got and same_value(got[k], v) for k, v in expected.items())
+    """Rejections by reason: each the same count (exact types)."""
+    return _same_dict(got, expected, same_value)
 
 
 def _show_dict(d) -> str:
