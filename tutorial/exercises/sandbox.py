@@ -46,6 +46,7 @@ from jupyter_client.manager import AsyncKernelManager
 from nbgrader.preprocessors import Execute
 
 ENV = "RTT_SANDBOX"
+PRIVATE = ("/tmp", "/var/tmp", "/dev/shm")  # the kernel's own, empty at its start
 PASSED_ENV = ("PATH", "LANG", "LC_ALL", "ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RTT_TEST_MODE", "MUJOCO_GL")
 
 
@@ -130,10 +131,10 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[P
         script += [f"mkdir -p {q(f'{held}/{k}')}", f"mount --bind {q(path)} {q(f'{held}/{k}')}"]
     for path in job.hide:
         script.append(f"if [ -d {q(path)} ]; then mount -t tmpfs -o mode=755,size=1m tmpfs {q(path)}; fi")
-    for k, path in enumerate(keep):
-        script += [f"mkdir -p {q(path)}", f"mount --move {q(f'{held}/{k}')} {q(path)}"]
-    for path in ("/tmp", "/var/tmp", "/dev/shm"):
+    for path in PRIVATE:
         script.append(f"mount -t tmpfs -o mode=1777,size=2g tmpfs {path}")
+    for k, path in enumerate(keep):  # last: a clone under /tmp keeps its library and environment
+        script += [f"mkdir -p {q(path)}", f"mount --move {q(f'{held}/{k}')} {q(path)}"]
     for group in groups:
         script.append(f"echo $$ > {q(str(group / 'cgroup.procs'))}")
     script.append('exec "$@"')
@@ -164,14 +165,15 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[P
 
 
 def kept_paths(hide: list[str]) -> list[str]:
-    """What a hidden folder holds that the kernel needs: the Python installation (root's pyenv, say), the
-    environment, and the library's own folders of a clone in a home folder (never its notebooks or course)."""
+    """What a hidden or private folder holds that the kernel needs: the Python installation (root's pyenv,
+    say), the environment, and the library's own folders of a clone in a home folder or under /tmp (never its
+    notebooks or course)."""
     repository = Path(__file__).resolve().parents[2]
     needed = {os.path.realpath(sys.base_prefix), os.path.realpath(sys.prefix)}
     needed |= {str(repository / p) for p in ("tutorial", "project", "model") if (repository / p).is_dir()}
     keep = []
     for path in needed:
-        if any(path.startswith(h.rstrip("/") + "/") for h in hide):
+        if any(path.startswith(h.rstrip("/") + "/") for h in [*hide, *PRIVATE]):
             keep.append(path)
     return sorted(keep)
 
