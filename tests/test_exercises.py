@@ -14,6 +14,7 @@ import json
 import re
 
 import pytest
+from exercise_rules import HIDDEN_MISTAKES, HIDDEN_MODULES, RULES, VISIBLE_ONLY
 
 from conftest import ROOT
 
@@ -632,36 +633,9 @@ def test_a_failed_line_names_its_subject_once_and_wraps_for_nbgrader():
 
 # ---- hidden cases (grader.hidden_random): drawn while grading, by the statement's rules ----
 
-HIDDEN = ["1.1", "1.2", "3.1", "3.2"]  # the exercises whose checks draw hidden cases
-# Answers written for the visible cases alone: each passes its check's visible cases and fails the hidden ones.
-VISIBLE_ONLY = {
-    "1.1": "TABLE = {(0, 0): (0.0, 0.0), (0, 1): (1.0, 1.0), (0, -1): (-1.0, -1.0), (1, 0): (-0.5, 0.5),\n"
-    "         (-1, 0): (0.5, -0.5), (1, 1): (0.5, 1.5), (-1, -1): (-0.5, -1.5), (1, -1): (-1.5, -0.5)}\n"
-    "def dpad_track_velocities(axes):\n"
-    "    if len(axes) < 6 or axes[0] != 0.0 or axes[5] != axes[5]:\n        return 0.0, 0.0\n"
-    "    return TABLE.get((axes[4], axes[5]), (0.0, 0.0))\n",
-    "1.2": "class ShotCountingTankController(RttTankController):\n"
-    "    shots = 0\n    a_down = False\n"
-    "    def on_joy(self, msg):\n        super().on_joy(msg)\n"
-    "        down = len(msg.buttons) > 0 and msg.buttons[0] == 1\n"
-    "        with self._lock:\n"
-    "            if down and not self.a_down:\n                self.shots = min(self.shots + 1, 2)  # 2 at most\n"
-    "            self.a_down = down\n"
-    "    def summary(self):\n        with self._lock:\n            shots = self.shots\n"
-    "        return {**super().summary(), 'shots': shots}\n",
-    # the range checked only for the joints the visible cases push past their limits
-    "3.2": "import math\nfrom collections import Counter\n"
-    "def my_match(joints, names, positions):\n"
-    "    by_name = {j.name: j for j in joints}\n    copies = Counter(names)\n    applied = {}\n"
-    "    for name, q in zip(names, positions):\n"
-    "        joint = by_name.get(name)\n"
-    "        if joint is None or copies[name] > 1 or not math.isfinite(q):\n            continue\n"
-    "        tolerance = 0.01 if joint.kind == 'slide' else 0.05\n"
-    "        if name in ('TURRET_P', 'TROLLEY', 'TURRET_Y') and not "
-    "joint.lower - tolerance <= q <= joint.upper + tolerance:\n"
-    "            continue\n"
-    "        applied[name] = q\n    return applied\n",
-}
+# Every check draws hidden cases while grading, after its visible ones: a wrong answer the visible cases catch
+# (MISTAKES) is caught while grading too.  Their tables (answers for the visible cases alone, the rules and
+# their cases, the mistakes only the hidden cases catch) are in tests/exercise_rules.py.
 
 
 def hidden_cases_on(monkeypatch, *modules: str) -> None:
@@ -677,10 +651,10 @@ def hidden_cases_on(monkeypatch, *modules: str) -> None:
 @pytest.fixture
 def grading_seed(monkeypatch):
     """The checks' hidden cases on, as while grading (the same every run)."""
-    hidden_cases_on(monkeypatch, "step1_tank_controller", "step3_viewer")
+    hidden_cases_on(monkeypatch, *HIDDEN_MODULES)
 
 
-@pytest.mark.parametrize("number", HIDDEN)
+@pytest.mark.parametrize("number", EXERCISES)
 def test_the_worked_solution_passes_the_hidden_cases_too(ros, grading_seed, number):
     ex = exercise(number)
     result = grade(ex, ex["stub"], ex["solution"])
@@ -698,60 +672,20 @@ def test_an_answer_for_the_visible_cases_alone_fails_the_hidden_ones(ros, monkey
     assert not any(c.isdigit() for c in graded.message.split("failed")[1]), graded.message  # no values
 
 
-@pytest.mark.parametrize("number, right, wrong, caught_by", [m for m in MISTAKES if m[0] in HIDDEN])
-def test_a_wrong_answer_still_fails_with_the_hidden_cases(ros, grading_seed, number, right, wrong, caught_by):
+@pytest.mark.parametrize("number, right, wrong, caught_by", HIDDEN_MISTAKES)
+def test_a_mistake_only_the_hidden_cases_catch_fails_on_its_case(ros, grading_seed, number, right, wrong, caught_by):
     ex = exercise(number)
-    assert right in ex["solution"]
-    assert not grade(ex, ex["stub"], ex["solution"].replace(right, wrong)).passed
+    assert ex["solution"].count(right) == 1, right
+    result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
+    assert not result.passed, f"{number} passed {wrong!r}"
+    assert caught_by in result.case, (caught_by, str(result))
+    if "a hidden case failed" in result.message:
+        assert not any(c.isdigit() for c in result.message.split("failed")[1]), result.message  # no values
 
 
-# Each statement's rules, and the labels of the visible cases (or the hidden cases' description) that check
-# each: a rule with no case fails here.  Exercises 1.1, 1.2, 3.1 and 3.2 (the others: not listed yet).
-RULES = {
-    "1.1": {
-        "up drives both tracks forward at DPAD_SPEED, down backward": ["(up)", "(down)"],
-        "left turns left on the spot (left -DPAD_TURN, right +DPAD_TURN), right the other way": ["(left)", "(right)"],
-        "a diagonal is the sum of its two directions, reversing too": ["(up and left)", "(down and right)"],
-        "a missing axis counts as 0": ["(a Joy with only 4 axes)", "a Joy too short for the D-pad's axes"],
-        "a non-finite axis counts as 0": ["(NaN on the vertical axis)", "a D-pad axis NaN or infinite"],
-        "only axes 4 and 5 count": ["(left stick up, D-pad released)", "with the sticks moved"],
-    },
-    "1.2": {
-        "a press is a change from released to pressed": ["(press, release, press)", "a long random sequence"],
-        "A held down over repeated Joys is one shot": ["(A held for 10 repeats, then released)"],
-        "before any Joy, A counts as released": ["(the first Joy already has A pressed)"],
-        "a Joy with too few buttons reads A as released": ["(a Joy with no buttons between two presses)"],
-        "A is button 0, not B": ["(only B pressed)", "a long random sequence of A, B, both"],
-        "super().on_joy(msg) first: the tank still drives": ["on_joy(a Joy with the left stick up)"],
-        "what both threads touch, under self._lock": ["what on_joy() remembers, under self._lock"],
-    },
-    "3.1": {
-        "a message naming some of this body's joints, and nothing else, is applied as before": [
-            "(the tank's own message)",
-            "(only one of the tank's joints)",
-        ],
-        "a message naming a joint the body does not have is refused whole": ["(one of the tank's joints and one"],
-        "a message naming none of its joints is refused": ["(the crane's message)", "(an empty message)"],
-        "each refused message counts once as wrong_model": ["(the crane's message, twice)"],
-        "other messages stay with the matcher (its rejections)": ["(the tank's, with a NaN)"],
-        "after a refusal, a good message is applied": ["(the crane's, then the tank's)", "a random run of"],
-    },
-    "3.2": {
-        "matched by name, in any order": ["(reordered)"],
-        "unknown names skipped": ["(unknown name)", "names known, unknown and repeated"],
-        "every entry of a duplicated name skipped": ["(duplicate name)", "(three copies of a name)"],
-        "entries without a position or name skipped": ["(short positions)", "(short names)"],
-        "non-finite values skipped": ["(NaN)", "(minus infinity)", "(an unlimited hinge at infinity)"],
-        "outside the range by more than 0.05 rad skipped, within applied": [
-            "(past the limit a little)",
-            "(past the limit a lot)",
-            "(just below a lower limit)",
-            "(far below a lower limit)",
-        ],
-        "a slide's tolerance is 0.01 m": ["(a slide a little past its limit)", "(a slide 0.05 m past its limit)"],
-        "an unlimited joint has no range": ["(an unlimited hinge far round)"],
-    },
-}
+def test_every_exercise_has_its_rules_and_an_answer_for_the_visible_cases_alone():
+    assert sorted(RULES) == sorted(EXERCISES)
+    assert sorted(VISIBLE_ONLY) == sorted(EXERCISES)
 
 
 @pytest.mark.parametrize("number", sorted(RULES))

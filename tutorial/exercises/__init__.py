@@ -3,6 +3,8 @@
 
 A notebook imports the check of each exercise from its notebook's module, e.g.
 ``from tutorial.exercises.step1_tank_controller import check_dpad_steering``.
+The checks' helpers: ``capture`` (what a controller publishes, kept in-process) and ``camera_rig``
+(Step 6's camera controller driven on the tank, picture by picture).
 
 Grading's own parts, which no notebook imports: ``release`` (the release's
 stubs, in ``nbgrader generate_assignment``), ``sandbox`` (each graded

@@ -15,8 +15,9 @@ on real pictures, the same on every run (no wall-clock timing).
 from __future__ import annotations
 
 import math
+from numbers import Integral
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade
+from tutorial.exercises.grader import NUMBER_TYPES, Case, CaseFailed, Result, grade, hidden_random
 
 BUDGET_BIT_S = 500_000  # bits per second the camera may use (a tenth of a 5 Mbit/s link)
 OVERHEAD_BYTES = 100  # RTPS, UDP and IP headers of one picture's message, about
@@ -38,10 +39,16 @@ def check_lossy_link_qos(func) -> Result:
     gets it before the next one replaces it; and the *last* state arrives
     (best effort loses it as often as any other).  So: reliable, keep last 1,
     volatile.
+
+    While grading, hidden publishers name every policy (liveliness automatic,
+    any depth, keep last or all, a lifespan or none): a subscription asking
+    for more than they offer (a manual liveliness, a deadline, a lease)
+    matches none of them.
     """
     from rclpy.qos import (
         DurabilityPolicy,
         HistoryPolicy,
+        LivelinessPolicy,
         QoSCompatibility,
         QoSProfile,
         ReliabilityPolicy,
@@ -62,16 +69,52 @@ def check_lossy_link_qos(func) -> Result:
             state["qos"] = got
         return state["qos"]
 
-    def matches(label, publisher, hint):
-        call = f"lossy_link_qos() against {label}"
+    def matches(label, publisher, hint, hidden=False):
+        call = label if hidden else f"lossy_link_qos() against {label}"
 
         def run():
             # ERROR: they never match.  (WARNING only says a policy is left to the system's default.)
             result, reason = qos_check_compatible(publisher, profile())
             if result == QoSCompatibility.ERROR:
                 raise CaseFailed(f"{call}: they do not match ({reason.strip().rstrip(';')}).", hint)
+            if profile().avoid_ros_namespace_conventions != publisher.avoid_ros_namespace_conventions:
+                raise CaseFailed(  # the check above does not see it: the DDS topic's name is another ("rt/" or not)
+                    f"{call}: they do not match (one avoids ROS's namespace conventions, so its DDS topic has "
+                    "another name).",
+                    "keep avoid_ros_namespace_conventions=False, as every ROS publisher does.",
+                )
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden)
+
+    def publishers(rng):
+        """Hidden cases: the Step 2 publisher, and ordinary volatile ones of any depth, naming every policy as the
+        statement asks (liveliness automatic, no deadline, no lease): a subscription must ask for no more."""
+        from rclpy.duration import Duration
+
+        step2 = joint_state_qos()
+        step2.liveliness = LivelinessPolicy.AUTOMATIC
+        yield matches(
+            "the tank's joint-state publisher, naming every policy",
+            step2,
+            "ask a publisher for nothing it does not offer: liveliness automatic (or the default), no deadline, "
+            "no liveliness lease.",
+            True,
+        )
+        for _ in range(3):
+            ordinary = QoSProfile(
+                history=rng.choice((HistoryPolicy.KEEP_LAST, HistoryPolicy.KEEP_ALL)),
+                depth=rng.randrange(1, 101),
+                reliability=ReliabilityPolicy.RELIABLE,
+                durability=DurabilityPolicy.VOLATILE,
+                liveliness=LivelinessPolicy.AUTOMATIC,
+                lifespan=Duration(seconds=rng.choice((0.0, rng.uniform(0.1, 10.0)))),
+            )
+            yield matches(
+                "an ordinary volatile publisher of any depth, naming every policy",
+                ordinary,
+                "a subscription that asks for what an ordinary publisher does not offer never matches it.",
+                True,
+            )
 
     def newest_only():
         qos = profile()
@@ -92,6 +135,7 @@ def check_lossy_link_qos(func) -> Result:
                 "best effort) and makes the last state arrive.",
             )
 
+    rng = hidden_random("8.1")  # while grading: this learner's own publishers to match
     return grade(
         "Exercise 8.1, a QoS for the monitor on a lossy link",
         [
@@ -116,6 +160,7 @@ def check_lossy_link_qos(func) -> Result:
                     "the monitor's second, transient-local subscription already asks for the kept state.",
                 ),
             ),
+            *(publishers(rng) if rng else ()),
         ],
     )
 
@@ -127,6 +172,11 @@ def _expect(condition: bool, what: str, hint: str) -> None:
 
 def camera_pictures(count: int = PICTURES):
     """``count`` pictures of the tank's camera as its turret swings right (RGB arrays); the same on every call."""
+    return camera_views([(0.9 * k / max(1, count - 1), 0.0) for k in range(count)])  # rad, towards the crate
+
+
+def camera_views(poses) -> list:
+    """The tank camera's pictures (RGB arrays) with its turret at each ``(yaw, pitch)`` of ``poses`` (rad)."""
     import mujoco
 
     from tutorial.core.world import build_world
@@ -136,12 +186,12 @@ def camera_pictures(count: int = PICTURES):
     data = mujoco.MjData(model)
     camera = next(i for i in range(model.ncam) if model.camera(i).name.startswith("Tank/"))
     width, height = (int(v) for v in model.cam_resolution[camera])
-    turret = model.joint("Tank/TURRET_Y").qposadr[0]
+    turret, gun = model.joint("Tank/TURRET_Y").qposadr[0], model.joint("Tank/TURRET_P").qposadr[0]
     renderer = mujoco.Renderer(model, height, width)
     try:
         pictures = []
-        for k in range(count):
-            data.qpos[turret] = 0.9 * k / max(1, count - 1)  # rad, towards the crate
+        for yaw, pitch in poses:
+            data.qpos[turret], data.qpos[gun] = yaw, pitch
             mujoco.mj_forward(model, data)
             renderer.update_scene(data, camera=camera)
             pictures.append(renderer.render())
@@ -162,7 +212,11 @@ def camera_bit_rate(rate: float, quality: int, pictures) -> float:
 
 
 def check_camera_settings(func) -> Result:
-    """Check ``func() -> (rate, jpeg_quality)``: watchable, recognisable, within :data:`BUDGET_BIT_S`."""
+    """Check ``func() -> (rate, jpeg_quality)``: watchable, recognisable, within :data:`BUDGET_BIT_S`.
+
+    The rate a number from 10 to 30 pictures/s, the quality an int (the publisher's parameter) from 30 to 100;
+    within the budget along the check's turret swing and, while grading, along hidden ones anywhere round.
+    """
     state: dict = {}
 
     def settings():
@@ -170,16 +224,17 @@ def check_camera_settings(func) -> Result:
             got = func()
             try:
                 rate, quality = got
+                numbers = type(rate) in NUMBER_TYPES and type(quality) in NUMBER_TYPES
                 rate, quality = float(rate), int(quality)
             except (TypeError, ValueError):
                 raise CaseFailed(
                     f"camera_settings() returned {got!r}, expected (rate in pictures/s, JPEG quality 1..100)."
                 ) from None
-            if not (math.isfinite(rate) and rate > 0 and 1 <= quality <= 100 and quality == got[1]):
+            if not (numbers and math.isfinite(rate) and rate > 0 and 1 <= quality <= 100 and quality == got[1]):
                 raise CaseFailed(
                     f"camera_settings() returned {got!r}, expected a rate > 0 and a quality that is an integer 1..100."
                 )
-            state["got"] = (rate, quality)
+            state["got"], state["whole"] = (rate, quality), isinstance(got[1], Integral)
         return state["got"]
 
     def watchable():
@@ -197,10 +252,15 @@ def check_camera_settings(func) -> Result:
                 f"camera_settings() asks JPEG quality {quality}, expected at least {MIN_QUALITY}.",
                 "lower the rate before the quality: below 30 the crate's edges smear into blocks.",
             )
+        if not state["whole"]:
+            raise CaseFailed(
+                f"camera_settings() asks JPEG quality {quality}.0, a float, expected an int.",
+                f"the publisher's jpeg_quality parameter takes an int: write {quality}, not {quality}.0.",
+            )
 
-    def fits():
+    def fits(pictures=None):
         rate, quality = settings()
-        bits = camera_bit_rate(rate, quality, camera_pictures())
+        bits = camera_bit_rate(rate, quality, camera_pictures() if pictures is None else pictures)
         if bits > BUDGET_BIT_S:
             raise CaseFailed(
                 f"camera_settings() = ({rate:g}, {quality}) sends {bits / 1e6:.2f} Mbit/s on these pictures, "
@@ -208,12 +268,40 @@ def check_camera_settings(func) -> Result:
                 "the bytes a second are rate x bytes a picture: lower the quality, or the rate.",
             )
 
+    def swings(rng):
+        """Hidden cases: the same budget along other turret swings, a third to half a radian anywhere round, the
+        gun level or lowered (all rendered at once, when the first is checked)."""
+        drawn = []
+        for _ in range(8):
+            start, width = rng.uniform(-math.pi, math.pi), rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 0.6)
+            pitch = rng.uniform(-0.17, 0.0)  # rad: the gun's lowest to level
+            drawn.append([(start + width * k / (PICTURES - 1), pitch) for k in range(PICTURES)])
+
+        def pictures(n):
+            if "swings" not in state:
+                views = camera_views([pose for swing in drawn for pose in swing])
+                state["swings"] = [views[k : k + PICTURES] for k in range(0, len(views), PICTURES)]
+            return state["swings"][n]
+
+        for n in range(len(drawn)):
+            yield Case(
+                "camera_settings(): within the budget along another turret swing",
+                lambda n=n: fits(pictures(n)),
+                "leave a margin: where the turret points elsewhere, pictures take more bytes; lower the quality "
+                "or the rate.",
+                True,
+            )
+
+    rng = hidden_random("8.2")  # while grading: this learner's own turret swings
     return grade(
         "Exercise 8.2, a camera that fits 0.5 Mbit/s",
         [
             Case("camera_settings()", settings, "return rate, jpeg_quality: two numbers, the second an integer."),
             Case(f"camera_settings(): {MIN_RATE:g} to {MAX_RATE:g} pictures/s", watchable),
             Case("camera_settings(): a picture you can recognise", recognisable),
-            Case(f"camera_settings(): within {BUDGET_BIT_S / 1e6:g} Mbit/s (a real encode of the camera)", fits),
+            Case(
+                f"camera_settings(): within {BUDGET_BIT_S / 1e6:g} Mbit/s (a real encode of the camera)", lambda: fits()
+            ),
+            *(swings(rng) if rng else ()),
         ],
     )

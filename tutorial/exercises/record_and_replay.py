@@ -18,9 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, show
 
 T0 = 1_700_000_000_000_000_000  # ns: the bags' first log time (any epoch time will do)
+JOY, OTHER_JOY = "/joy", "/remote/joy"  # the operator's Joys; another gamepad's, which do not count
 
 
 def write_bag(path: Path, messages: list[tuple[str, float, object]]) -> Path:
@@ -45,10 +46,12 @@ def write_bag(path: Path, messages: list[tuple[str, float, object]]) -> Path:
     return path
 
 
-def _joy(lv: float = 0.0, rh: float = 0.0, axes=None):
+def _joy(lv: float = 0.0, rh: float = 0.0, axes=None, stamp: float = 0.0):
     from sensor_msgs.msg import Joy
 
-    return Joy(axes=list(axes) if axes is not None else [0.0, lv, rh, 0.0, 0.0, 0.0, 0.0, 0.0], buttons=[0] * 8)
+    msg = Joy(axes=list(axes) if axes is not None else [0.0, lv, rh, 0.0, 0.0, 0.0, 0.0, 0.0], buttons=[0] * 8)
+    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(round(stamp * 1e9), 1_000_000_000)
+    return msg
 
 
 def _state(t: float, turret_y: float):
@@ -66,10 +69,15 @@ def check_release_times(func) -> Result:
     release is a released Joy right after one that was not.  Times are log
     times (when the recorder received the message), in seconds since the
     bag's first ``/joy`` message.  Other topics are ignored.
+
+    While grading, hidden bags drawn by the same rules (a D-pad or trigger
+    pushed alone, an axis barely off centre, two axes pushed opposite ways,
+    another gamepad's Joys, a first Joy that is released, the Joys stamped by
+    the gamepad's own clock) are judged by :func:`_releases`.
     """
 
-    def bag(label, messages, expected, hint):
-        call = f"release_times(a bag: {label})"
+    def bag(label, messages, expected, hint, hidden=False):
+        call = label if hidden else f"release_times(a bag: {label})"
 
         def run():
             with tempfile.TemporaryDirectory() as d:
@@ -84,8 +92,26 @@ def check_release_times(func) -> Result:
                     f"{call} returned {show([round(t, 4) for t in got_list])}, expected {show(expected)}.", hint
                 )
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden)
 
+    def drawn(label, kind):
+        """A hidden case: a bag drawn by ``kind``'s rules, its releases found by the statement's rule."""
+        messages = _random_joy_bag(rng, kind)
+        return bag(label, messages, _releases(messages), "follow each rule of the statement, for every Joy.", True)
+
+    rng = hidden_random("7.1")  # while grading: this learner's own bags, by the statement's rules
+    hidden = (
+        [
+            drawn("a D-pad or trigger axis pushed alone", "dpad"),
+            drawn("an axis barely off centre, which is not released", "tiny"),
+            drawn("two axes pushed opposite ways at once", "opposite"),
+            drawn("another gamepad's Joys and joint states between the Joys", "topics"),
+            drawn("a bag whose first Joy is released and comes after other topics", "late"),
+            drawn("a long drive of pushes, repeats and releases over several seconds", "long"),
+        ]
+        if rng
+        else []
+    )
     repeat = [0.05 * k for k in range(20)]  # a joy node repeating its state at 20 Hz for 1 s
     return grade(
         "Exercise 7.1, when did the operator let go",
@@ -140,8 +166,71 @@ def check_release_times(func) -> Result:
                 [0.2],
                 "a Joy with no axes has no stick pushed: it is released.",
             ),
+            *hidden,
         ],
     )
+
+
+def _releases(messages) -> list[float]:
+    """The statement's rule: log times of the /joy Joys with every axis 0 right after one that was not, in s
+    after the first /joy (as :func:`write_bag` stores the times: whole nanoseconds)."""
+    joys = sorted(((T0 + round(s * 1e9), msg) for topic, s, msg in messages if topic == JOY), key=lambda j: j[0])
+    times, pushed = [], False
+    for t, msg in joys:
+        released = all(a == 0.0 for a in msg.axes)
+        if released and pushed:
+            times.append((t - joys[0][0]) * 1e-9)
+        pushed = not released
+    return times
+
+
+def _pushed_axes(rng, kind: str) -> list[float]:
+    """The axes of a pushed Joy: ``dpad`` a D-pad or trigger alone, ``tiny`` an axis barely off centre,
+    ``opposite`` two axes pushed opposite ways (their sum 0), else one to three axes anywhere."""
+    axes = [0.0] * 8
+    if kind == "dpad":
+        axes[rng.randrange(4, 8)] = rng.choice((-1.0, 1.0, rng.uniform(0.1, 1.0)))
+    elif kind == "tiny":
+        axes[rng.randrange(8)] = rng.choice((-1.0, 1.0)) * rng.uniform(1e-4, 0.04)
+    elif kind == "opposite":
+        i, j = rng.sample(range(8), 2)
+        axes[i] = rng.uniform(0.1, 1.0)
+        axes[j] = -axes[i]
+    else:
+        for i in rng.sample(range(8), rng.randrange(1, 4)):
+            axes[i] = rng.choice((-1.0, 1.0)) * rng.uniform(0.01, 1.0)
+    return axes
+
+
+def _random_joy_bag(rng, kind: str) -> list[tuple[str, float, object]]:
+    """A bag's ``(topic, s, message)``: pushes (by :func:`_pushed_axes`) and releases on /joy, each state repeated
+    at 20 Hz a few times, the Joys stamped by the gamepad's clock (not the recorder's); for ``topics``, ``late``
+    and ``long``, joint states and another gamepad's Joys between them, sometimes before the first /joy."""
+    clock = rng.uniform(1.0, 500.0)  # s: the gamepad's clock when the bag starts
+    released = (lambda: [0.0] * 8, lambda: [-0.0] * 8, lambda: [], lambda: [0.0] * rng.randrange(1, 8))
+    t = rng.uniform(0.5, 3.0) if kind in ("topics", "late") else rng.choice((0.0, rng.uniform(0.0, 2.0)))
+    pushing = {"late": False, "long": rng.random() < 0.5}.get(kind, True)  # does the first Joy push?
+    messages = []
+    for _ in range(rng.randrange(5, 9) if kind == "long" else rng.randrange(3, 6)):
+        axes = _pushed_axes(rng, kind if kind in ("dpad", "tiny", "opposite") else "any") if pushing else None
+        for _ in range(rng.randrange(1, 5)):
+            state = axes if pushing else rng.choice(released)()
+            messages.append((JOY, t, _joy(axes=state, stamp=clock + t - rng.uniform(0.001, 0.03))))
+            t += 0.05
+        t += rng.uniform(0.0, 0.6)
+        pushing = not pushing
+    if kind in ("topics", "late", "long"):
+        end = t
+        for _ in range(rng.randrange(4, 12)):
+            s = rng.uniform(0.0, end)
+            if rng.random() < 0.5:
+                messages.append(("/Tank/joint_state", s, _state(s, rng.uniform(-1.0, 1.0))))
+            else:
+                axes = _pushed_axes(rng, "any") if rng.random() < 0.5 else [0.0] * 8
+                messages.append((OTHER_JOY, s, _joy(axes=axes, stamp=clock + s)))
+        first = min(s for topic, s, _ in messages if topic == JOY)
+        messages.append((OTHER_JOY, first * rng.uniform(0.0, 0.9), _joy(axes=_pushed_axes(rng, "any"))))
+    return sorted(messages, key=lambda m: m[1])
 
 
 def check_peak_speed(func) -> Result:
@@ -150,6 +239,10 @@ def check_peak_speed(func) -> Result:
     ``speed`` in rad/s (or m/s), ``time`` the later stamp of that pair, s;
     a state without the joint (NaN) is skipped, and so is a pair with the
     same stamp; fewer than two usable states give ``(0.0, nan)``.
+
+    While grading, hidden series drawn by the same rules (stamps from a
+    second or more, uneven, repeated; exact ties; states without the joint)
+    are judged by :func:`_peak`.
     """
     from tutorial.bag.series import JointSeries
 
@@ -162,8 +255,8 @@ def check_peak_speed(func) -> Result:
             {"TURRET_Y": np.asarray(q, dtype=float), "TURRET_P": np.zeros(len(stamps))},
         )
 
-    def case(label, s, joint, expected, hint):
-        call = f"peak_speed(a series: {label}, {joint!r})"
+    def case(label, s, joint, expected, hint, hidden=False):
+        call = label if hidden else f"peak_speed(a series: {label}, {joint!r})"
 
         def run():
             got = func(s, joint)
@@ -183,8 +276,27 @@ def check_peak_speed(func) -> Result:
                     )
                 raise CaseFailed(said, hint)
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden)
 
+    def drawn(label, kind):
+        """A hidden case: a series drawn by ``kind``'s rules, its peak found by the statement's rule."""
+        s, joint = _random_series(rng, kind)
+        return case(label, s, joint, _peak(s.stamp, s.positions[joint]), "follow each rule of the statement.", True)
+
+    rng = hidden_random("7.2")  # while grading: this learner's own series, by the statement's rules
+    hidden = (
+        [
+            drawn("states stamped a second or more into the simulation, unevenly spaced", "late"),
+            drawn("a drive of many states, stamped a second or more in", "late"),
+            drawn("several pairs tied at the top speed", "ties"),
+            drawn("states without the joint at the ends and in a row", "nan"),
+            drawn("several states sharing a stamp", "repeats"),
+            drawn("only one state carries the joint", "one"),
+            drawn("a joint that stood still, stamped a second or more in", "still"),
+        ]
+        if rng
+        else []
+    )
     t = [0.0, 0.02, 0.04, 0.06, 0.08]
     return grade(
         "Exercise 7.2, the turret's top speed",
@@ -238,5 +350,50 @@ def check_peak_speed(func) -> Result:
                 (0.0, math.nan),
                 "with fewer than two usable states, return (0.0, math.nan).",
             ),
+            *hidden,
         ],
     )
+
+
+def _peak(stamps, q) -> tuple[float, float]:
+    """The statement's rule: the largest |dq/dt| between consecutive usable states (NaN skipped, a pair with no
+    time between them skipped; the first of equal speeds), and the later stamp; (0.0, nan) without a pair."""
+    usable = [(t, x) for t, x in zip(stamps.tolist(), q.tolist()) if not math.isnan(x)]
+    best = (0.0, math.nan)
+    for (t0, q0), (t1, q1) in zip(usable, usable[1:]):
+        if t1 > t0 and (math.isnan(best[1]) or abs((q1 - q0) / (t1 - t0)) > best[0]):
+            best = (abs((q1 - q0) / (t1 - t0)), t1)
+    return best
+
+
+def _random_series(rng, kind: str):
+    """A JointSeries of TURRET_Y and TURRET_P, and the joint to ask for: stamped from a second or more of
+    simulation time, states 1 ms to 0.1 s apart, received 0 to 5 ms later, the other joint moving too.
+    ``ties``: speeds of a few values, exact in binary, the top one more than once; ``repeats``: states sharing a
+    stamp; ``nan``, ``one``: states without the joint; ``still``: the joint does not move."""
+    from tutorial.bag.series import JointSeries
+
+    n = rng.randrange(6, 40)
+    if kind == "ties":
+        steps = [rng.choice((1, 2, 4)) / 64 for _ in range(n - 1)]
+        speeds = [rng.choice((-2, -1, 0, 1, 2)) for _ in steps]
+        for k in rng.sample(range(n - 1), rng.randrange(2, 4)):
+            speeds[k] = rng.choice((-4, 4))
+        start, moves = rng.randrange(1, 400) + rng.randrange(64) / 64, [v * dt for v, dt in zip(speeds, steps)]
+    else:
+        steps = [rng.choice((0.001, 0.02, 0.02, 0.05, rng.uniform(0.001, 0.1))) for _ in range(n - 1)]
+        start, moves = rng.uniform(1.0, 500.0), [rng.uniform(-3.0, 3.0) * dt for dt in steps]
+        for k in rng.sample(range(n - 1), rng.randrange(2, 5)) if kind == "repeats" else ():
+            steps[k], moves[k] = 0.0, rng.uniform(-0.5, 0.5)  # two messages in one step
+    stamps = np.cumsum([start, *steps])
+    q = np.cumsum([rng.randrange(-64, 64) / 64, *([0.0] * (n - 1) if kind == "still" else moves)])
+    if kind == "nan":
+        gone = [0, n - 1, *rng.sample(range(1, n - 2), 3)]
+        q[gone + [gone[-1] + 1]] = np.nan
+    elif kind == "one":
+        keep = rng.randrange(n)
+        q[[k for k in range(n) if k != keep]] = np.nan
+    other = np.cumsum([0.0, *(rng.uniform(-3.0, 3.0) * dt for dt in steps)])
+    received = stamps + np.array([rng.uniform(0.0, 0.005) for _ in range(n)])
+    joint, another = rng.sample(("TURRET_Y", "TURRET_P"), 2)
+    return JointSeries("/Tank/joint_state", stamps, received - received[0], {joint: q, another: other}), joint

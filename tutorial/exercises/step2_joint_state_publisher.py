@@ -10,16 +10,31 @@ script by simulated time, deaf to the network, so always the same run)
 with the learner's controller attached, captures what it publishes
 in-process (:mod:`tutorial.exercises.capture`) and compares it with the
 simulation's own state at each message's stamp.
+
+While grading (:func:`tutorial.exercises.grader.hidden_random`) each check also
+runs hidden cases, drawn from the learner's seed: for 2.1, other choices,
+spacings and rates of the tank's joints with the turret moving at random, and
+names the tank lacks (``configure`` must log an error); for 2.2, the tank
+tilted and tumbling in the air (no gravity) at other rates, stamped past
+2 s, and the publisher's QoS.
+
+The module is over 400 lines and still one job: the two checks share one
+scripted run of the tank (``_drive``, ``_Probe``) and its comparisons.
 """
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import math
 
 from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, not_done, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, not_done, show
 
 DURATION = 2.0  # s of simulated time per checked run
+# s of a hidden run of 2.2: it stamps t = 2 s, where the simulation's clock reads a hair under 2 (1.99999999999989)
+HIDDEN_DURATION = 2.5
+TANK = ["TURRET_Y", "TURRET_P"]  # the tank's joints, in its order
 
 
 class _Probe:
@@ -55,8 +70,10 @@ class _Probe:
 TURN_SCRIPT = ((0.2, (0.0, 0.0, 0.0, 0.0)), (10.0, (0.8, 0.0, 0.0, 0.0)))
 
 
-def _drive(name: str, cls, parameters: dict, script=None):
+def _drive(name: str, cls, parameters: dict, script=None, duration: float = DURATION, tumble=None):
     """Run the scripted drive with ``cls`` attached as ``name``; ``(capturing node, probe, app)``.
+
+    ``tumble``: a controller attached first (:func:`_tumbling`).
 
     Raises:
         tutorial.app.app.ControllerError: the learner's controller refused to configure (or raised there).
@@ -71,16 +88,14 @@ def _drive(name: str, cls, parameters: dict, script=None):
     node = CapturingNode(rclpy.create_node("exercise_check"))
     probe = _Probe()
     tank = RttTankController()
-    summary, app = run_headless(
-        project,
-        DURATION,
-        node=node,
-        attach=[
-            ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=script)),
-            ("Tank", "RttTankController", tank),
-            ("Tank", "Probe", probe.controller),
-        ],
-    )
+    attach = [
+        ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=script)),
+        ("Tank", "RttTankController", tank),
+        ("Tank", "Probe", probe.controller),
+    ]
+    if tumble is not None:
+        attach.insert(0, ("Tank", "Tumble", tumble))
+    summary, app = run_headless(project, duration, node=node, attach=attach)
     if summary.get("error"):
         if "NotImplementedError" in summary["error"]:
             raise NotImplementedError
@@ -92,19 +107,71 @@ def _stamp(msg) -> float:
     return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
 
+def _turret_script(rng):
+    """A drive of random sticks (``ScriptedJoy``'s script): the tank rolls, the turret turns and tilts, either way."""
+
+    def sticks():  # the right stick well off its centre: both turret joints move
+        turn, tilt = (rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 0.8) for _ in range(2))
+        return (0.0, rng.uniform(-0.5, 0.5), turn, tilt)
+
+    return ((0.1, (0.0, 0.0, 0.0, 0.0)), (0.9, sticks()), (1.0, sticks()))
+
+
+def _tumbling(rng):
+    """A controller that turns gravity off and puts the tank in the air at t = 0, turned at random and tumbling.
+
+    It spins at least 1 rad/s about both of its horizontal axes, so its pose tilts far from upright.
+    """
+    from tutorial.core.controller import SimpleController
+
+    quat = [rng.gauss(0.0, 1.0) for _ in range(4)]
+    quat = [v / math.sqrt(sum(q * q for q in quat)) for v in quat]
+    spin = [rng.choice((-1.0, 1.0)) * rng.uniform(1.0, 2.0) for _ in range(2)] + [rng.uniform(-2.0, 2.0)]  # rad/s
+    place = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 1.0]  # m: a tank's length above the floor, at least
+    drift = [rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.05, 0.05)]  # m/s
+
+    class Tumble(SimpleController):
+        def initialize(self, io):
+            model = io.body.model  # this run's own
+            model.opt.gravity[:] = 0.0
+            joint = model.body_jntadr[io.body.root_id]  # the root's free joint
+            q, v = model.jnt_qposadr[joint], model.jnt_dofadr[joint]
+            io.data.qpos[q : q + 7] = place + quat  # position, then the quaternion w x y z
+            io.data.qvel[v : v + 6] = drift + spin
+            io.body.notify_kinematic_state_change()
+            return True
+
+    return Tumble()
+
+
+@contextlib.contextmanager
+def _errors_logged(name: str):
+    """The records of level ERROR or more that logger ``name`` (or a child) handles while the block runs."""
+    records: list[logging.LogRecord] = []
+    handler = logging.Handler(logging.ERROR)
+    handler.emit = records.append
+    logger = logging.getLogger(name)
+    logger.addHandler(handler)
+    try:
+        yield records
+    finally:
+        logger.removeHandler(handler)
+
+
 def check_selected_joints(cls) -> Result:
     """Check a ``RttJointStatePublisher`` subclass with a ``joints`` parameter.
 
     ``joints`` is a string of joint names separated by commas (spaces around
     a name are ignored); the publisher publishes those joints only, in that
-    order, with the right values; an empty string means every joint; a name
-    the body does not have makes ``configure`` refuse.
+    order, with the right values (position, velocity, effort), at the
+    ``rate`` parameter; an empty string means every joint; a name the body
+    does not have makes ``configure`` log an error and return False.
     """
     from tutorial.app.app import ControllerError
     from tutorial.interfaces.joint_state import joint_state_topic
 
-    def published(joints: str, rate: float):
-        node, probe, app = _drive("Selected", cls, {"joints": joints, "rate": rate})
+    def published(joints: str, rate: float, script=None):
+        node, probe, app = _drive("Selected", cls, {"joints": joints, "rate": rate}, script)
         pubs = node.published(joint_state_topic("Tank"))
         if len(pubs) != 1:
             raise CaseFailed(
@@ -115,11 +182,11 @@ def check_selected_joints(cls) -> Result:
             )
         return pubs[0].messages(), probe, app
 
-    def selects(joints: str, expected: list[str], rate: float = 50.0, hint: str = ""):
-        call = f"{cls.__name__} with joints={joints!r}, rate={rate}"
+    def selects(joints: str, expected: list[str], rate: float = 50.0, hint: str = "", script=None, label=None):
+        call = label or f"{cls.__name__} with joints={joints!r}, rate={rate}"
 
         def run():
-            messages, probe, app = published(joints, rate)
+            messages, probe, app = published(joints, rate, script)
             body = app.bodies["Tank"]
             want = round(rate * DURATION)
             if len(messages) < want:
@@ -163,26 +230,58 @@ def check_selected_joints(cls) -> Result:
                                 "in the order of the names you publish: not from its qpos address.",
                             )
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden=label is not None)
 
-    def refuses(joints: str):
-        call = f"{cls.__name__} with joints={joints!r}"
+    def refuses(joints: str, label=None):
+        call = label or f"{cls.__name__} with joints={joints!r}"
         hint = (
             "configure() should return False when a name is not in config.body.joint_names "
             "(and log why with config.log.error)."
         )
 
         def run():
-            try:
-                published(joints, 50.0)
-            except ControllerError as exc:
-                if not_done(exc):
-                    raise
-                return
+            with _errors_logged("rtt.Selected") as logged:  # config.log, the controller's own logger
+                try:
+                    published(joints, 50.0)
+                except ControllerError as exc:
+                    if not_done(exc):
+                        raise
+                    if label and not logged:  # a hidden case also holds the statement's "log an error"
+                        raise CaseFailed(f"{call}: configure returned False without logging an error.") from None
+                    return
             raise CaseFailed(f"{call} was accepted, but the tank has no joint {joints.split(',')[0].strip()!r}.")
 
-        return Case(call, run, hint)
+        return Case(call, run, hint, hidden=label is not None)
 
+    def hidden_cases(rng):
+        """The statement's rules on this learner's draws: a choice of the tank's joints (none: every joint), in a
+        random order, spaced at random, at a random rate, the turret moving; and names the tank lacks."""
+
+        def spaced(names):
+            return ",".join(" " * rng.randrange(3) + name + " " * rng.randrange(3) for name in names)
+
+        for _ in range(4):
+            chosen = rng.sample(TANK, rng.randrange(3))
+            label = "the tank's joints chosen at random (or none), in a random order and spacing, at a random rate"
+            yield selects(
+                spaced(chosen),
+                chosen or TANK,
+                rng.choice((12.5, 20.0, 25.0, 40.0, 100.0, 200.0)),
+                "those joints only, in that order, each with its own position, velocity and effort, at the rate.",
+                _turret_script(rng),
+                label + ", the turret moving",
+            )
+        lacks = {  # kinds of name the tank lacks, and one of each drawn
+            "a joint of the tank in the wrong case": lambda: rng.choice((str.lower, str.capitalize))(rng.choice(TANK)),
+            "a part of a joint's name": lambda: rng.choice(("TURRET", "TURRET_", "URRET_P", "RRET_Y", "_P")),
+            "another robot's joint": lambda: rng.choice(("GUN", "SLEW", "LUFF", "TROLLEY", "WHEEL_L")),
+        }
+        for kind, draw in lacks.items():
+            known = rng.sample(TANK, rng.randrange(1, 3))
+            known.insert(rng.randrange(len(known)), draw())  # before a known name: not only the last is checked
+            yield refuses(spaced(known), f"a name the tank lacks ({kind}): configure logs an error, returns False")
+
+    rng = hidden_random("2.1")  # while grading: this learner's own choices, rates, drives and wrong names
     return grade(
         "Exercise 2.1, publish chosen joints",
         [
@@ -197,6 +296,7 @@ def check_selected_joints(cls) -> Result:
             selects("TURRET_P", ["TURRET_P"], rate=10.0, hint="the rate parameter still applies."),
             refuses("GUN"),
             refuses("TURRET_Y,GUN"),
+            *(hidden_cases(rng) if rng else ()),
         ],
     )
 
@@ -205,19 +305,24 @@ def check_pose_publisher(cls) -> Result:
     """Check a controller that publishes the body's root pose (``geometry_msgs/PoseStamped``).
 
     Topic ``/<body>/pose``; ``rate`` Hz of simulated time (default 10), the
-    first at t = 0; ``header.frame_id`` ``world``; stamp = simulation time;
-    position in m and orientation (x, y, z, w, ROS's order) of the root link.
+    first at t = 0; ``header.frame_id`` ``world``; stamp = simulation time
+    (whole seconds in ``sec``, the rest in ``nanosec``); position in m and
+    orientation (x, y, z, w, ROS's order) of the root link, tilted or not;
+    QoS the joint state's; ``unconfigure()`` destroys the publisher.
     """
     call = f"{cls.__name__} on the Tank, scripted drive of {DURATION} s"
     turning = f"{cls.__name__} with rate=25, the tank turning on the spot"
-    runs: dict = {}  # one drive per kind serves every case of that kind
+    # kind: (rate, script, duration, tumble); one run per kind serves every case of that kind
+    plans: dict = {"drive": (10.0, None, DURATION, None), "turn": (25.0, TURN_SCRIPT, DURATION, None)}
+    runs: dict = {}
 
     def poses(kind: str = "drive"):
         if kind not in runs:
             from geometry_msgs.msg import PoseStamped
 
-            parameters, script = ({}, None) if kind == "drive" else ({"rate": 25.0}, TURN_SCRIPT)
-            node, probe, _ = _drive("PosePublisher", cls, parameters, script)
+            rate, script, duration, tumble = plans[kind]
+            parameters = {} if kind == "drive" else {"rate": rate}  # the drive: the default rate
+            node, probe, _ = _drive("PosePublisher", cls, parameters, script, duration, tumble)
             pubs = node.published("/Tank/pose")
             if len(pubs) != 1:
                 topics = [p.topic for p in node.published()]
@@ -227,26 +332,35 @@ def check_pose_publisher(cls) -> Result:
                 )
             if pubs[0].msg_type is not PoseStamped:
                 raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__}, expected geometry_msgs/PoseStamped.")
-            runs[kind] = (pubs[0].messages(), probe, pubs[0])
+            messages = pubs[0].messages()
+            runs[kind] = (messages[: round(rate * duration)], messages, probe, pubs[0])
         return runs[kind]
 
     def removed():  # the drive ended with unconfigure()
-        poses()[2].require_destroyed(
+        poses()[3].require_destroyed(
             f"{cls.__name__}.unconfigure()",
             "in unconfigure(): destroy_publisher(...) of the publisher configure() made (keep the node: "
             "self.node = config.node).",
         )
 
-    def timing(kind: str = "drive", rate: float = 10.0, who: str = call):
+    def qos():
+        from tutorial.interfaces.joint_state import joint_state_qos
+
+        got, want = poses()[3].qos_profile, joint_state_qos()
+        if any(getattr(got, f) != getattr(want, f) for f in ("reliability", "durability", "history", "depth")):
+            raise CaseFailed(f"{call}: the publisher's QoS is {got}, expected {want}.")
+
+    def timing(kind: str = "drive", who: str = call):
+        rate, _, duration, _ = plans[kind]
         messages, *_ = poses(kind)
-        want = round(rate * DURATION)
-        if len(messages) < want:
+        if len(messages) < round(rate * duration):
             raise CaseFailed(
-                f"{who}: published {len(messages)} poses, expected {want} ({rate:g} Hz for {DURATION} s).",
+                f"{who}: published {len(messages)} poses, expected {round(rate * duration)} "
+                f"({rate:g} Hz for {duration} s).",
                 "use a PeriodAccumulator(io.time_step, rate) in initialize, with the rate parameter, "
                 "and tick() it in control().",
             )
-        for k, msg in enumerate(messages[:want]):
+        for k, msg in enumerate(messages):
             t = _stamp(msg)
             if abs(t - k / rate) > 1e-9:
                 raise CaseFailed(
@@ -255,37 +369,41 @@ def check_pose_publisher(cls) -> Result:
                     "read config.parameters['rate'].",
                 )
 
-    want = round(10.0 * DURATION)
+    def split(kind: str, who: str):  # a ROS time: whole seconds in sec, nanosec below one second
+        for msg in poses(kind)[0]:
+            if not 0 <= msg.header.stamp.nanosec < 1_000_000_000:
+                raise CaseFailed(f"{who}: a stamp of {msg.header.stamp.sec} s and {msg.header.stamp.nanosec} ns.")
 
-    def position():
-        messages, probe, _ = poses()
-        for msg in messages[:want]:
+    def position(kind: str = "drive", who: str = call, tol: float = 5e-3):
+        messages, _, probe, _ = poses(kind)
+        for msg in messages:
             t = _stamp(msg)
             if msg.header.frame_id != "world":
                 raise CaseFailed(
-                    f"{call}: frame_id is {msg.header.frame_id!r}, expected 'world'.",
+                    f"{who}: frame_id is {msg.header.frame_id!r}, expected 'world'.",
                     "the pose is the root link's, in the world frame.",
                 )
             pos = probe.at(t)[1]
             p = msg.pose.position
             got = (p.x, p.y, p.z)
-            if max(abs(a - b) for a, b in zip(got, pos)) > 5e-3:
+            if not max(abs(a - b) for a, b in zip(got, pos)) <= tol:
                 raise CaseFailed(
-                    f"{call}: at t = {t:.2f} s the position was {show(list(got))}, the root was at "
+                    f"{who}: at t = {t:.2f} s the position was {show(list(got))}, the root was at "
                     f"{show([round(float(v), 4) for v in pos])} m.",
                     "io.body.root_pose() gives the root's (position, quaternion).",
                 )
 
-    def orientation(kind: str = "drive", who: str = call):
-        messages, probe, _ = poses(kind)
-        turned = 0.0
+    def orientation(kind: str = "drive", who: str = call, tol: float = 1e-2):
+        _, messages, probe, _ = poses(kind)
+        turned = tilted = 0.0
         for msg in messages:
             t = _stamp(msg)
             quat = probe.at(t)[2]
             turned = max(turned, abs(2 * math.atan2(float(quat[3]), float(quat[0]))))
+            tilted = max(tilted, math.hypot(float(quat[1]), float(quat[2])))
             o = msg.pose.orientation
             got, expected = (o.x, o.y, o.z, o.w), (quat[1], quat[2], quat[3], quat[0])
-            if not _same_rotation(got, expected):
+            if not _same_rotation(got, expected, tol):
                 raise CaseFailed(
                     f"{who}: at t = {t:.2f} s the orientation (x, y, z, w) was "
                     f"{show([round(v, 4) for v in got])}, expected "
@@ -295,16 +413,59 @@ def check_pose_publisher(cls) -> Result:
                 )
         if kind == "turn":
             assert turned > 0.3, f"the check's own drive did not turn the tank ({turned:.3f} rad)"
+        if plans[kind][3] is not None:
+            assert tilted > 0.3, f"the check's own run did not tilt the tank ({tilted:.3f})"
 
+    def hidden_cases(rng):
+        """The statement's rules on this learner's draws: the tank tilted and tumbling in the air, at a rate of a
+        whole and of a fractional number of hertz, its poses compared to a micrometre; and the publisher's QoS."""
+        rules = (  # what a case tests, how (kind, who), its hint
+            (
+                "its rate, the first at the start, stamped with simulation time",
+                timing,
+                "publish at the rate parameter, as given (a float), the first at the start, stamped with "
+                "io.current_time.",
+            ),
+            (
+                "whole seconds in sec, the rest in nanosec",
+                split,
+                "a ROS time's nanosec is under a second: stamp_parts(io.current_time) splits it.",
+            ),
+            (
+                "the root's position, frame world",
+                lambda kind, who: position(kind, who, 1e-6),
+                "io.body.root_pose() gives the root's position, tilted or not.",
+            ),
+            (
+                "the root's orientation, tilted",
+                lambda kind, who: orientation(kind, who, 1e-9),
+                "copy each of the quaternion's four numbers to its own field (ROS: x, y, z, w; root_pose: w, x, y, "
+                "z), whatever the tilt: not a yaw alone.",
+            ),
+        )
+        for kind, rates in (("whole", (4.0, 8.0, 20.0, 40.0, 50.0, 100.0, 250.0)), ("fractional", (2.5, 12.5, 62.5))):
+            plans[kind] = (rng.choice(rates), None, HIDDEN_DURATION, _tumbling(rng))
+            who = f"the tank tilted and tumbling in the air, at a rate of its own, a {kind} number of hertz"
+            for what, test, hint in rules:
+                yield Case(f"{who}: {what}", lambda test=test, kind=kind, who=who: test(kind, who), hint, hidden=True)
+        yield Case(
+            f"{cls.__name__}: the publisher's QoS, the joint state's",
+            qos,
+            "create the publisher with joint_state_qos(), as the joint state's publisher does.",
+            hidden=True,
+        )
+
+    rng = hidden_random("2.2")  # while grading: this learner's own rates and tumbles
     return grade(
         "Exercise 2.2, publish the pose",
         [
             Case(f"{call}: 10 Hz from t = 0, stamped with simulation time", timing),
             Case(f"{call}: the root's position, frame world", position),
             Case(f"{call}: the root's orientation", orientation),
-            Case(f"{turning}: 25 Hz from t = 0", lambda: timing("turn", 25.0, turning)),
+            Case(f"{turning}: 25 Hz from t = 0", lambda: timing("turn", turning)),
             Case(f"{turning}: the root's orientation as it turns", lambda: orientation("turn", turning)),
             Case(f"{cls.__name__}.unconfigure()", removed),
+            *(hidden_cases(rng) if rng else ()),
         ],
     )
 

@@ -12,17 +12,29 @@ once per ``holdoff`` seconds of simulated time.
 Each check runs the tank in its room driven by the demo script "wall" (by
 simulated time, deaf to the network, so always the same run), with a probe
 that keeps every step's accelerometer reading, captures what the learner's
-controller publishes in-process (:mod:`tutorial.exercises.capture`) and
-compares it with what the readings say it should be.  The checks run on
-the calling thread.
+controller publishes in-process (:mod:`tutorial.exercises.capture`), in
+order across its topics, and compares it with what the readings say it
+should be.  The checks run on the calling thread.
+
+While grading (:func:`tutorial.exercises.grader.hidden_random`) each check
+also runs hidden cases, drawn from the learner's seed: for 4.1, rates whose
+period is no whole number of steps, and a rate of 0 (each step a period);
+for 4.2, other rates, thresholds and holdoffs, and a period exactly at
+threshold; for both, each message published right after its Imu message,
+and the publisher's QoS.
+
+The module is over 400 lines and still one job: the two checks share one
+scripted run of the tank (``_drive``, ``_Probe``) and its comparisons.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, show
 
 DURATION = 3.0  # s of simulated time per checked run: the tank hits the wall at about 2.05 s
 TIME_STEP_NS = 1_000_000  # the tank world's 1 ms step
@@ -53,6 +65,25 @@ class _Probe:
         return self.controller.readings
 
 
+class _NotingNode(CapturingNode):
+    """A :class:`CapturingNode` that also notes, in ``order``, the topic of each message published, in turn."""
+
+    def __init__(self, node):
+        super().__init__(node)
+        self.order: list[str] = []
+
+    def create_publisher(self, msg_type, topic, qos_profile, **kwargs):
+        publisher = super().create_publisher(msg_type, topic, qos_profile, **kwargs)
+        publish = publisher.publish
+
+        def noted(msg) -> None:
+            self.order.append(topic)
+            publish(msg)
+
+        publisher.publish = noted
+        return publisher
+
+
 def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: float = DURATION):
     """Run the tank world with ``cls`` attached as ``name``, driven by ``script``.
 
@@ -72,7 +103,7 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
     from tutorial.notebook.runs import load, run_headless
 
     project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
-    node = CapturingNode(rclpy.create_node("exercise_check_imu"))
+    node = _NotingNode(rclpy.create_node("exercise_check_imu"))
     probe = _Probe()
     tank = RttTankController()
     summary, _ = run_headless(
@@ -139,16 +170,47 @@ def _horizontal(v) -> float:
     return math.hypot(float(v[0]), float(v[1]))
 
 
+def _follows(node, topic: str) -> list:
+    """For each message published on ``topic``: the index of the Imu message published just before it
+    (None when the message just before it was not an Imu message)."""
+    from tutorial.interfaces.imu import imu_topic
+
+    imu, count, previous, after = imu_topic("Tank"), 0, None, []
+    for published in node.order:
+        count += published == imu
+        if published == topic:
+            after.append(count - 1 if previous == imu else None)
+        previous = published
+    return after
+
+
+def _imu_qos(publisher, call: str) -> None:
+    """CaseFailed unless ``publisher`` was made with the QoS of ``imu_qos()`` (the statement's)."""
+    from tutorial.interfaces.imu import imu_qos
+
+    if publisher.qos_profile != imu_qos():
+        raise CaseFailed(f"{call}: the publisher of {publisher.topic} has the QoS {publisher.qos_profile}.")
+
+
+def _half_step(rng, low: int, high: int) -> float:
+    """A holdoff of ``low`` to ``high`` ms and a half: never a whole number of steps, so no two stamps
+    are exactly a holdoff apart (where the float ``self.data.time`` would decide, not the rule)."""
+    return (rng.randrange(low, high) + 0.5) / 1000
+
+
 def check_peak_publisher(cls) -> Result:
     """Check a ``RttImuStatePublisher`` subclass publishing each period's peak horizontal acceleration.
 
     Topic ``/<body>/peak_acceleration``, ``std_msgs/Float64``, m/s^2: after
     each Imu message, the largest ``hypot(x, y)`` of the accelerometer's
     reading in any single step of the steps that message averages.
+    Hidden cases: two other rates, whose periods are no whole number of
+    steps, and a rate of 0 (every step its own period); each peak published
+    right after its Imu message; the publisher's QoS ``imu_qos()``.
     """
     from std_msgs.msg import Float64
 
-    runs: dict = {}  # rate -> (Imu messages, peaks, probe): one run serves several cases
+    runs: dict = {}  # rate -> (Imu messages, peaks, probe, publisher, node): one run serves several cases
 
     def run(rate: float):
         if rate not in runs:
@@ -169,14 +231,15 @@ def check_peak_publisher(cls) -> Result:
                     "expected one peak after each Imu message.",
                     "publish the peak in publish(), right after super().publish().",
                 )
-            runs[rate] = (imu, [p.data for p in peaks], probe, node.published("/Tank/peak_acceleration")[0])
+            publisher = node.published("/Tank/peak_acceleration")[0]
+            runs[rate] = (imu, [p.data for p in peaks], probe, publisher, node)
         return runs[rate]
 
-    def compare(label: str, rate: float, chosen, hint: str):
-        call = f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s ({label})"
+    def compare(label: str, rate: float, chosen, hint: str, hidden: bool = False):
+        call = label if hidden else f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s ({label})"
 
         def check():
-            imu, peaks, probe, _ = run(rate)
+            imu, peaks, probe, *_ = run(rate)
             readings = probe.readings
             for k, ((first, last), got) in enumerate(zip(_windows(imu), peaks)):
                 t = _stamp_ns(imu[k]) * 1e-9
@@ -192,8 +255,35 @@ def check_peak_publisher(cls) -> Result:
                         _diagnose(got, mean, readings, first, last) or hint,
                     )
 
-        return Case(call, check, hint)
+        return Case(call, check, hint, hidden)
 
+    def right_after():
+        if _follows(run(20.0)[4], "/Tank/peak_acceleration") != list(range(len(run(20.0)[0]))):
+            raise CaseFailed(f"{cls.__name__}: a peak was not published right after its Imu message.")
+
+    hidden = []
+    rng = hidden_random("4.1")  # while grading: other rates for this learner, by the same rule
+    if rng:
+        periods = "each peak covers exactly the steps its Imu message averages: start over in publish()."
+        hidden = [
+            *(
+                compare("every period, at a rate of no whole number of steps", rate, lambda t: True, periods, True)
+                for rate in (rng.uniform(6, 20), rng.uniform(20, 45))
+            ),
+            compare("every period, at a rate of zero: each step is a period", 0.0, lambda t: True, periods, True),
+            Case(
+                "each peak published right after its Imu message",
+                right_after,
+                "publish the peak in publish(), after super().publish(): the Imu message first, then its peak.",
+                True,
+            ),
+            Case(
+                "the QoS of the peak's publisher",
+                lambda: _imu_qos(run(20.0)[3], cls.__name__),
+                "create the publisher with imu_qos(), as the statement asks.",
+                True,
+            ),
+        ]
     return grade(
         "Exercise 4.1, the peak of each period",
         [
@@ -217,6 +307,7 @@ def check_peak_publisher(cls) -> Result:
                 f"{cls.__name__}.unconfigure()",
                 lambda: _destroyed(run(20.0)[3], f"{cls.__name__}.unconfigure()", "peak_publisher"),
             ),
+            *hidden,
         ],
     )
 
@@ -272,16 +363,18 @@ def check_collision_reporter(cls) -> Result:
     default 20) and no collision was reported in the ``holdoff`` s (default
     0.5) of simulated time before; the stamp and frame are the Imu
     message's, the vector its acceleration's horizontal part ``(x, y, 0)``.
+    Hidden cases: other rates, thresholds and holdoffs; a period exactly at
+    threshold (not above it); each report published right after its Imu
+    message; the publisher's QoS ``imu_qos()``.
     """
     from geometry_msgs.msg import Vector3Stamped
 
-    made: list = []  # each run's publisher of /Tank/collision, for the unconfigure() case
+    runs: dict = {}  # parameters -> (node, publisher, Imu messages, the indices of those reported)
 
-    def reports(parameters: dict):
-        where = ", ".join(f"{k}={v}" for k, v in parameters.items()) or "default parameters"
-        call = f"{cls.__name__} with {where}, the wall script for {DURATION} s"
-
-        def check():
+    def outcome(parameters: dict, call: str):
+        """Run with ``parameters`` (once) and compare the reports with the rule; raise CaseFailed if they differ."""
+        key = tuple(sorted(parameters.items()))
+        if key not in runs:
             node, _ = _drive("CollisionReporter", cls, parameters)
             imu = _imu_messages(node, call)
             publisher = _one_publisher(
@@ -292,54 +385,55 @@ def check_collision_reporter(cls) -> Result:
                 "create it in configure: config.node.create_publisher("
                 'Vector3Stamped, f"/{config.body_name}/collision", imu_qos()).',
             )
-            made.append(publisher)
-            got = publisher.messages()
-            threshold, holdoff = parameters.get("threshold", 20.0), parameters.get("holdoff", 0.5)
-            expected, last = [], None
-            for msg in imu:
-                a, t = msg.linear_acceleration, _stamp_ns(msg)
-                if math.hypot(a.x, a.y) > threshold and (last is None or t - last >= holdoff * 1e9):
-                    expected.append(msg)
-                    last = t
-            if not expected:
-                raise CaseFailed(
-                    f"{call}: the Imu messages show no collision at all; the tank "
-                    "should have hit the wall at about 2.05 s.",
-                    "keep RttImuStatePublisher's behaviour: call super().publish().",
-                )
-            at = [round(_stamp_ns(m) * 1e-9, 3) for m in got]
-            want = [round(_stamp_ns(m) * 1e-9, 3) for m in expected]
-            if len(got) != len(expected):
-                raise CaseFailed(
-                    f"{call} made {_reports(len(got))}, stamped t = {at} s; expected "
-                    f"{_reports(len(expected))}, at t = {want} s.",
-                    "report when hypot(x, y) of the mean is above threshold, and then not "
-                    "again until holdoff s of simulated time have passed since that report "
-                    "(a period above threshold that is not reported does not start it again).",
-                )
-            for report, msg, t in zip(got, expected, want):
-                a = msg.linear_acceleration
-                vector = [report.vector.x, report.vector.y, report.vector.z]
-                if _stamp_ns(report) != _stamp_ns(msg):
-                    raise CaseFailed(
-                        f"{call}: the report of the Imu message of t = {t} s is stamped "
-                        f"{_stamp_ns(report) * 1e-9:.3f} s.",
-                        "copy the Imu message's header (stamp and frame_id).",
-                    )
-                if report.header.frame_id != msg.header.frame_id:
-                    raise CaseFailed(
-                        f"{call}: the report at t = {t} s has frame_id "
-                        f"{report.header.frame_id!r}, expected {msg.header.frame_id!r}.",
-                        "the vector is in the IMU's frame: use the Imu message's frame_id.",
-                    )
-                if max(abs(g - e) for g, e in zip(vector, [a.x, a.y, 0.0])) > 1e-9:
-                    raise CaseFailed(
-                        f"{call}: the report at t = {t} s carries {show(vector)}, expected {show([a.x, a.y, 0.0])}.",
-                        "the vector is the mean acceleration's horizontal part: (x, y, 0).",
-                    )
+            runs[key] = (node, publisher, imu, _compare_reports(call, parameters, imu, publisher.messages()))
+        return runs[key]
 
-        return Case(call, check)
+    def reports(parameters: dict, label: str = ""):
+        where = ", ".join(f"{k}={v}" for k, v in parameters.items()) or "default parameters"
+        call = label or f"{cls.__name__} with {where}, the wall script for {DURATION} s"
+        hint = "above threshold, then not again for holdoff s of self.data.time: time, not a count of messages."
+        return Case(call, lambda: outcome(parameters, call), hint if label else "", bool(label))
 
+    def exactly_at_threshold(holdoff: float):
+        """Threshold: the horizontal mean of one Imu message of the default run; holdoff: less than a period."""
+        _, _, imu, _ = outcome({}, cls.__name__)
+        outcome({"threshold": _exact_threshold(imu), "holdoff": holdoff}, cls.__name__)
+
+    def right_after(parameters: dict):
+        node, _, _, reported = outcome(parameters, cls.__name__)
+        if _follows(node, "/Tank/collision") != reported:
+            raise CaseFailed(f"{cls.__name__}: a report was not published right after its Imu message.")
+
+    hidden = []
+    rng = hidden_random("4.2")  # while grading: this learner's own parameters, judged by the same rule
+    if rng:
+        # a faster rate with a holdoff of many periods, then a slower one: time, not a count of messages.
+        # From 9.5 to 15 Hz the hit's period is above 13 m/s^2 (below 9.5 Hz it may be diluted to 12).
+        low = {"rate": rng.uniform(30, 50), "threshold": rng.uniform(2.5, 5), "holdoff": _half_step(rng, 150, 400)}
+        hit = {"rate": rng.uniform(9.5, 15), "threshold": rng.uniform(5, 10), "holdoff": _half_step(rng, 20, 600)}
+        tiny = _half_step(rng, 2, 45)  # a holdoff shorter than the default period: each period above is reported
+        hidden = [
+            reports(low, "driving hard: a faster rate, a low threshold, a longer holdoff"),
+            reports(hit, "the hit: a slower rate, another threshold and holdoff"),
+            Case(
+                "a period exactly at threshold is not above it",
+                lambda: exactly_at_threshold(tiny),
+                "above threshold means hypot(x, y) > threshold: a period exactly at it is no collision.",
+                True,
+            ),
+            Case(
+                "each report published right after its Imu message",
+                lambda: right_after(low),
+                "report in publish(), after super().publish(): the Imu message first, then its report.",
+                True,
+            ),
+            Case(
+                "the QoS of the collision publisher",
+                lambda: _imu_qos(outcome({}, cls.__name__)[1], cls.__name__),
+                "create the publisher with imu_qos(), as the statement asks.",
+                True,
+            ),
+        ]
     return grade(
         "Exercise 4.2, report collisions",
         [
@@ -351,7 +445,69 @@ def check_collision_reporter(cls) -> Result:
             reports({"threshold": 3.0, "holdoff": 0.12}),
             Case(
                 f"{cls.__name__}.unconfigure()",
-                lambda: _destroyed(made[0], f"{cls.__name__}.unconfigure()", "collision_publisher"),
+                lambda: _destroyed(
+                    outcome({}, cls.__name__)[1], f"{cls.__name__}.unconfigure()", "collision_publisher"
+                ),
             ),
+            *hidden,
         ],
     )
+
+
+def _compare_reports(call: str, parameters: dict, imu, got) -> list[int]:
+    """CaseFailed unless ``got`` are the reports the rule makes of ``imu``; the indices of the Imu messages reported."""
+    threshold, holdoff = parameters.get("threshold", 20.0), parameters.get("holdoff", 0.5)
+    reported, last = [], None
+    for k, msg in enumerate(imu):
+        a, t = msg.linear_acceleration, _stamp_ns(msg)
+        if math.hypot(a.x, a.y) > threshold and (last is None or t - last >= holdoff * 1e9):
+            reported.append(k)
+            last = t
+    expected = [imu[k] for k in reported]
+    if not expected:
+        raise CaseFailed(
+            f"{call}: the Imu messages show no collision at all; the tank should have hit the wall at about 2.05 s.",
+            "keep RttImuStatePublisher's behaviour: call super().publish().",
+        )
+    at = [round(_stamp_ns(m) * 1e-9, 3) for m in got]
+    want = [round(_stamp_ns(m) * 1e-9, 3) for m in expected]
+    if len(got) != len(expected):
+        raise CaseFailed(
+            f"{call} made {_reports(len(got))}, stamped t = {at} s; expected "
+            f"{_reports(len(expected))}, at t = {want} s.",
+            "report when hypot(x, y) of the mean is above threshold, and then not "
+            "again until holdoff s of simulated time have passed since that report "
+            "(a period above threshold that is not reported does not start it again).",
+        )
+    for report, msg, t in zip(got, expected, want):
+        a, stamp, should = msg.linear_acceleration, report.header.stamp, msg.header.stamp
+        vector = [report.vector.x, report.vector.y, report.vector.z]
+        if (stamp.sec, stamp.nanosec) != (should.sec, should.nanosec):  # nanosec is below 1 s, sec the rest
+            raise CaseFailed(
+                f"{call}: the report of the Imu message of t = {t} s is stamped sec={stamp.sec}, "
+                f"nanosec={stamp.nanosec}; expected sec={should.sec}, nanosec={should.nanosec}.",
+                "copy the Imu message's header (stamp and frame_id).",
+            )
+        if report.header.frame_id != msg.header.frame_id:
+            raise CaseFailed(
+                f"{call}: the report at t = {t} s has frame_id "
+                f"{report.header.frame_id!r}, expected {msg.header.frame_id!r}.",
+                "the vector is in the IMU's frame: use the Imu message's frame_id.",
+            )
+        if max(abs(g - e) for g, e in zip(vector, [a.x, a.y, 0.0])) > 1e-9:
+            raise CaseFailed(
+                f"{call}: the report at t = {t} s carries {show(vector)}, expected {show([a.x, a.y, 0.0])}.",
+                "the vector is the mean acceleration's horizontal part: (x, y, 0).",
+            )
+    return reported
+
+
+def _exact_threshold(imu) -> float:
+    """The horizontal mean of an Imu message below the largest, the same by every usual way to compute it
+    (``math.hypot``, ``math.sqrt(x * x + y * y)``, ``numpy.hypot``, ``numpy.linalg.norm``)."""
+    means = sorted(((m.linear_acceleration.x, m.linear_acceleration.y) for m in imu), key=_horizontal, reverse=True)
+    for x, y in means:
+        h = math.hypot(x, y)
+        if h < _horizontal(means[0]) and h == math.sqrt(x * x + y * y) == np.hypot(x, y) == np.linalg.norm([x, y]):
+            return h
+    raise CaseFailed("the Imu messages have no mean that every way to compute hypot(x, y) gives alike.")

@@ -13,6 +13,15 @@ learner's class) headless on the calling thread, which plays the viewer's
 main thread, and hands it messages directly, as ``call_later`` would: no
 network, no wall-clock timing (the controller's ``clock`` is replaced by a
 simulated one), so the same code always gets the same line.
+
+While grading (:func:`tutorial.exercises.grader.hidden_random`) each check
+also runs hidden cases, drawn from the learner's seed: for 5.1, readings
+with the tank moved, tilted and turned any way, and an arrow exactly
+``ACCEL_MIN_LENGTH`` long; for 5.2, a stamp exactly 1 s older than the
+newest, and random runs of messages stamped past 1 s.
+
+The module is over 400 lines and still one job: the two checks share one
+headless viewer (``_viewer``) and the messages they hand it (``_imu``).
 """
 
 from __future__ import annotations
@@ -22,11 +31,12 @@ import math
 
 import numpy as np
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, show
 
 GREEN = (0.2, 0.8, 0.2)
 ARROW = "Tank/horizontal_acceleration"
 RESTART = 1.0  # s: a stamp further back than this is a restarted publisher
+GRID = 1_953_125  # ns, 1/512 s: hidden stamps are whole numbers of it, exact as float seconds too
 
 
 class _Clock:
@@ -72,12 +82,13 @@ def _viewer(cls, name: str):
         node.destroy_node()
 
 
-def _imu(accel, gyro=(0.0, 0.0, 0.0), stamp: float = 0.0, frame_id: str = "CHASSIS"):
+def _imu(accel, gyro=(0.0, 0.0, 0.0), stamp: float = 0.0, frame_id: str = "CHASSIS", stamp_ns: int | None = None):
     from sensor_msgs.msg import Imu
 
     msg = Imu()
     msg.header.frame_id = frame_id
-    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(round(stamp * 1e9), 1_000_000_000)
+    stamp_ns = round(stamp * 1e9) if stamp_ns is None else stamp_ns
+    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns, 1_000_000_000)
     a, w = msg.linear_acceleration, msg.angular_velocity
     a.x, a.y, a.z = (float(v) for v in accel)
     w.x, w.y, w.z = (float(v) for v in gyro)
@@ -86,10 +97,18 @@ def _imu(accel, gyro=(0.0, 0.0, 0.0), stamp: float = 0.0, frame_id: str = "CHASS
 
 def _turn_left(app, controller, angle: float) -> None:
     """Yaw the viewer's tank by ``angle`` rad about z (its root's orientation), main thread."""
+    _place(app, controller, orientation=[math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)])
+
+
+def _place(app, controller, position=None, orientation=None) -> None:
+    """Put the viewer's tank's root at ``position`` (m), turned by the quaternion ``orientation`` (w, x, y, z)."""
     from tutorial.controllers.imu_state_subscriber import root_position_address
 
     root = root_position_address(app.model, controller.body.root_id)
-    app.data.qpos[root + 3 : root + 7] = [math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)]
+    if position is not None:
+        app.data.qpos[root : root + 3] = position
+    if orientation is not None:
+        app.data.qpos[root + 3 : root + 7] = np.asarray(orientation) / np.linalg.norm(orientation)
     controller.body.notify_kinematic_state_change()
 
 
@@ -100,6 +119,9 @@ def check_horizontal_arrow(cls) -> Result:
     at the IMU; its vector is 0.1 m per m/s^2 of the reading's x and y (z = 0
     in the IMU's axes), turned into the world like the other two; hidden when
     shorter than 0.05 m; redrawn whenever the others are (the shake too).
+    Hidden cases: random readings with the tank moved, tilted and turned
+    (so the horizontal part in the IMU's axes is not the world's); an arrow
+    exactly 0.05 m long, shown.
     """
     name = cls.__name__
 
@@ -184,10 +206,50 @@ def check_horizontal_arrow(cls) -> Result:
                     "draw it in draw_arrows(), which the shake tick calls too, not in update_imu().",
                 )
 
+    def readings(poses, accels):
+        """Each reading with the tank placed at its pose: the arrow, by the statement's rule."""
+        with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
+            arrow = arrow_of(app)
+            for (position, orientation), accel in zip(poses, accels):
+                _place(app, controller, position, orientation)
+                controller.update_imu(_imu(accel), clock())
+                horizontal = 0.1 * np.array([accel[0], accel[1], 0.0])
+                to_world = app.data.site_xmat[controller.site].reshape(3, 3)
+                if not (
+                    np.allclose(arrow.origin, app.data.site_xpos[controller.site], atol=1e-9)
+                    and np.allclose(arrow.vector, to_world @ horizontal, atol=1e-9)
+                    and arrow.visible == (np.linalg.norm(horizontal) >= 0.05)
+                ):
+                    raise CaseFailed(f"{name}: the arrow of a reading is wrong.")
+
     hint_turn = (
         "the reading is in the IMU's axes: turn the vector into the world with "
         "self.data.site_xmat[self.site].reshape(3, 3) @ vector, as draw_arrows() does."
     )
+    hidden = []
+    rng = hidden_random("5.1")  # while grading: this learner's own poses and readings
+    for _ in range(3 if rng else 0):
+        poses = [([rng.uniform(-2, 2) for _ in "xyz"], [rng.gauss(0, 1) for _ in "wxyz"]) for _ in range(4)]
+        accels = [_reading(rng) for _ in poses]
+        hidden.append(
+            Case(
+                "readings with the tank moved, tilted and turned any way",
+                lambda poses=poses, accels=accels: readings(poses, accels),
+                "x and y of the reading in the IMU's axes, z set to zero, then turned into the world: on a "
+                "tilted tank that is not the world's horizontal part.",
+                True,
+            )
+        )
+    if rng:
+        exact = (*rng.choice(((0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5))), rng.uniform(5, 15))
+        hidden.append(
+            Case(
+                "an arrow exactly as long as ACCEL_MIN_LENGTH: shown",
+                lambda: readings([(None, [1.0, 0.0, 0.0, 0.0])], [exact]),
+                "hidden when shorter than ACCEL_MIN_LENGTH: an arrow exactly that long is shown (>=).",
+                True,
+            )
+        )
     return grade(
         "Exercise 5.1, a third arrow",
         [
@@ -215,8 +277,18 @@ def check_horizontal_arrow(cls) -> Result:
             ),
             Case(f"{name}.update_imu() of (3, 4, 11.8) m/s^2, then of a NaN", keeps_after_rejection),
             Case(f"{name}: a hit of (-30, 0, 9.8) m/s^2, then a shake tick 20 ms later", follows_the_shake),
+            *hidden,
         ],
     )
+
+
+def _reading(rng) -> tuple[float, float, float]:
+    """A random acceleration, m/s^2: a bump, a drive, or a hit; never within 1e-6 m of the shortest arrow shown."""
+    while True:
+        scale = rng.choice((0.6, 5.0, 40.0))
+        accel = (rng.uniform(-scale, scale), rng.uniform(-scale, scale), rng.uniform(0.0, 20.0))
+        if abs(0.1 * math.hypot(accel[0], accel[1]) - 0.05) > 1e-6:
+            return accel
 
 
 def check_in_order(cls) -> Result:
@@ -226,7 +298,10 @@ def check_in_order(cls) -> Result:
     refused: counted as ``rejected["out_of_order"]``, nothing drawn, no
     shake.  A stamp more than 1 s older than the newest is a restarted
     publisher: shown, and the newest from then on.  A message rejected for
-    another reason does not count as shown.
+    another reason does not count as shown.  Hidden cases: a stamp exactly
+    1 s older than the newest (refused), then one just over (shown); random
+    runs of stamps of many seconds, newer, late, repeated, restarted, NaN
+    and hits, each message's return value, arrow and shake judged.
     """
     name = cls.__name__
 
@@ -267,10 +342,56 @@ def check_in_order(cls) -> Result:
 
         return Case(call, run, hint)
 
+    def judged(label, messages, hint):
+        """A hidden case: ``messages`` ``[(stamp ns, "ok" | "nan" | "hit")]``, each judged by :func:`_judge`."""
+
+        def run():
+            newest, accel_x, hits, counts = None, None, 0, {}
+            with _viewer(cls, "InOrder") as (_, controller, clock):
+                for k, (stamp, kind) in enumerate(messages):
+                    accel = {"nan": math.nan, "hit": -30.0 - k}.get(kind, 1.0 + k)
+                    got = controller.update_imu(_imu((accel, 0.0, 9.8), stamp_ns=stamp), clock())
+                    reason, newest = _judge(newest, stamp, kind)
+                    if reason is None:
+                        accel_x, hits = 0.1 * accel, hits + (kind == "hit")
+                    else:
+                        counts[reason] = counts.get(reason, 0) + 1
+                    if not (got is None if reason is None else type(got) is str and got == reason):
+                        raise CaseFailed(f"{name}.update_imu() returned {got!r}, expected {reason!r}.")
+                    if accel_x is not None and abs(controller.accel_arrow.vector[0] - accel_x) > 1e-9:
+                        raise CaseFailed(f"{name}: the arrow does not show the newest message shown.")
+                summary = controller.summary()
+            want = (len(messages) - sum(counts.values()), dict(sorted(counts.items())), hits)
+            if (summary["accepted"], summary["rejected"], summary["hits"]) != want:
+                raise CaseFailed(f"{name}: the summary {summary} counts otherwise.")
+
+        return Case(label, run, hint, True)
+
     refuse = (
         "a stamp not newer than the newest shown is refused: count self.rejected['out_of_order'] "
         '+= 1 and return "out_of_order" before super().update_imu() can show it.'
     )
+    hidden = []
+    rng = hidden_random("5.2")  # while grading: this learner's own stamps, judged by the statement's rule
+    if rng:
+        first = rng.randrange(512, 512 * 60) * GRID  # 1 s to 60 s, with nanoseconds
+        newest = first + rng.randrange(1, 100) * GRID
+        back = [(first, "ok"), (newest, "ok"), (newest - 512 * GRID, "ok"), (newest - 513 * GRID, "ok")]
+        hidden.append(
+            judged(
+                "a stamp exactly a second older than the newest, then one just over a second older",
+                back + [(newest - 513 * GRID + GRID * rng.randrange(1, 50), "ok")],
+                "exactly a second older is not more than a second: refuse it; just over is a restarted publisher.",
+            )
+        )
+        for _ in range(5):
+            hidden.append(
+                judged(
+                    "a random run of messages: newer, late, repeated, restarted, NaN and hits",
+                    _messages(rng, 14),
+                    "follow each rule of the statement, for every message, in order; return what it says.",
+                )
+            )
     return grade(
         "Exercise 5.2, refuse old news",
         [
@@ -325,5 +446,36 @@ def check_in_order(cls) -> Result:
                 hits=(1,),
                 hint="a message in order is shown as before, and a hit still shakes.",
             ),
+            *hidden,
         ],
     )
+
+
+def _judge(newest: int | None, stamp: int, kind: str) -> tuple[str | None, int | None]:
+    """The statement's rule for one message (stamps in ns): ``(the reason it is refused or None, the newest)``."""
+    if newest is not None and newest - RESTART * 1e9 <= stamp <= newest:
+        return "out_of_order", newest
+    if kind == "nan":
+        return "not_finite", newest
+    return None, stamp
+
+
+def _messages(rng, n: int) -> list[tuple[int, str]]:
+    """Random messages ``(stamp ns, kind)`` from a first one of 1 to 60 s on: newer, late (less than a second),
+    the same stamp, exactly a second back, restarted (more than a second back), a NaN (newer), hits."""
+    newest = rng.randrange(512, 512 * 60) * GRID
+    messages = [(newest, "ok")]
+    for _ in range(n - 1):
+        how = rng.choice(("newer", "newer", "newer", "late", "late", "same", "second", "restart", "nan"))
+        stamp = {
+            "newer": newest + rng.randrange(1, 100) * GRID,
+            "late": newest - rng.randrange(1, 512) * GRID,
+            "same": newest,
+            "second": newest - 512 * GRID,
+            "restart": rng.randrange(0, max(newest // GRID - 512, 1)) * GRID,
+            "nan": newest + rng.randrange(1, 100) * GRID,
+        }[how]
+        kind = "nan" if how == "nan" else rng.choice(("ok", "ok", "ok", "hit"))
+        messages.append((stamp, kind))
+        newest = _judge(newest, stamp, kind)[1]
+    return messages

@@ -6,29 +6,24 @@ Exercise 6.2, publish the CameraInfo: a subclass that also publishes the
 camera's ``sensor_msgs/CameraInfo`` (pinhole calibration from the field of
 view) on ``/<body>/camera/camera_info``, one with each picture, stamped alike.
 
-The learner's controller is configured on the tank and this thread plays
-the simulation thread, as ``tests/test_camera_publisher.py`` does: it poses
-the turret, calls ``control()`` up to the step a picture is due, and waits
-until the controller's own render thread has published it (captured
-in-process, :mod:`tutorial.exercises.capture`) before going on.  So no
-picture is skipped, and each is compared with one this check renders from
-the same pose: the same answer on every run.
+Each check drives the learner's controller on the tank, picture by picture
+(:mod:`tutorial.exercises.camera_rig`): no picture is skipped, and each is
+compared with one rendered from the same pose, so every run gets the same
+answer.  While grading, each check also drives a camera drawn per learner
+(:func:`_random_camera`, its hidden cases): another size, field of view and
+name, on a tank of another name, from a start past a second, the turret at
+random poses.
 """
 
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 
-from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, show
+from tutorial.exercises.camera_rig import KINECT, Camera, drive, references
+from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, show
 
-STEP = 0.001  # s, the simulation step
-RATE = 10.0  # pictures per simulated second in the checks: one every 100 steps
-WAIT = 20.0  # s of wall time for a picture to be published
-IMAGE_TOPIC, INFO_TOPIC = "/Tank/camera/image", "/Tank/camera/camera_info"
 LUMA = (0.299, 0.587, 0.114)  # ITU-R BT.601 weights of R, G, B
 OFF_BY_ONE = 0.01  # share of a gray picture's pixels that may be off by one (rounding at .5 done otherwise)
 # Where the turret points for each picture: (label, TURRET_Y, TURRET_P), rad.
@@ -41,232 +36,132 @@ POSES = [
 ]
 
 
-class _Rig:
-    """The learner's camera controller on the tank; the calling thread plays the simulation thread.
+def _random_camera(rng) -> Camera:
+    """Another camera, by the statements' rules: its size (landscape or portrait), field of view and name, its
+    body's name, and a start of a second or more, past the half second (where rounding the seconds fails), below
+    four (where a whole time in nanosec would not fit its 32 bits: it is judged, not refused by the message)."""
+    start = rng.randrange(1, 4) + round(rng.uniform(0.5, 0.7), 3)
+    size = rng.randrange(64, 241), rng.randrange(48, 181)
+    return Camera(rng.choice(("Scout", "Rover")), rng.choice(("Eye", "Xtion")), *size, rng.uniform(30, 100), start)
 
-    Args:
-        cls: the controller class; it is configured with ``rate`` = :data:`RATE`
-            and its other parameters' defaults.
 
-    Raises:
-        CaseFailed: ``configure``, ``initialize`` or ``start`` refused.
-        NotImplementedError: the learner's code is not written yet.
+def _stamp_fault(header, t: float) -> str | None:
+    """What is wrong with ``header``'s stamp for ``t`` s, or None: whole seconds in ``sec``, the rest in
+    ``nanosec`` (below a second), to the nanosecond (truncated or rounded)."""
+    from tutorial.interfaces.timing import stamp_parts
+
+    sec, nanosec = header.stamp.sec, header.stamp.nanosec
+    if 0 <= nanosec < 1_000_000_000 and abs(sec * 1e9 + nanosec - t * 1e9) <= 1:
+        return None
+    return f"stamped sec={sec}, nanosec={nanosec}, expected {t:.3f} s as sec, nanosec = {stamp_parts(t)}"
+
+
+def _gray_fault(msg, t: float, colour: np.ndarray, camera: Camera) -> tuple[str, str, str] | None:
+    """The first way a gray picture is wrong, ``(rule, what, hint)``, or None.
+
+    ``rule``: ``layout`` (encoding, size, step, is_bigendian), ``frame``, ``stamp`` or ``pixels``.
     """
-
-    def __init__(self, cls):
-        import mujoco
-        import rclpy
-
-        from tutorial.core.body import Body
-        from tutorial.core.controller import ControllerConfig, ControllerIO
-        from tutorial.core.world import build_world
-        from tutorial.notebook.runs import load
-
-        self.name = cls.__name__
-        self.model = build_world(load("tank_world.yaml").models, time_step=STEP)
-        self.node = CapturingNode(rclpy.create_node("exercise_check_camera"))
-        self.controller = cls()
-        self.configured = False
-        parameters = {name: default for name, (_, default, _) in cls.PARAMETERS.items()}
-        parameters["rate"] = RATE
-        main_body = Body(self.model, mujoco.MjData(self.model), "Tank")
-        config = ControllerConfig(name=self.name, body=main_body, node=self.node, parameters=parameters)
-        try:
-            self.configured = bool(self.controller.configure(config))
-        finally:
-            if not self.configured:
-                self.close()
-        if not self.configured:
-            raise CaseFailed(
-                f"{self.name}.configure returned False.",
-                "return what RttCameraImagePublisher.configure returned, and True after your own setup.",
-            )
-        self.data = mujoco.MjData(self.model)  # the simulation's
-        io = ControllerIO(body=Body(self.model, self.data, "Tank"), time_step=STEP, node=self.node, data=self.data)
-        if not self.controller.initialize(io) or not self.controller.start():
-            self.close()
-            raise CaseFailed(f"{self.name}.initialize or start returned False.")
-        self.turret = [self.model.joint(f"Tank/{j}").qposadr[0] for j in ("TURRET_Y", "TURRET_P")]
-        self.steps = 0
-        self.poses: list[tuple[float, np.ndarray]] = []  # (time, qpos) of each picture due
-
-    def images(self):
-        """The capturing publisher of the camera's Image topic (the first one made)."""
-        pubs = self.node.published(IMAGE_TOPIC)
-        if not pubs:
-            topics = [p.topic for p in self.node.published()]
-            raise CaseFailed(
-                f"{self.name} made no publisher of {IMAGE_TOPIC} (it made {topics}).",
-                "let RttCameraImagePublisher.configure create it: call super().configure(config).",
-            )
-        return pubs[0]
-
-    def picture(self, turret_y: float, turret_p: float) -> None:
-        """Pose the turret, step to the next picture, and wait until it is published."""
-        self.data.qpos[self.turret[0]], self.data.qpos[self.turret[1]] = turret_y, turret_p
-        steps = 1 if self.steps == 0 else round(1 / (RATE * STEP))  # due at t = 0, then every 0.1 s
-        for _ in range(steps):
-            t = self.data.time
-            if not self.controller.control():
-                raise CaseFailed(
-                    f"{self.name}.control() returned False at t = {t:.3f} s: {self._error() or 'no error was set'}."
-                )
-            self.steps += 1
-            self.data.time = self.steps * STEP
-        self.poses.append((t, self.data.qpos.copy()))
-        wanted = len(self.poses)
-        deadline = time.monotonic() + WAIT
-        while len(self.images().sent) < wanted:
-            if self._error():
-                raise CaseFailed(f"{self.name}: the render thread failed: {self._error()}.")
-            if time.monotonic() > deadline:
-                raise CaseFailed(
-                    f"{self.name}: the picture due at t = {t:.3f} s was not published within {WAIT:.0f} s.",
-                    "publish_image must publish the message it fills.",
-                )
-            time.sleep(0.005)
-
-    def _error(self) -> str | None:
-        error = getattr(self.controller, "error", None)
-        if error and "NotImplementedError" in error:
-            raise NotImplementedError(error)
-        return error
-
-    def close(self) -> None:
-        """Stop the controller as the simulation would, end its render thread, remove the node."""
-        from tutorial.controllers.camera_image_publisher import RttCameraImagePublisher
-
-        c = self.controller
-        try:
-            if getattr(self, "steps", 0):
-                c.stop()
-            if self.configured:
-                c.unconfigure()
-        finally:
-            if getattr(c, "thread", None) is not None and c.thread.is_alive():
-                RttCameraImagePublisher.finish_rendering(c)  # a broken unconfigure must not leave it running
-                c.thread.join(5.0)
-            self.node.destroy_node()
-
-
-def _drive(cls, poses=POSES) -> _Rig:
-    """Configure ``cls``, take one picture per pose, close; the rig, with everything captured."""
-    rig = _Rig(cls)
-    try:
-        for _, turret_y, turret_p in poses:
-            rig.picture(turret_y, turret_p)
-    finally:
-        rig.close()
-    return rig
-
-
-def _references(model, poses: list[tuple[float, np.ndarray]]) -> list[np.ndarray]:
-    """``(H, W, 3)`` uint8 pictures of the Kinect at each ``(time, qpos)``, rendered on this thread."""
-    import mujoco
-
-    from tutorial.controllers.camera_image_publisher import render_snapshot
-    from tutorial.core.simulator import Snapshot
-
-    cam = model.camera("Tank/Kinect").id
-    width, height = (int(v) for v in model.cam_resolution[cam])
-    renderer = mujoco.Renderer(model, height, width)
-    try:
-        data = mujoco.MjData(model)
-        return [render_snapshot(renderer, data, Snapshot(t, q, 0), cam).copy() for t, q in poses]
-    finally:
-        renderer.close()
-
-
-def _stamp(msg) -> float:
-    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+    expected = {
+        "encoding": ("mono8", "a gray picture of one byte a pixel is mono8."),
+        "height": (
+            camera.height,
+            "height is the number of rows, width the pixels in a row: gray.shape is (rows, columns).",
+        ),
+        "width": (camera.width, "height is the number of rows, width the pixels in a row."),
+        "step": (camera.width, "step is the bytes in one row: one byte a pixel, so the width."),
+        "is_bigendian": (0, "set is_bigendian to 0."),
+    }
+    for name, (want, hint) in expected.items():
+        if getattr(msg, name) != want:
+            return "layout", f"{name} was {getattr(msg, name)!r}, expected {want!r}", hint
+    if msg.header.frame_id != camera.name:
+        hint = "keep the frame_id RttCameraImagePublisher.configure set: reuse self.msg."
+        return "frame", f"frame_id was {msg.header.frame_id!r}, expected {camera.name!r}", hint
+    size = camera.width * camera.height
+    if len(msg.data) != size:
+        return (
+            "layout",
+            f"data has {len(msg.data)} bytes, expected step x height = {size}",
+            "one byte a pixel: the gray array as uint8.",
+        )
+    stamp = _stamp_fault(msg.header, t)
+    if stamp:
+        return "stamp", stamp, "stamp each picture with its time_s: stamp_parts(time_s)."
+    gray = np.frombuffer(bytes(msg.data), np.uint8).reshape(camera.height, camera.width).astype(int)
+    want = np.round(colour @ np.array(LUMA)).astype(int)
+    off = np.abs(gray - want)
+    # Off by one: integer arithmetic (OpenCV's) may round a luma a hair from .5 the other way, a
+    # pixel in a thousand; truncating instead of rounding puts about half the pixels there.
+    few_ones = np.count_nonzero(off == 1) <= OFF_BY_ONE * gray.size
+    wrong = np.argwhere(off > 1) if (off > 1).any() or few_ones else np.argwhere(off == 1)
+    if not len(wrong):
+        return None
+    r, c = (int(v) for v in wrong[0])
+    return (
+        "pixels",
+        f"{len(wrong)} of {gray.size} pixels are off by {'more than ' if off[r, c] > 1 else ''}1, e.g. row {r}, "
+        f"column {c} is {gray[r, c]}, expected {want[r, c]} (R, G, B = {show([int(v) for v in colour[r, c]])})",
+        "gray = 0.299 R + 0.587 G + 0.114 B, rounded (np.round: astype alone cuts the fraction off): "
+        "green counts most, blue least.",
+    )
 
 
 def check_gray_camera(cls) -> Result:
     """Check a ``RttCameraImagePublisher`` subclass that publishes ``mono8`` pictures.
 
-    Each picture: ``encoding`` ``mono8``, 320 x 240, ``step`` = width (one
-    byte a pixel), ``is_bigendian`` 0, ``frame_id`` ``Kinect``, stamped with
-    the simulation time it was due at, each pixel ``0.299 R + 0.587 G +
-    0.114 B`` of the colour picture, rounded (within 1, and off by 1 in at most 1 % of the pixels).
+    Each picture: ``encoding`` ``mono8``, the camera's size (320 x 240 for
+    the Kinect), ``step`` = width (one byte a pixel), ``is_bigendian`` 0,
+    ``frame_id`` the camera's name (``Kinect``), stamped with the simulation
+    time it was due at (whole seconds in ``sec``, the rest in ``nanosec``),
+    each pixel ``0.299 R + 0.587 G + 0.114 B`` of the colour picture, rounded
+    (within 1, and off by 1 in at most 1 % of the pixels).  Hidden cases: the
+    same rules for a random camera (:func:`_random_camera`) at random poses.
     """
     from sensor_msgs.msg import Image
 
-    runs: list = []  # one drive serves every case
+    runs: dict = {}  # one drive a camera serves every case
 
-    def drive():
-        if not runs:
-            rig = _drive(cls)
+    def shots(camera: Camera, poses):
+        if camera not in runs:
+            rig = drive(cls, camera, poses)
             pub = rig.images()
             if pub.msg_type is not Image:
-                raise CaseFailed(
-                    f"{rig.name} publishes {pub.msg_type.__name__} on {IMAGE_TOPIC}, expected sensor_msgs/Image."
-                )
-            runs.append((pub.messages(), rig.poses, _references(rig.model, rig.poses)))
-        return runs[0]
+                raise CaseFailed(f"{rig.name} publishes {pub.msg_type.__name__} on {pub.topic}, expected an Image.")
+            runs[camera] = [(m, t, c) for m, (t, _), c in zip(pub.messages(), rig.poses, references(rig))]
+        return runs[camera]
 
-    def picture(k: int, label: str):
+    def picture(k: int, label: str) -> Case:
         call = f"{cls.__name__}, picture {k + 1} ({label}, t = {0.1 * k:.1f} s)"
 
         def run():
-            messages, poses, references = drive()
-            msg, (t, _), colour = messages[k], poses[k], references[k]
-            fields = {
-                "encoding": msg.encoding,
-                "height": msg.height,
-                "width": msg.width,
-                "step": msg.step,
-                "is_bigendian": msg.is_bigendian,
-                "frame_id": msg.header.frame_id,
-            }
-            expected = {
-                "encoding": "mono8",
-                "height": 240,
-                "width": 320,
-                "step": 320,
-                "is_bigendian": 0,
-                "frame_id": "Kinect",
-            }
-            hints = {
-                "encoding": "a gray picture of one byte a pixel is mono8.",
-                "step": "step is the bytes in one row: one byte a pixel, so the width.",
-                "height": "height is the number of rows, width the pixels in a row: gray.shape is (rows, columns).",
-                "width": "height is the number of rows, width the pixels in a row.",
-                "is_bigendian": "set is_bigendian to 0.",
-                "frame_id": "keep the frame_id RttCameraImagePublisher.configure set: reuse self.msg.",
-            }
-            for name, want in expected.items():
-                if fields[name] != want:
-                    raise CaseFailed(f"{call}: {name} was {fields[name]!r}, expected {want!r}.", hints[name])
-            if len(msg.data) != 320 * 240:
-                raise CaseFailed(
-                    f"{call}: data has {len(msg.data)} bytes, expected step x height = 76800.",
-                    "one byte a pixel: the gray array as uint8.",
-                )
-            if abs(_stamp(msg) - t) > 1e-9:
-                raise CaseFailed(
-                    f"{call}: stamped {_stamp(msg):.3f} s, expected {t:.3f} s.",
-                    "stamp each picture with its time_s: stamp_parts(time_s).",
-                )
-            gray = np.frombuffer(bytes(msg.data), np.uint8).reshape(240, 320).astype(int)
-            want = np.round(colour @ np.array(LUMA)).astype(int)
-            off = np.abs(gray - want)
-            # Off by one: integer arithmetic (OpenCV's) may round a luma a hair from .5 the other way, a
-            # pixel in a thousand; truncating instead of rounding puts about half the pixels there.
-            few_ones = np.count_nonzero(off == 1) <= OFF_BY_ONE * gray.size
-            wrong = np.argwhere(off > 1) if (off > 1).any() or few_ones else np.argwhere(off == 1)
-            if len(wrong):
-                r, c = (int(v) for v in wrong[0])
-                raise CaseFailed(
-                    f"{call}: {len(wrong)} of {gray.size} pixels are off by {'more than ' if off[r, c] > 1 else ''}1,"
-                    f" e.g. row {r}, column {c} is {gray[r, c]}, expected {want[r, c]} (R, G, B = "
-                    f"{show([int(v) for v in colour[r, c]])}).",
-                    "gray = 0.299 R + 0.587 G + 0.114 B, rounded (np.round: astype alone cuts the fraction off): "
-                    "green counts most, blue least.",
-                )
+            fault = _gray_fault(*shots(KINECT, POSES)[k], KINECT)
+            if fault:
+                raise CaseFailed(f"{call}: {fault[1]}.", fault[2])
 
         return Case(call, run)
 
-    return grade("Exercise 6.1, a gray camera", [picture(k, label) for k, (label, _, _) in enumerate(POSES)])
+    def hidden_case(camera: Camera, poses, rule: str, call: str, hint: str) -> Case:
+        def run():  # a picture's first fault names the rule it breaks: that rule's case fails
+            for shot in shots(camera, poses):
+                fault = _gray_fault(*shot, camera)
+                if fault and fault[0] == rule:
+                    raise CaseFailed(call, hint)
+
+        return Case(call, run, hint, hidden=True)
+
+    cases = [picture(k, label) for k, (label, _, _) in enumerate(POSES)]
+    rng = hidden_random("6.1")  # while grading: this learner's own camera and poses
+    if rng:
+        camera = _random_camera(rng)
+        poses = [("", rng.uniform(-math.pi, math.pi), rng.uniform(-0.15, 0.75)) for _ in range(3)]
+        for rule, call, hint in [
+            ("layout", "a camera of another size: encoding, height, width, step", "take the size from the picture."),
+            ("frame", "a camera of another name: the frame_id", "reuse self.msg: its frame_id is the camera's."),
+            ("stamp", "stamps of a second or more: sec and nanosec", "whole seconds in sec, the rest in nanosec."),
+            ("pixels", "the turret at random poses: each pixel's luma", "the luma of each pixel, rounded."),
+        ]:
+            cases.append(hidden_case(camera, poses, rule, call, hint))
+    return grade("Exercise 6.1, a gray camera", cases)
 
 
 def expected_camera_info(width: int, height: int, fovy_deg: float) -> dict:
@@ -289,71 +184,67 @@ def check_camera_info(cls) -> Result:
     """Check a ``RttCameraImagePublisher`` subclass that also publishes ``sensor_msgs/CameraInfo``.
 
     Topic ``/<body>/camera/camera_info``, the camera's QoS (best effort, keep
-    last 1), one CameraInfo with each Image, with its stamp and ``frame_id``;
-    320 x 240, ``plumb_bob`` with five zero distortion coefficients, and
-    ``k``, ``r``, ``p`` as :func:`expected_camera_info` gives them.
+    last 1, volatile), one CameraInfo with each Image, with its stamp and
+    ``frame_id``; the camera's size (320 x 240 for the Kinect), ``plumb_bob``
+    with five zero distortion coefficients, and ``k``, ``r``, ``p`` as
+    :func:`expected_camera_info` gives them for the camera's size and field of
+    view.  Hidden cases: the same rules for a random camera (:func:`_random_camera`).
     """
-    from rclpy.qos import ReliabilityPolicy
     from sensor_msgs.msg import CameraInfo
 
-    runs: list = []  # one drive serves every case
+    from tutorial.interfaces.image import camera_image_qos
+
+    runs: dict = {}  # one drive a camera serves every case
     name = cls.__name__
 
-    def drive():
-        if not runs:
-            rig = _drive(cls)
-            images = rig.images().messages()
-            pubs = rig.node.published(INFO_TOPIC)
+    def published(camera: Camera):
+        if camera not in runs:
+            rig = drive(cls, camera, POSES)
+            pubs = rig.node.published(camera.topic("camera_info"))
             if len(pubs) != 1:
-                topics = [p.topic for p in rig.node.published()]
                 raise CaseFailed(
-                    f"{name} made publishers of {topics}, expected one of {INFO_TOPIC}.",
+                    f"{name} made publishers of {[p.topic for p in rig.node.published()]}, expected one of "
+                    f"{camera.topic('camera_info')}.",
                     'name it after the body: f"/{config.body_name}/camera/camera_info".',
                 )
-            cam = rig.model.camera("Tank/Kinect").id
-            runs.append((images, pubs[0], float(rig.model.cam_fovy[cam])))
-        return runs[0]
+            image = rig.images()  # destroyed by super().unconfigure(), after the render thread has ended
+            first = next((p for p in rig.node.destroyed if p is image or p is pubs[0]), None)
+            runs[camera] = (image.messages(), pubs[0], pubs[0].messages(), first is image)
+        return runs[camera]
 
-    def case(what: str, check, hint: str = "") -> Case:
-        call = f"{name}: {what}"
-        return Case(call, lambda: check(call), hint)
-
-    def one_with_each(call):
-        images, pub, _ = drive()
+    def one_with_each(call, camera):
+        images, pub, infos, _ = published(camera)
         if pub.msg_type is not CameraInfo:
+            raise CaseFailed(f"{call}: it publishes {pub.msg_type.__name__} on {pub.topic}, expected a CameraInfo.")
+        got, want = pub.real.qos_profile, camera_image_qos()
+        policies = [(q.reliability, q.history, q.depth, q.durability) for q in (got, want)]
+        if policies[0] != policies[1]:
+            said = [f"{q[0].name.lower()}, {q[1].name.lower()} {q[2]}, {q[3].name.lower()}" for q in policies]
             raise CaseFailed(
-                f"{call}: it publishes {pub.msg_type.__name__} on {INFO_TOPIC}, expected sensor_msgs/CameraInfo."
-            )
-        qos = pub.real.qos_profile
-        if qos.reliability != ReliabilityPolicy.BEST_EFFORT or qos.depth != 1:
-            raise CaseFailed(
-                f"{call}: it is published {qos.reliability.name.lower()}, depth {qos.depth}; "
-                "expected the camera's QoS (best effort, keep last 1).",
+                f"{call}: it is published {said[0]}; expected the camera's QoS ({said[1]}).",
                 "a subscriber takes the Image and its CameraInfo together: use camera_image_qos().",
             )
-        infos = pub.messages()
         if len(infos) != len(images):
             raise CaseFailed(
                 f"{call}: {len(infos)} CameraInfo were published with {len(images)} pictures.",
                 "publish one in publish_image, after the Image.",
             )
 
-    def stamps(call):
-        images, pub, _ = drive()
-        for k, (image, info) in enumerate(zip(images, pub.messages())):
-            if (_stamp(info), info.header.frame_id) != (_stamp(image), image.header.frame_id):
+    def stamps(call, camera):
+        images, _, infos, _ = published(camera)
+        for k, (image, info) in enumerate(zip(images, infos)):
+            got, want = (info.header.stamp, info.header.frame_id), (image.header.stamp, image.header.frame_id)
+            if got != want:
                 raise CaseFailed(
-                    f"{call}: CameraInfo {k + 1} is stamped {_stamp(info):.3f} s, frame "
-                    f"{info.header.frame_id!r}; its Image {_stamp(image):.3f} s, frame "
-                    f"{image.header.frame_id!r}.",
+                    f"{call}: CameraInfo {k + 1} is stamped {show((got[0].sec, got[0].nanosec))}, frame "
+                    f"{got[1]!r}; its Image {show((want[0].sec, want[0].nanosec))}, frame {want[1]!r}.",
                     "give each CameraInfo its Image's header: the same stamp and frame_id.",
                 )
 
-    def size(call):
-        _, pub, _ = drive()
-        info = pub.messages()[0]
+    def size(call, camera):
+        info = published(camera)[2][0]
         got = [info.width, info.height, info.distortion_model, [float(v) for v in info.d]]
-        want = [320, 240, "plumb_bob", [0.0] * 5]
+        want = [camera.width, camera.height, "plumb_bob", [0.0] * 5]
         if got != want:
             raise CaseFailed(
                 f"{call}: width, height, distortion_model, d were {show(got)}, expected {show(want)}.",
@@ -361,40 +252,59 @@ def check_camera_info(cls) -> Result:
             )
 
     def matrix(key: str):
-        def run(call):
-            _, pub, fovy = drive()
-            info = pub.messages()[0]
-            want = expected_camera_info(320, 240, fovy)[key]
+        def run(call, camera):
+            info = published(camera)[2][0]
+            want = expected_camera_info(camera.width, camera.height, camera.fovy)[key]
             got = [float(v) for v in getattr(info, key)]
             if not np.allclose(got, want, rtol=0, atol=1e-6):
-                raise CaseFailed(
-                    f"{call}: {key} was {show([round(v, 3) for v in got])}, expected "
-                    f"{show([round(v, 3) for v in want])}."
-                )
+                raise CaseFailed(f"{call}: {key} was {show([round(v, 3) for v in got])}, expected {show(want)}.")
 
         return run
 
-    def removed(call):  # the drive ended with unconfigure(); super().unconfigure() ends the render thread
-        drive()[1].require_destroyed(f"{name}.unconfigure()", "super().unconfigure() first, then destroy_publisher().")
+    def removed(call, camera):  # the drive ended with unconfigure()
+        _, pub, _, in_order = published(camera)
+        hint = "super().unconfigure() first (it ends the render thread), then destroy_publisher()."
+        pub.require_destroyed(f"{name}.unconfigure()", hint)
+        if not in_order:
+            raise CaseFailed(f"{call}: the CameraInfo publisher was destroyed before super().unconfigure().", hint)
 
-    return grade(
-        "Exercise 6.2, publish the CameraInfo",
-        [
-            case(f"one CameraInfo on {INFO_TOPIC} with each Image", one_with_each),
-            case("each CameraInfo has its Image's stamp and frame", stamps),
-            case("size and distortion", size),
-            case(
-                "k, from the vertical field of view",
-                matrix("k"),
-                "fy = (height / 2) / tan(fovy / 2), fovy in radians; fx = fy (square pixels); "
-                "cx = (width - 1) / 2, cy = (height - 1) / 2.",
+    def case(what: str, check, hint: str = "", camera: Camera = KINECT) -> Case:
+        call = f"{name}: {what}" if camera is KINECT else what
+        return Case(call, lambda: check(call, camera), hint, camera is not KINECT)
+
+    fovy_hint = "fy = (height / 2) / tan(fovy / 2), fovy in radians; fx = fy (square pixels); "
+    cases = [
+        case(f"one CameraInfo on {KINECT.topic('camera_info')} with each Image", one_with_each),
+        case("each CameraInfo has its Image's stamp and frame", stamps),
+        case("size and distortion", size),
+        case(
+            "k, from the vertical field of view",
+            matrix("k"),
+            fovy_hint + "cx = (width - 1) / 2, cy = (height - 1) / 2.",
+        ),
+        case("r, the identity", matrix("r"), "a single camera needs no rectifying rotation."),
+        case(
+            "p, k with a fourth column of zeros",
+            matrix("p"),
+            "p is the 3 x 4 matrix [k | 0], row by row: a single camera has no baseline.",
+        ),
+        case("unconfigure() removes the CameraInfo publisher", removed),
+    ]
+    rng = hidden_random("6.2")  # while grading: this learner's own camera
+    if rng:
+        camera = _random_camera(rng)
+        topic = "name the topic after the body, with the camera's QoS."
+        header = "give each CameraInfo its Image's header: the same stamp and frame_id."
+        for what, check, hint in [
+            (
+                "a tank of another name: one CameraInfo with each Image on its camera_info topic, the camera's QoS",
+                one_with_each,
+                topic,
             ),
-            case("r, the identity", matrix("r"), "a single camera needs no rectifying rotation."),
-            case(
-                "p, k with a fourth column of zeros",
-                matrix("p"),
-                "p is the 3 x 4 matrix [k | 0], row by row: a single camera has no baseline.",
-            ),
-            case("unconfigure() removes the CameraInfo publisher", removed),
-        ],
-    )
+            ("stamps of a second or more, a camera of another name: each CameraInfo's header", stamps, header),
+            ("a camera of another size: width and height", size, "the picture's size: self.width, self.height."),
+            ("another size and field of view: k", matrix("k"), "the camera's own field of view and size."),
+            ("another size and field of view: p", matrix("p"), "the camera's own field of view and size."),
+        ]:
+            cases.append(case(what, check, hint, camera))
+    return grade("Exercise 6.2, publish the CameraInfo", cases)
