@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+import shlex
 import subprocess
 import sys
 import threading
@@ -798,3 +799,39 @@ def test_the_edges_of_the_parameters_are_accepted(monkeypatch, parameters):
     rig = StandInRig(monkeypatch, parameters)
     assert rig.configured
     rig.controller.unconfigure()
+
+
+def without_opengl_libraries(command: list[str]) -> subprocess.CompletedProcess:
+    """``command`` run where libEGL and libOpenGL cannot be loaded (each hidden by an empty file, in a mount
+    namespace of its own), as on a minimal server or container, with ``MUJOCO_GL`` unset."""
+    found = subprocess.run(["ldconfig", "-p"], capture_output=True, text=True, check=True).stdout
+    libraries = sorted({line.split(" => ")[1] for line in found.splitlines() if "libEGL.so.1 " in line or
+                        "libOpenGL.so.0 " in line})  # fmt: skip
+    assert len(libraries) >= 2, found
+    hide = " && ".join(f"mount --bind /dev/null {path}" for path in libraries)
+    script = f"mount --make-rprivate / && {hide} && exec {' '.join(map(shlex.quote, command))}"
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    return subprocess.run(["unshare", "--mount", "sh", "-c", script], capture_output=True, text=True, timeout=120,
+                          cwd=ROOT, env=env)  # fmt: skip
+
+
+@pytest.mark.cross_process
+def test_without_opengl_libraries_step_2_runs_and_the_camera_says_what_to_install():
+    from tutorial import NO_OPENGL
+
+    if os.geteuid() != 0:
+        pytest.skip("hiding a library needs a mount namespace (root)")
+    step2 = without_opengl_libraries(
+        module_command("tutorial.tools.rtt_run", str(PROJECT / "step2.yaml"), "--headless", "--json", "--duration", "1")
+    )
+    assert step2.returncode == 0, step2.stderr[-2000:]
+    summary = [line for line in step2.stdout.splitlines() if '"event": "summary"' in line]
+    assert summary and '"simulated_time": 1.0' in summary[0], step2.stdout[-2000:]
+    step6 = without_opengl_libraries(
+        module_command("tutorial.tools.rtt_run", str(PROJECT / "step6.yaml"), "--headless", "--duration", "1")
+    )
+    assert step6.returncode == 1, step6.stdout + step6.stderr
+    first = step6.stderr.strip().splitlines()[0]
+    said = "cannot render camera Kinect offscreen (MUJOCO_GL=disable; without a display, use egl): "
+    assert first == said + NO_OPENGL
+    assert "Traceback" not in step6.stdout + step6.stderr

@@ -49,6 +49,7 @@ import time
 import mujoco
 import numpy as np
 
+from .. import NO_OPENGL
 from ..core.call_later import MainLoop
 from ..core.controller import ControllerConfig, ControllerIO, SimpleController
 from ..core.period import PeriodAccumulator
@@ -253,10 +254,11 @@ class RttCameraImagePublisher(SimpleController):
             self.loop = MainLoop()  # owned by this thread: runs what is handed over
         except Exception as exc:  # noqa: BLE001 - configure() reports it
             gl = os.environ.get("MUJOCO_GL", "unset")
+            # "disable": `import tutorial` found no EGL library
+            why = NO_OPENGL if gl == "disable" else f"{type(exc).__name__}: {exc}"
             self.error = (
                 f"cannot render camera {self.camera_name} offscreen "
-                f"(MUJOCO_GL={gl}; without a display, use egl): "
-                f"{type(exc).__name__}: {exc}"
+                f"(MUJOCO_GL={gl}; without a display, use egl): {why}"
             )
         self.ready.set()
         try:
