@@ -14,6 +14,10 @@
 #                       folder; a trial only) or "users" (each learner a Unix user of this machine; the hub
 #                       runs as root; RTT_HUB_PYTHON then names an environment every user can run)
 #   RTT_HUB_PYTHON      the Python of the learners' environment (default this project's .venv)
+#   RTT_HUB_IDLE_TIMEOUT  seconds without use after which a learner's server is stopped (default 3600);
+#                       RTT_HUB_ACTIVITY_INTERVAL how often the servers report their use (default 300 s)
+#   RTT_HUB_MEM_LIMIT, RTT_HUB_CPU_LIMIT, RTT_HUB_PIDS_LIMIT  each learner's server's memory (default 2G),
+#                       cores (default 1.0) and processes (default 500): course/limits.py
 #   RTT_HUB_DOMAINS     the ROS domains to give out, comma-separated (default: every one a server has, 1-101
 #                       and 215-232; tests pick their own)
 #   RTT_HUB_FRAME_RATE  the learners' live views' frames per second, at most (default 20: a server's CPU is
@@ -42,6 +46,7 @@ sys.path.insert(0, str(COURSE))
 
 from assignments import learner_notebook  # noqa: E402 - course/ is on the path only from here
 from domains import BOOK_NAME, DomainBook, DomainError, hub_state  # noqa: E402
+from limits import LimitedLocalProcessSpawner, LimitedSimpleLocalProcessSpawner  # noqa: E402
 
 c = get_config()  # noqa: F821 - JupyterHub provides it
 
@@ -79,11 +84,15 @@ c.Authenticator.allowed_users = set(LEARNERS)
 #   Kubernetes (Zero to JupyterHub):  pip install jupyterhub-kubespawner;  c.JupyterHub.spawner_class = "kubespawner"
 #   systemd units with resource limits:  pip install jupyterhub-systemdspawner;  c.JupyterHub.spawner_class = "systemd"
 # In a container or pod each learner has a network namespace of their own: set RTT_HUB_PER_LEARNER_NETWORK=1.
-if os.environ.get("RTT_HUB_SPAWNER", "simple") == "users":
-    c.JupyterHub.spawner_class = "localprocess"  # each learner's server runs as their Unix user
+# The local spawners here keep each learner's server in cgroups of its own (course/limits.py): memory, processes
+# and CPU, so one learner cannot take the class's server down.  Containers and pods get theirs from
+# DockerSpawner's or KubeSpawner's mem_limit and cpu_limit.
+UNIX_USERS = os.environ.get("RTT_HUB_SPAWNER", "simple") == "users"
+if UNIX_USERS:
+    c.JupyterHub.spawner_class = LimitedLocalProcessSpawner  # each learner's server runs as their Unix user
     c.LocalProcessSpawner.notebook_dir = "~"
 else:
-    c.JupyterHub.spawner_class = "simple"  # a trial only: no isolation between learners' files
+    c.JupyterHub.spawner_class = LimitedSimpleLocalProcessSpawner  # a trial: no isolation between learners' files
     c.SimpleLocalProcessSpawner.home_dir_template = str(STATE / "homes" / "{username}")
     if os.geteuid() == 0:  # a trial started as root (a container): Jupyter refuses root without this
         c.Spawner.args = ["--allow-root"]
@@ -92,6 +101,11 @@ c.Spawner.ip = "127.0.0.1"
 c.Spawner.default_url = "/lab/tree/notebooks/00_setup_check.ipynb"
 c.Spawner.http_timeout = 60  # s: a 2-core server starting several learners at once is slow
 c.Spawner.start_timeout = 120
+# Each learner's limits (course/limits.py): what Step 6's camera notebook needs with room to spare (its kernel
+# peaks near 0.5 GiB), a fifth of the processes a fork bomb would want, and one of the server's cores.
+c.Spawner.mem_limit = os.environ.get("RTT_HUB_MEM_LIMIT", "2G")
+c.Spawner.cpu_limit = float(os.environ.get("RTT_HUB_CPU_LIMIT", "1.0"))
+c.LimitedLocalProcessSpawner.pids_limit = int(os.environ.get("RTT_HUB_PIDS_LIMIT", "500"))
 c.Spawner.environment = {
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",  # a learner's nodes never look beyond this machine
     "PATH": f"{ENV_BIN}:/usr/local/bin:/usr/bin:/bin",  # rtt-* in the learner's terminals
@@ -144,12 +158,18 @@ SHELL = "/bin/bash" if Path("/bin/bash").exists() else "/bin/sh"
                 "jpserver_extensions": {
                     "nbgrader.server_extensions.formgrader": False,
                     "nbgrader.server_extensions.course_list": False,
+                    "own_ports": True,
                 },
                 "terminado_settings": {"shell_command": [SHELL]},
             }
         }
     )
     + "\n"
+)
+# A learner's Jupyter proxies (/user/NAME/proxy/PORT/) only the ports their own processes serve: not another
+# learner's meshcat page or server on this machine (course/own_ports.py).
+(LEARNER_CONFIG / "jupyter_server_config.py").write_text(
+    f"import sys\nsys.path.insert(0, {str(COURSE)!r})  # own_ports, a server extension (jupyter_server_config.json)\n"
 )
 for path in (LEARNER_CONFIG, LEARNER_CONFIG / "labconfig"):
     path.chmod(0o755)
@@ -186,7 +206,7 @@ def give_learner_their_domain_and_notebooks(spawner):
     spawner.environment["ROS_DOMAIN_ID"] = str(domain)
     spawner.environment["RTT_ASSIGNED_ROS_DOMAIN_ID"] = str(domain)  # the notebooks warn if it is changed
     spawner.log.info("learner %s: ROS domain %d", name, domain)
-    unix_user = c.JupyterHub.spawner_class == "localprocess"
+    unix_user = UNIX_USERS
     home = Path(pwd.getpwnam(name).pw_dir) if unix_user else Path(spawner.home_dir)
     # The learner's own copies, made once (their work is never overwritten): the notebooks, and what their
     # "Outside Jupyter" sections run from a terminal in the home folder (rtt-run project/step1.yaml, ...).
@@ -230,3 +250,32 @@ def _give_to_learner(path: Path, name: str, unix_user: bool) -> None:
 
 
 c.Spawner.pre_spawn_hook = give_learner_their_domain_and_notebooks
+
+# ---- idle culling: a learner's server nobody has used for IDLE_TIMEOUT seconds is stopped (with everything it
+# started: course/limits.py), by JupyterHub's own culler, a service of this hub.  Their notebooks stay in their
+# home and their ROS domain in the book: logging in again brings both back.  A server is used while a page of it
+# is open and talks to it (a notebook, a terminal, a live view) or a cell runs; a simulation left running in a
+# kernel nobody looks at is not use.  The servers tell the hub of their activity every ACTIVITY_INTERVAL s.
+IDLE_TIMEOUT = int(os.environ.get("RTT_HUB_IDLE_TIMEOUT", "3600"))
+ACTIVITY_INTERVAL = int(os.environ.get("RTT_HUB_ACTIVITY_INTERVAL", "300"))
+c.JupyterHub.last_activity_interval = ACTIVITY_INTERVAL
+c.Spawner.environment["JUPYTERHUB_ACTIVITY_INTERVAL"] = str(ACTIVITY_INTERVAL)
+c.JupyterHub.load_roles = [
+    {
+        "name": "idle-culler",
+        "scopes": ["list:users", "read:users:activity", "read:servers", "delete:servers"],
+        "services": ["idle-culler"],
+    }
+]
+c.JupyterHub.services = [
+    {
+        "name": "idle-culler",
+        "command": [
+            sys.executable,
+            "-m",
+            "jupyterhub_idle_culler",
+            f"--timeout={IDLE_TIMEOUT}",
+            f"--cull-every={max(1, min(300, IDLE_TIMEOUT // 4))}",
+        ],
+    }
+]

@@ -25,7 +25,7 @@ from conftest import ROOT
 sys.path.insert(0, str(ROOT / "course"))
 
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
-from hub import PASSWORD, Hub, Learner  # noqa: E402
+from hub import PASSWORD, Hub, KernelDied, Learner  # noqa: E402
 
 from netns import net, on  # noqa: E402,F401 - net: the network tier's fixture
 
@@ -66,6 +66,17 @@ def hub(tmp_path):
     h = Hub(tmp_path / "hub", ["learner-a", "learner-b", "learner-c"], DOMAINS)  # two domains, three learners
     yield h
     h.close()
+    assert h.cgroups_left == [], "a learner's server stopped without removing its cgroups (course/limits.py)"
+
+
+# A learner's cell that asks for 8 GiB, every page touched, stopping itself there (a limit must stop it sooner:
+# a missing limit fails the test, it does not take the machine down).
+MEMORY_HOG = """
+import numpy as np
+held = [np.ones(256 * 2**20, dtype=np.uint8) for _ in range(32)]
+print(f"held {len(held) / 4:.2f} GiB")
+del held
+"""
 
 
 def run_drive(learner: Learner, with_joy: bool) -> dict:
@@ -141,6 +152,15 @@ def test_each_learners_robots_are_their_own(hub):
     assert rb["nodes"].count("rtt") == 1 and ra["nodes"].count("rtt") == 1
     assert ra["warnings"] == [] and rb["warnings"] == []  # no "2 nodes are named /rtt"
 
+    # B's kernel asks for 8 GiB: the memory limit of B's server (course/limits.py) stops that kernel alone.
+    if os.geteuid() == 0:  # the limits need root (cgroups); a trial without root has none
+        assert "learner learner-b: at most 2.0 GiB, 500 processes, 1.00 cores" in hub.log()
+        with pytest.raises(KernelDied):
+            b.run(MEMORY_HOG, timeout=120)
+        said = b.run("from tutorial.notebook.session import init_ros\ninit_ros()")  # the first cell, run again
+        assert "more than its memory limit (2.0 GiB)" in said, said
+        assert a.run("print(40 + 2)").strip() == "42"  # A's kernel and server never noticed
+
     # rtt-run's own meshcat page, started from A's terminal as the notebooks' "Outside Jupyter" sections say:
     # its line names the page on the hub's address, through A's Jupyter (jupyter-server-proxy).
     said = a.terminal(
@@ -149,10 +169,14 @@ def test_each_learners_robots_are_their_own(hub):
         "end.\r",
         timeout=90,
     )
-    page = re.search(r"JupyterHub's address followed by (/user/learner-a/proxy/\d+/static/) in a browser", said)
+    page = re.search(r"JupyterHub's address followed by (/user/learner-a/proxy/(\d+)/static/) in a browser", said)
     pid = re.search(r"pid=(\d+)", said)
     assert page and pid, said
     try:
+        # B's own Jupyter does not proxy A's page (course/own_ports.py); A's does.
+        for learner, status in ((b, 403), (a, 200)):
+            r = learner.api("GET", f"proxy/{page.group(2)}/static/")
+            assert r.status_code == status, (learner.name, r.status_code, r.text[:300])
         # Each learner in a browser of their own: logged in through the hub's form, a notebook that starts Step 2
         # with its live view; both views get their scene over their own notebook's connection and draw.
         both_live_views_draw(hub, ["learner-a", "learner-b"], rtt_run_page=("learner-a", page.group(1)))
@@ -419,3 +443,229 @@ def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environme
         assert "rtt_joy" not in results["b"]["nodes"]
     finally:
         hub.close()
+
+
+# ---- each learner's server in cgroups of its own (course/limits.py) ----
+
+
+def running(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, killed and not yet reaped, does not)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+FORKS = """
+import subprocess, sys
+started = []
+try:
+    for _ in range(200):  # stopping itself at 200
+        started.append(subprocess.Popen(["sleep", "30"], stdout=subprocess.DEVNULL))
+except OSError as exc:
+    print(f"refused after {len(started)}: {type(exc).__name__}")
+for p in started:
+    p.kill()
+"""
+
+
+@pytest.mark.cross_process
+def test_a_learners_server_and_what_it_starts_stay_in_its_cgroups_and_go_with_it(tmp_path):
+    import asyncio
+    import subprocess
+    from types import SimpleNamespace
+
+    from limits import LimitedSimpleLocalProcessSpawner
+
+    if os.geteuid() != 0 or not Path("/sys/fs/cgroup/pids/cgroup.procs").exists():
+        pytest.skip("the learners' limits need root and cgroup v1")
+    name = f"rttlimits{os.getpid()}"
+    spawner = LimitedSimpleLocalProcessSpawner(
+        user=SimpleNamespace(name=name), home_dir_template=str(tmp_path / "{username}"), mem_limit="256M", pids_limit=40
+    )
+    groups = spawner.cgroups()
+    try:
+        # A "server" that starts a process in a session of its own (as a kernel is), then the forks.
+        kernel = "import subprocess, sys; subprocess.Popen(['sleep', '60'], start_new_session=True, stdout=-3)"
+        server = subprocess.Popen(
+            [sys.executable, "-c", f"{kernel}; exec(sys.argv[1])", FORKS],
+            preexec_fn=spawner.make_preexec_fn(name), start_new_session=True, stdout=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        out, _ = server.communicate(timeout=60)
+        assert re.fullmatch(r"refused after (\d+): BlockingIOError\n", out), out
+        assert int(out.split()[2].rstrip(":")) < 40  # the pids limit, not the loop's own end, stopped it
+        memory = next(g for g in groups if g.parent.name == "memory")
+        assert int((memory / "memory.limit_in_bytes").read_text()) == 256 * 1024**2
+        cpu = next(g for g in groups if g.parent.name == "cpu")
+        assert (cpu / "cpu.cfs_quota_us").read_text().strip() == "100000"  # one core
+        left = (memory / "cgroup.procs").read_text().split()
+        assert len(left) == 1, left  # the server is gone; what it started in a session of its own is not
+        asyncio.run(spawner.remove_cgroups())
+        assert not any(g.exists() for g in groups)
+        assert not running(int(left[0]))
+    finally:
+        asyncio.run(spawner.remove_cgroups())
+
+
+# What A's and B's kernels run meanwhile: Step 2 with a demo joystick for ``seconds``; the simulation's real-time
+# factor, and how late the joint states came to the kernel: the gaps between them (50 per second), p99.
+STEP2_WATCHED = """
+import json, os, subprocess, sys, time
+import numpy as np
+import rclpy
+from sensor_msgs.msg import JointState
+venv = os.path.dirname(sys.executable)
+sim = subprocess.Popen([os.path.join(venv, "rtt-run"), "{root}/project/step2.yaml", "--headless", "--json",
+                        "--duration", "{seconds}"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "{seconds}"],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+if not rclpy.ok():
+    rclpy.init()
+node = rclpy.create_node("arrivals")
+arrivals = []
+node.create_subscription(JointState, "/Tank/joint_state", lambda m: arrivals.append(time.monotonic()), 100)
+while sim.poll() is None:
+    rclpy.spin_once(node, timeout_sec=0.1)
+node.destroy_node()
+out, _ = sim.communicate(timeout=60)
+joy.wait(60)
+summary = [json.loads(x) for x in out.splitlines() if x.startswith('{{"event": "summary"')][-1]
+gaps = np.diff(arrivals[len(arrivals) // 10:]) * 1000  # ms, after the first tenth (start-up)
+print(json.dumps({{"rtf": summary["real_time_factor"], "gap_p99_ms": float(np.percentile(gaps, 99))}}))
+"""
+
+# Learner C's misbehaviours, one at a time, each stopping itself where the issue says.
+BUSY = """
+import subprocess, sys
+loops = [subprocess.Popen([sys.executable, "-c", "import time\\nend = time.monotonic() + {seconds}\\n"
+                           "while time.monotonic() < end: pass"]) for _ in range(4)]
+print("busy", [p.wait() for p in loops])
+"""
+FORK_BOMB = """
+import subprocess
+started = []
+try:
+    while len(started) < 2000:  # stopping itself at 2,000 processes
+        started.append(subprocess.Popen(["sleep", "60"], stdout=subprocess.DEVNULL))
+except OSError as exc:
+    print(f"refused after {len(started)}: {type(exc).__name__}")
+for p in started:
+    p.kill()
+    p.wait()
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.cross_process
+def test_one_learner_cannot_take_the_others_down(tmp_path):
+    """A and B run Step 2 with a joystick while C runs busy loops, then a memory hog, then a fork bomb."""
+    import threading
+
+    if os.geteuid() != 0:
+        pytest.skip("the learners' limits need root (cgroups)")
+    seconds = 15
+    domains = (_FIRST, _FIRST + 1, 201 + os.getpid() % 10)  # C's from the block below 215's
+    hub = Hub(tmp_path / "hub", ["learner-a", "learner-b", "learner-c"], domains)
+    try:
+        a, b, c = (Learner(hub, name) for name in ("learner-a", "learner-b", "learner-c"))
+        for learner in (a, b, c):
+            assert learner.log_in().status_code == 302, hub.log()[-2000:]
+            learner.start_server()
+        started = {x.name: x.server()["started"] for x in (a, b)}
+
+        def round_with(misbehaviour: str | None) -> tuple[dict, str | Exception]:
+            results, errors, said = {}, [], {}
+
+            def watch(learner):
+                try:
+                    results[learner.name] = json.loads(
+                        learner.run(STEP2_WATCHED.format(root=ROOT, seconds=seconds), timeout=180).splitlines()[-1]
+                    )
+                except BaseException as exc:  # noqa: BLE001 - collected and asserted below
+                    errors.append(exc)
+
+            def misbehave():
+                try:
+                    said["c"] = c.run(misbehaviour.replace("{seconds}", str(seconds - 3)), timeout=180)
+                except Exception as exc:  # noqa: BLE001 - what C got is the case's result
+                    said["c"] = exc
+
+            threads = [threading.Thread(target=watch, args=(x,)) for x in (a, b)]
+            if misbehaviour:
+                threads.append(threading.Thread(target=misbehave))
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join(240)
+            assert not errors, errors
+            return results, said.get("c", "")
+
+        before, _ = round_with(None)
+        print("before", before)
+        for name, misbehaviour in (("busy", BUSY), ("memory", MEMORY_HOG), ("fork bomb", FORK_BOMB)):
+            during, got = round_with(misbehaviour)
+            print(name, during, repr(got)[:300])
+            for learner in ("learner-a", "learner-b"):
+                assert during[learner]["rtf"] >= 0.99, (name, learner, during)
+                assert during[learner]["gap_p99_ms"] <= 2 * before[learner]["gap_p99_ms"], (name, before, during)
+            if name == "busy":
+                assert got.startswith("busy [0, 0, 0, 0]"), got
+                stat = Path("/sys/fs/cgroup/cpu/rtt-learner-learner-c/cpu.stat").read_text()
+                assert int(re.search(r"nr_throttled (\d+)", stat).group(1)) > 0, stat  # C's quota held them back
+            elif name == "memory":
+                assert isinstance(got, KernelDied), got  # the limit stopped C's kernel before 8 GiB
+            else:
+                found = re.match(r"refused after (\d+): BlockingIOError", got)
+                assert found and int(found.group(1)) < 500, got
+        assert hub.proc.poll() is None
+        for x in (a, b):  # A's and B's servers never restarted
+            assert x.server()["started"] == started[x.name]
+    finally:
+        hub.close()
+    assert hub.cgroups_left == []
+
+
+@pytest.mark.slow
+@pytest.mark.cross_process
+def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
+    """C starts a simulation and leaves: the hub's idle culler stops C's server and all it ran; C comes back."""
+    import time
+
+    idle = 20  # s: the test's timeout (a class's: an hour)
+    hub = Hub(
+        tmp_path / "hub",
+        ["learner-c"],
+        DOMAINS[:1],
+        extra_env={"RTT_HUB_IDLE_TIMEOUT": str(idle), "RTT_HUB_ACTIVITY_INTERVAL": "5"},
+    )
+    try:
+        c = Learner(hub, "learner-c")
+        assert c.log_in().status_code == 302, hub.log()[-2000:]
+        c.start_server()
+        said = c.run(
+            "import os, subprocess, sys\n"
+            "open(os.path.expanduser('~/my_notes.txt'), 'w').write('mine')\n"
+            "sim = subprocess.Popen([os.path.join(os.path.dirname(sys.executable), 'rtt-run'), "
+            f"'{ROOT}/project/step2.yaml', '--headless', '--duration', '600'])\n"
+            "print(os.environ['ROS_DOMAIN_ID'], sim.pid)"
+        )
+        domain, sim = said.split()
+        left = time.monotonic()
+        while c.server() and time.monotonic() - left < idle + 60:  # the culler's timeout, its period, slack
+            time.sleep(1)  # polling the hub's record of C's server, within the deadline
+        assert not c.server(), f"C's server still runs {time.monotonic() - left:.0f} s after C left"
+        waited = time.monotonic() - left
+        assert waited >= idle - 1, waited  # not before the timeout
+        assert "idle-culler" in hub.log() and "learner-c" in hub.log()
+        assert not running(int(sim)), "the simulation C left running outlived C's server"
+        # C comes back: their notebooks, their file and their domain are there.
+        c.kernel_id = None  # that kernel went with the server
+        c.start_server()
+        again = c.run(
+            "import os\nprint(os.environ['ROS_DOMAIN_ID'], open(os.path.expanduser('~/my_notes.txt')).read(), "
+            "os.path.exists(os.path.expanduser('~/notebooks/03_step3_viewer.ipynb')))"
+        )
+        assert again.split() == [domain, "mine", "True"], again
+    finally:
+        hub.close()
+    assert hub.cgroups_left == []

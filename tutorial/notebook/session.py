@@ -19,6 +19,7 @@ it never changes what a checked output says.
 from __future__ import annotations
 
 import os
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -38,7 +39,9 @@ def init_ros() -> None:
 
     rclpy would otherwise take over SIGINT and shut ROS down when you press
     the notebook's "interrupt" button.  Calling it again does nothing.  On a class's hub it warns (stderr)
-    when ``ROS_DOMAIN_ID`` is not the learner's own domain (:func:`tutorial.ros.env.assigned_domain_warning`).
+    when ``ROS_DOMAIN_ID`` is not the learner's own domain (:func:`tutorial.ros.env.assigned_domain_warning`),
+    and says when a kernel of this server was stopped for going over its memory limit
+    (:func:`memory_limit_note`).
     """
     import rclpy
     from rclpy.signals import SignalHandlerOptions
@@ -48,6 +51,31 @@ def init_ros() -> None:
         # a domain set by hand since the kernel started (a learner's shutdown() and init again) is said here
         ros_env.warn_if_not_assigned_domain()
         rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+        note = memory_limit_note()
+        if note:
+            print(note, file=sys.stderr)
+
+
+def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory")) -> str:
+    """What to tell a learner whose server holds a kernel stopped at its memory limit; "" if none was.
+
+    On a class's hub each learner's server is in a memory cgroup of its own (``course/limits.py``), whose
+    ``memory.oom_control`` counts the processes stopped for going over ``MEM_LIMIT`` bytes.  Any thread.
+    """
+    try:
+        line = next(x for x in Path("/proc/self/cgroup").read_text().splitlines() if x.split(":")[1] == "memory")
+        control = (cgroup_root / line.split(":", 2)[2].lstrip("/") / "memory.oom_control").read_text()
+        killed = int(control.split("oom_kill ")[1].split()[0])
+        limit = int(os.environ["MEM_LIMIT"])
+    except (OSError, StopIteration, IndexError, KeyError, ValueError):
+        return ""
+    if not killed:
+        return ""
+    return (
+        f"Note: {killed} process(es) of your server were stopped for using more than its memory limit "
+        f"({limit / 1024**3:.1f} GiB), and Jupyter restarted the kernel: that is why the earlier cells' "
+        "results and runs are gone. Use less memory (smaller arrays, fewer runs at once, reset() between runs)."
+    )
 
 
 def register(thing):
