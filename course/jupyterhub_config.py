@@ -33,8 +33,6 @@
 import json
 import os
 import pwd
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
@@ -44,8 +42,8 @@ COURSE = Path(__file__).resolve().parent
 ROOT = COURSE.parent
 sys.path.insert(0, str(COURSE))
 
-from assignments import learner_notebook  # noqa: E402 - course/ is on the path only from here
 from domains import BOOK_NAME, DomainBook, DomainError, hub_state  # noqa: E402
+from learner_home import make_learner_home  # noqa: E402 - course/ is on the path only from here
 from limits import LimitedLocalProcessSpawner, LimitedSimpleLocalProcessSpawner  # noqa: E402
 
 c = get_config()  # noqa: F821 - JupyterHub provides it
@@ -208,37 +206,8 @@ def give_learner_their_domain_and_notebooks(spawner):
     spawner.log.info("learner %s: ROS domain %d", name, domain)
     unix_user = UNIX_USERS
     home = Path(pwd.getpwnam(name).pw_dir) if unix_user else Path(spawner.home_dir)
-    # The learner's own copies, made once (their work is never overwritten): the notebooks, and what their
-    # "Outside Jupyter" sections run from a terminal in the home folder (rtt-run project/step1.yaml, ...).
-    for folder in ("project", "model", "launch_py"):
-        if not (home / folder).exists():
-            shutil.copytree(ROOT / folder, home / folder, ignore=shutil.ignore_patterns("__pycache__"))
-            _give_to_learner(home / folder, name, unix_user)
-    target = home / "notebooks"
-    if target.exists():
-        return
-    # Made whole beside it, then renamed into place: a spawn that fails halfway leaves no copy that the next
-    # spawn would take as made (with the worked solutions still in it).
-    making = home / ".notebooks-being-made"
-    shutil.rmtree(making, ignore_errors=True)
-    shutil.copytree(ROOT / "notebooks", making, ignore=shutil.ignore_patterns(".*", "*.cfg", "*.toml"))
-    if not SHOW_SOLUTIONS:  # the folded worked solutions held back, as in the graded assignments
-        for path in making.glob("*.ipynb"):
-            notebook = json.loads(path.read_text(encoding="utf-8"))
-            path.write_text(json.dumps(learner_notebook(notebook), indent=1) + "\n", encoding="utf-8")
-    # Trusted in the learner's own Jupyter, so the notebooks' recorded 3D views run (JupyterLab runs no
-    # script of an untrusted output).  A signature is of the notebook's content, not its path.
-    subprocess.run(
-        [str(ENV_BIN / "jupyter"), "trust", *map(str, sorted(making.glob("*.ipynb")))],
-        env={"HOME": str(home), "PATH": spawner.environment["PATH"]},
-        capture_output=True,
-        timeout=120,
-        check=False,
-    )
-    _give_to_learner(making, name, unix_user)
-    making.rename(target)
-    if (home / ".local").exists():
-        _give_to_learner(home / ".local", name, unix_user)
+    for made in make_learner_home(home, SHOW_SOLUTIONS, ENV_BIN / "jupyter"):
+        _give_to_learner(made, name, unix_user)
 
 
 def _give_to_learner(path: Path, name: str, unix_user: bool) -> None:

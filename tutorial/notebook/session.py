@@ -59,12 +59,16 @@ def init_ros() -> None:
 def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory")) -> str:
     """What to tell a learner whose server holds a kernel stopped at its memory limit; "" if none was.
 
-    On a class's hub each learner's server is in a memory cgroup of its own (``course/limits.py``), whose
-    ``memory.oom_control`` counts the processes stopped for going over ``MEM_LIMIT`` bytes.  Any thread.
+    On a class's hub each learner's server is in a memory cgroup of its own (``course/limits.py``, or the
+    learner's container), whose ``memory.oom_control`` counts the processes stopped for going over ``MEM_LIMIT``
+    bytes.  Any thread.
     """
     try:
         line = next(x for x in Path("/proc/self/cgroup").read_text().splitlines() if x.split(":")[1] == "memory")
-        control = (cgroup_root / line.split(":", 2)[2].lstrip("/") / "memory.oom_control").read_text()
+        group = cgroup_root / line.split(":", 2)[2].lstrip("/")
+        if not group.exists():  # in a container, whose own group is the root of what it sees
+            group = cgroup_root
+        control = (group / "memory.oom_control").read_text()
         killed = int(control.split("oom_kill ")[1].split()[0])
         limit = int(os.environ["MEM_LIMIT"])
     except (OSError, StopIteration, IndexError, KeyError, ValueError):

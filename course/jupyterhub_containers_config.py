@@ -1,0 +1,46 @@
+# The class on containers: each learner's server is a container of the learner image
+# (course/containers/Containerfile), started by JupyterHub's DockerSpawner through Docker's API, which
+# podman serves too (`podman system service`).
+#
+#   make hub-containers     # http://127.0.0.1:8000, as `make hub`; podman, as root
+#
+# What it shares with course/jupyterhub_config.py (read first, then changed here): who logs in, where the hub
+# listens, the idle culler.  What differs:
+# - each learner's server is a container on a network of its own (RTT_HUB_CONTAINER_NETWORK, made by
+#   `make hub-containers` with --internal: nothing routes from it beyond this machine), whose address the
+#   hub's API also listens on (RTT_HUB_CONTAINER_GATEWAY), for the servers to reach the hub;
+# - the learner's home is a named volume, rtt-home-<name>: the image's notebooks and project files the first
+#   time, the learner's own work after (a container is removed when its server stops; the volume stays);
+# - the limits are DockerSpawner's (mem_limit, cpu_limit, a pids limit), from the same figures as course/limits.py;
+# - no book of ROS domains: each container has a network namespace of its own, where discovery on localhost
+#   finds that learner's nodes only, so every learner uses the same domain (RTT_HUB_CONTAINER_DOMAIN, default 0).
+# Not here yet: nbgrader's exchange (a volume shared by every learner's container and the teacher).
+
+import os
+from pathlib import Path
+
+c = get_config()  # noqa: F821 - JupyterHub provides it
+load_subconfig(str(Path(__file__).with_name("jupyterhub_config.py")))  # noqa: F821
+
+GATEWAY = os.environ.get("RTT_HUB_CONTAINER_GATEWAY", "127.0.0.1")
+c.JupyterHub.hub_ip = GATEWAY  # the hub's API, for the learners' servers: on the containers' network only
+c.JupyterHub.hub_connect_ip = GATEWAY
+
+c.JupyterHub.spawner_class = "docker"
+c.DockerSpawner.image = os.environ.get("RTT_HUB_IMAGE", "localhost/ros-tank-tutorial:learner")
+c.DockerSpawner.network_name = os.environ.get("RTT_HUB_CONTAINER_NETWORK", "rtt-learners")
+c.DockerSpawner.use_internal_ip = True  # the proxy reaches each container at its address on that network
+c.DockerSpawner.remove = True
+c.DockerSpawner.notebook_dir = "/home/jovyan"
+c.DockerSpawner.volumes = {"rtt-home-{username}": "/home/jovyan"}
+c.DockerSpawner.extra_host_config = {"pids_limit": int(os.environ.get("RTT_HUB_PIDS_LIMIT", "500"))}
+c.Spawner.cmd = ["jupyterhub-singleuser"]  # the image's own environment, not this machine's
+c.Spawner.args = []
+c.Spawner.ip = "0.0.0.0"  # inside the container: its own network namespace, on the containers' network
+c.Spawner.pre_spawn_hook = None  # no domain to give, no files to copy: the image and the volume hold them
+c.Spawner.environment = {
+    "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+    "ROS_DOMAIN_ID": os.environ.get("RTT_HUB_CONTAINER_DOMAIN", "0"),
+    "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
+    "JUPYTERHUB_ACTIVITY_INTERVAL": c.Spawner.environment["JUPYTERHUB_ACTIVITY_INTERVAL"],
+}
