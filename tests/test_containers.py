@@ -45,7 +45,8 @@ def podman(*args: str, timeout: float = 120, check: bool = True) -> subprocess.C
 
 def run_in_image(*command: str, options: tuple[str, ...] = ("--network", "none"), timeout: float = 120):
     """``command`` in a throwaway container of the image, in this session's ROS domain."""
-    return podman("run", "--rm", *options, "-e", f"ROS_DOMAIN_ID={DOMAIN}", IMAGE, *command, timeout=timeout, check=False)
+    domain = ("-e", f"ROS_DOMAIN_ID={DOMAIN}")
+    return podman("run", "--rm", *options, *domain, IMAGE, *command, timeout=timeout, check=False)
 
 
 @pytest.fixture(scope="module", autouse=True)

@@ -29,3 +29,63 @@ def test_an_unstable_simulation_ends_with_an_error_not_a_silent_reset():
     assert sim.join(30)
     assert sim.error is not None and "became unstable" in sim.error
     assert sim.steps < 5000
+
+
+class Counting(SimpleController):
+    """Counts its control() calls (simulation thread), and signals when it has made ``until`` of them."""
+
+    def __init__(self, until: int):
+        import threading
+
+        self.calls, self.until, self.reached = 0, until, threading.Event()
+
+    def initialize(self, io):
+        return True
+
+    def control(self):
+        self.calls += 1
+        if self.calls == self.until:
+            self.reached.set()
+        return True
+
+
+def test_a_paused_simulation_holds_its_time_and_calls_no_controller_until_resumed():
+    import time
+
+    model = build_world([ModelEntry("Room", MODEL / "room.xml"), ModelEntry("Tank", MODEL / "tank.xml")])
+    counting = Counting(until=200)
+    sim = Simulator(model, mujoco.MjData(model), [Attachment("C", counting, "Tank")], realtime_sync=True, duration=1.0)
+    sim.start()
+    try:
+        assert counting.reached.wait(10)
+        sim.pause()
+        assert sim.paused
+        deadline = time.monotonic() + 5
+        while sim.snapshot().step != sim.steps and time.monotonic() < deadline:  # the held state, published
+            time.sleep(0.01)  # polling the simulation thread's snapshot, within the deadline
+        held_time, held_calls = sim.sim_time, counting.calls
+        wall = time.monotonic()
+        while time.monotonic() - wall < 0.3:  # 300 ms paused: nothing may move
+            assert sim.sim_time == held_time and counting.calls == held_calls
+            time.sleep(0.02)  # sampling the paused simulation, within its 300 ms
+        sim.resume()
+        assert sim.join(10)
+    finally:
+        sim.request_stop()
+        sim.join(10)
+    assert sim.error is None, sim.error
+    assert sim.steps == 1000 and counting.calls == 1000  # the whole second simulated, nothing skipped
+    assert sim.paused_for >= 0.3
+    # the pause is not counted as lateness: counted, the factor would be about 1.0 / 1.3
+    assert 0.9 <= sim.real_time_factor <= 1.05, sim.real_time_factor
+
+
+def test_a_paused_simulation_stops_when_asked():
+    model = build_world([ModelEntry("Room", MODEL / "room.xml"), ModelEntry("Tank", MODEL / "tank.xml")])
+    counting = Counting(until=10)
+    sim = Simulator(model, mujoco.MjData(model), [Attachment("C", counting, "Tank")], realtime_sync=True)
+    sim.start()
+    assert counting.reached.wait(10)
+    sim.pause()
+    sim.request_stop()
+    assert sim.join(10) and sim.error is None

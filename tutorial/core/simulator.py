@@ -64,7 +64,7 @@ class Simulator:
         record_timing: keep every step's lateness (wall time behind simulated
             time, s, 0 when on time) in :attr:`lateness`, for benchmarks.
 
-    ``start``, ``request_stop``, ``join`` and ``snapshot`` may be called from
+    ``start``, ``pause``, ``resume``, ``request_stop``, ``join`` and ``snapshot`` may be called from
     any thread; everything else runs on the simulation thread.
     """
 
@@ -86,6 +86,10 @@ class Simulator:
         self.dropped: list[str] = []  # controllers whose control() returned False
         self.lateness: list[float] | None = [] if record_timing else None
         self._stop = threading.Event()
+        self._running = threading.Event()  # cleared while paused: the simulation thread waits on it
+        self._running.set()
+        self._held = threading.Event()  # set while the simulation thread waits, paused
+        self.paused_for = 0.0  # s of wall time spent paused (left out of wall_time)
         self.finished = threading.Event()
         self._snapshot_lock = threading.Lock()
         self._snapshot = Snapshot(float(data.time), data.qpos.copy(), 0)
@@ -99,8 +103,31 @@ class Simulator:
         return self
 
     def request_stop(self) -> None:
-        """Ask the simulation thread to end after its current step (any thread)."""
+        """Ask the simulation thread to end after its current step, paused or not (any thread)."""
         self._stop.set()
+        self._running.set()
+
+    def pause(self) -> None:
+        """Hold the simulation before its next step (any thread).
+
+        Simulated time stands still: no step, no ``control()``, so a controller's
+        periods (in simulated time) lose nothing and nothing is published.  The
+        simulation thread waits without using the CPU until :meth:`resume`.
+        """
+        self._running.clear()
+
+    def resume(self) -> None:
+        """Go on from where :meth:`pause` held it, in real time from now (any thread)."""
+        self._running.set()
+
+    def wait_paused(self, timeout: float) -> bool:
+        """Wait until a :meth:`pause` has held the simulation (its snapshot then holds the paused state);
+        True when it has (any thread)."""
+        return self._held.wait(timeout)
+
+    @property
+    def paused(self) -> bool:
+        return not self._running.is_set()
 
     def join(self, timeout: float | None = None) -> bool:
         """Wait for the simulation thread; True when it has ended."""
@@ -157,11 +184,21 @@ class Simulator:
         active = list(active)
         controls = [(a, a.controller.control) for a in active]  # bound once: this loop runs every 1 ms
         stop, snapshot_wanted, step = self._stop.is_set, self._snapshot_wanted.is_set, mujoco.mj_step
+        running = self._running.is_set
         t0_sim = t = float(d.time)
         wall0 = time.perf_counter()
         cpu0 = time.thread_time()
         end = float("inf") if self.duration is None else t0_sim + self.duration - 0.5 * dt
         while t < end and not stop():
+            if not running():  # paused: the newest state for the views, then wait (request_stop ends it too)
+                self._publish_snapshot()
+                held = time.perf_counter()
+                self._held.set()
+                self._running.wait()
+                self._held.clear()
+                wall0 += time.perf_counter() - held  # real time goes on from here, with no catching up
+                self.paused_for += time.perf_counter() - held
+                continue
             for a, control in controls:
                 if not control():
                     controls = [(b, c) for b, c in controls if b is not a]

@@ -140,7 +140,7 @@ class RunControls(Panel):
                 return
             status = self.run.status
             # From the status, not from the thread: the owner thread reports "finished" while it is still alive.
-            active = status in ("starting", "running")
+            active = status.startswith(("starting", "running", "paused"))  # paused: while no page shows it
             self.start.disabled = active
             self.stop.disabled = not active
             self.say(f"/{self.run.node_name}: {status}", warning=status.startswith("failed"))

@@ -96,6 +96,11 @@ class _CellWatch:
         cls.busy = False
 
 
+def cell_running() -> bool:
+    """Whether the kernel is running a cell now (False outside IPython); any thread."""
+    return _CellWatch.busy
+
+
 class MeshcatWidget(anywidget.AnyWidget):
     """A live meshcat scene in a notebook output, over the kernel's connection.
 
@@ -127,6 +132,7 @@ class MeshcatWidget(anywidget.AnyWidget):
         self.rejected = 0
         self.last_rejection = ""
         self.hellos = 0
+        self.last_heard = time.monotonic()  # when a page last said anything: a run unwatched pauses (runs.py)
         self.probe: list | None = None  # a benchmark's list: (frame number, monotonic ns when sent) of each frame
         self.on_msg(self._on_message)
 
@@ -165,6 +171,7 @@ class MeshcatWidget(anywidget.AnyWidget):
 
     # ---- the kernel's thread: what the browser says ------------------------------------------------
     def _on_message(self, _widget, content, buffers) -> None:
+        self.last_heard = time.monotonic()
         kind = content.get("type") if isinstance(content, dict) else None
         if kind == "viewer_js":
             self.send({"type": "viewer_js"}, [viewer_script_gzip()])
