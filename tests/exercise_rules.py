@@ -167,7 +167,7 @@ RULES_02 = {
             "a name the tank lacks (a part of a joint's name)",
             "a name the tank lacks (another robot's joint)",
         ],
-        "... and log an error": ["configure logs an error, returns False"],
+        "... and log an error with config.log.error(...)": ["configure logs an error, returns False"],
     },
     "2.2": {
         "geometry_msgs/PoseStamped on /<body>/pose": ["10 Hz from t = 0, stamped with simulation time"],
@@ -412,6 +412,10 @@ RULES_04_05 = {
             "newer, late, repeated, restarted, NaN",
         ],
         "messages in order are shown as before; a hit still shakes": ["(in order)", "(a hit in order)"],
+        "otherwise returns what super().update_imu() returns (None when shown, the reason when rejected)": [
+            "a stamp exactly a second older than the newest",
+            "newer, late, repeated, restarted, NaN and hits",
+        ],
     },
 }
 
@@ -542,6 +546,8 @@ HIDDEN_MISTAKES_04_05 = [
         "            return\n",
         "a stamp exactly a second older than the newest",
     ),
+    # the reason of a message rejected for another reason (a NaN) not returned (passed the old check)
+    ("5.2", "        return reason\n", "        return None\n", "a random run of messages"),
     # the newest kept as the largest stamp shown, not the restarted one (passed the old check)
     (
         "5.2",
@@ -834,7 +840,7 @@ RULES_07_08_09 = {
         "a rate and a JPEG quality 1..100, two numbers": ["camera_settings()"],
         "at least 10 pictures/s to drive by, at most 30": ["10 to 30 pictures/s"],
         "a quality of at least 30, an int (the publisher's parameter)": ["a picture you can recognise"],
-        "fits 0.5 Mbit/s along a turret swing, 100 bytes of headers a picture included": [
+        "fits 0.5 Mbit/s wherever the turret swings, 100 bytes of headers a picture included": [
             "within 0.5 Mbit/s",
             "within the budget along another turret swing",
         ],

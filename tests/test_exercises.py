@@ -672,7 +672,14 @@ def test_an_answer_for_the_visible_cases_alone_fails_the_hidden_ones(ros, monkey
     assert not any(c.isdigit() for c in graded.message.split("failed")[1]), graded.message  # no values
 
 
-@pytest.mark.parametrize("number, right, wrong, caught_by", HIDDEN_MISTAKES)
+# make test keeps the first of each exercise's; make test-more runs the rest.
+FIRST_HIDDEN_MISTAKES = {m[0]: m for m in reversed(HIDDEN_MISTAKES)}.values()
+
+
+@pytest.mark.parametrize(
+    "number, right, wrong, caught_by",
+    [m if m in FIRST_HIDDEN_MISTAKES else pytest.param(*m, marks=pytest.mark.more) for m in HIDDEN_MISTAKES],
+)
 def test_a_mistake_only_the_hidden_cases_catch_fails_on_its_case(ros, grading_seed, number, right, wrong, caught_by):
     ex = exercise(number)
     assert ex["solution"].count(right) == 1, right
@@ -709,3 +716,53 @@ def test_every_rule_of_a_statement_has_its_cases(ros, grading_seed, monkeypatch,
         if not any(label in call for call in calls)
     ]
     assert not missing, missing
+
+
+@pytest.mark.parametrize("number", EXERCISES)
+def test_a_hidden_case_says_what_it_tests_without_values_or_the_learners_names(ros, grading_seed, monkeypatch, number):
+    """A hidden case's ``call`` is all a failing one shows: no number drawn, nor the learner's class or function."""
+    import importlib
+
+    from tutorial.exercises.grader import Result
+
+    ex = exercise(number)
+    module = importlib.import_module(f"tutorial.exercises.{ex['checks']}")
+    listed: list = []
+
+    def listing(exercise_name, cases):  # the cases, not run
+        listed.extend(cases)
+        return Result(exercise_name, True, "listed")
+
+    monkeypatch.setattr(module, "grade", listing)
+    renamed = f"\n{ex['target']}.__name__ = 'LearnersOwnName'\n"  # as a learner may name it
+    grade(ex, ex["stub"], ex["solution"] + renamed)
+    calls = [case.call for case in listed if case.hidden]
+    assert calls, number
+    assert not [c for c in calls if any(ch.isdigit() for ch in c) or "LearnersOwnName" in c], calls
+
+
+def test_the_hidden_stamps_of_5_2_are_never_negative_and_exactly_a_second_back_only_on_whole_seconds():
+    """Every stamp of 5.2's hidden runs fits a ROS time (``sec`` >= 0); every common float form of a stamp judges
+    each message as the check does (a stamp exactly 1 s older: whole seconds, exact in each of them)."""
+    import random
+
+    from tutorial.exercises import step5_imu_viewer as checks
+
+    def forms(ns):  # seconds, as an answer might compute them from sec and nanosec
+        sec, nanosec = divmod(ns, 1_000_000_000)
+        return (sec + nanosec * 1e-9, sec + nanosec / 1e9, (sec * 10**9 + nanosec) * 1e-9, (sec * 1e9 + nanosec) / 1e9)
+
+    boundaries = 0
+    for k in range(200):
+        rng = random.Random(f"s{k}/5.2")
+        for messages in (checks._a_second_back(rng), *(checks._messages(rng, 14) for _ in range(5))):
+            assert all(stamp >= 0 for stamp, _ in messages), messages
+            newest = None
+            for stamp, kind in messages:
+                reason, after = checks._judge(newest, stamp, kind)
+                if newest is not None:
+                    boundaries += newest - stamp == 1_000_000_000
+                    refused = [n - 1.0 <= s <= n and n - s <= 1.0 for n, s in zip(forms(newest), forms(stamp))]
+                    assert refused == [reason == "out_of_order"] * len(refused), (newest, stamp, refused, reason)
+                newest = after
+    assert boundaries > 200, boundaries  # the exact second is drawn in the random runs too

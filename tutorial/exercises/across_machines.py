@@ -6,9 +6,9 @@ when the link to the robot loses packets: it must match the Step 2
 publisher and ordinary volatile ones, keep only the newest state, and make
 sure the last state arrives.
 Exercise 8.2, a camera that fits 0.5 Mbit/s: ``camera_settings()`` returns
-``(rate, jpeg_quality)`` for 0.5 Mbit/s; the check renders the tank's camera along a
-scripted turret swing, encodes every picture as the publisher would, and
-adds up the bytes a second those settings send: a real run of the encoder
+``(rate, jpeg_quality)`` for 0.5 Mbit/s wherever the turret swings; the check renders the tank's camera along a
+scripted turret swing (while grading, also along hidden ones anywhere round), encodes every picture as the
+publisher would, and adds up the bytes a second those settings send: a real run of the encoder
 on real pictures, the same on every run (no wall-clock timing).
 """
 

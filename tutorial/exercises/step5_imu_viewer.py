@@ -18,7 +18,7 @@ While grading (:func:`tutorial.exercises.grader.hidden_random`) each check
 also runs hidden cases, drawn from the learner's seed: for 5.1, readings
 with the tank moved, tilted and turned any way, and an arrow exactly
 ``ACCEL_MIN_LENGTH`` long; for 5.2, a stamp exactly 1 s older than the
-newest, and random runs of messages stamped past 1 s.
+newest, and random runs of messages stamped past 1 s (never below 0).
 
 The module is over 400 lines and still one job: the two checks share one
 headless viewer (``_viewer``) and the messages they hand it (``_imu``).
@@ -36,7 +36,12 @@ from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_ra
 GREEN = (0.2, 0.8, 0.2)
 ARROW = "Tank/horizontal_acceleration"
 RESTART = 1.0  # s: a stamp further back than this is a restarted publisher
-GRID = 1_953_125  # ns, 1/512 s: hidden stamps are whole numbers of it, exact as float seconds too
+SECOND = 1_000_000_000  # ns
+GRID = 1_953_125  # ns, 1/512 s: hidden stamps are whole numbers of it
+# Seconds n whose stamps n s and n - 1 s (nanosec 0) are exact in every common float form, (sec * 10**9 + nanosec)
+# * 1e-9 too (15 s is not: 15.000000000000002): a hidden stamp exactly 1 s older than the newest is on these alone;
+# a float form of another stamp may be a hair off, so no other is within a GRID of 1 s older.
+WHOLE_SECONDS = tuple(n for n in range(2, 1000) if all(k * 10**9 * 1e-9 == k for k in (n, n - 1)))
 
 
 class _Clock:
@@ -374,13 +379,10 @@ def check_in_order(cls) -> Result:
     hidden = []
     rng = hidden_random("5.2")  # while grading: this learner's own stamps, judged by the statement's rule
     if rng:
-        first = rng.randrange(512, 512 * 60) * GRID  # 1 s to 60 s, with nanoseconds
-        newest = first + rng.randrange(1, 100) * GRID
-        back = [(first, "ok"), (newest, "ok"), (newest - 512 * GRID, "ok"), (newest - 513 * GRID, "ok")]
         hidden.append(
             judged(
                 "a stamp exactly a second older than the newest, then one just over a second older",
-                back + [(newest - 513 * GRID + GRID * rng.randrange(1, 50), "ok")],
+                _a_second_back(rng),
                 "exactly a second older is not more than a second: refuse it; just over is a restarted publisher.",
             )
         )
@@ -460,22 +462,50 @@ def _judge(newest: int | None, stamp: int, kind: str) -> tuple[str | None, int |
     return None, stamp
 
 
+def _a_second_back(rng) -> list[tuple[int, str]]:
+    """Messages ``(stamp ns, kind)``: a first, a newer one on whole seconds (:data:`WHOLE_SECONDS`), one exactly a
+    second older than it (nanosec 0 too: exact as float seconds), one just over a second older, then a newer one."""
+    newest = rng.choice(WHOLE_SECONDS) * SECOND
+    first = newest - rng.randrange(1, 100) * GRID  # with nanoseconds, away from the boundary
+    over = newest - SECOND - GRID
+    return [
+        (first, "ok"),
+        (newest, "ok"),
+        (newest - SECOND, "ok"),
+        (over, "ok"),
+        (over + rng.randrange(1, 50) * GRID, "ok"),
+    ]
+
+
 def _messages(rng, n: int) -> list[tuple[int, str]]:
     """Random messages ``(stamp ns, kind)`` from a first one of 1 to 60 s on: newer, late (less than a second),
-    the same stamp, exactly a second back, restarted (more than a second back), a NaN (newer), hits."""
+    the same stamp, exactly a second back, restarted (more than a second back), a NaN (newer), hits.
+
+    No stamp is below 0 (after a restart to under a second, only what fits above 0 is drawn).  Exactly a second
+    back is a pair of whole seconds (:data:`WHOLE_SECONDS`): a newer message, then one a second older than it; every
+    other stamp is at least :data:`GRID` from a second back of the newest.
+    """
     newest = rng.randrange(512, 512 * 60) * GRID
     messages = [(newest, "ok")]
-    for _ in range(n - 1):
-        how = rng.choice(("newer", "newer", "newer", "late", "late", "same", "second", "restart", "nan"))
-        stamp = {
-            "newer": newest + rng.randrange(1, 100) * GRID,
-            "late": newest - rng.randrange(1, 512) * GRID,
-            "same": newest,
-            "second": newest - 512 * GRID,
-            "restart": rng.randrange(0, max(newest // GRID - 512, 1)) * GRID,
-            "nan": newest + rng.randrange(1, 100) * GRID,
-        }[how]
+    while len(messages) < n:
+        hows = ("newer", "newer", "newer", "late", "late", "same", "second", "restart", "nan")
+        how = rng.choice([h for h in hows if (h != "late" or newest >= GRID) and (h != "restart" or newest > SECOND)])
         kind = "nan" if how == "nan" else rng.choice(("ok", "ok", "ok", "hit"))
+        if how == "second":  # a newer message on a whole second, shown, then one exactly a second older
+            whole = rng.choice([s for s in WHOLE_SECONDS if s * SECOND > newest][:3]) * SECOND
+            pair = [(whole, kind), (whole - SECOND, rng.choice(("ok", "ok", "ok", "hit")))]
+            for stamp, what in pair:
+                messages.append((stamp, what))
+                newest = _judge(newest, stamp, what)[1]
+            continue
+        if how in ("newer", "nan"):
+            stamp = newest + rng.randrange(1, 100) * GRID
+        elif how == "late":  # less than a second back, and not below 0
+            stamp = newest - rng.randrange(1, min(512, newest // GRID + 1)) * GRID
+        elif how == "restart":  # more than a second back, by a GRID at least
+            stamp = rng.randrange(0, newest // GRID - 512) * GRID
+        else:
+            stamp = newest
         messages.append((stamp, kind))
         newest = _judge(newest, stamp, kind)[1]
-    return messages
+    return messages[:n]
