@@ -17,7 +17,8 @@
 #   RTT_HUB_IDLE_TIMEOUT  seconds without use after which a learner's server is stopped (default 3600);
 #                       RTT_HUB_ACTIVITY_INTERVAL how often the servers report their use (default 300 s)
 #   RTT_HUB_MEM_LIMIT, RTT_HUB_CPU_LIMIT, RTT_HUB_PIDS_LIMIT  each learner's server's memory (default 2G),
-#                       cores (default 1.0) and processes (default 500): course/limits.py
+#                       a cap in cores (default none: an equal share each) and processes (default 500):
+#                       course/limits.py
 #   RTT_HUB_DOMAINS     the ROS domains to give out, comma-separated (default: every one a server has, 1-101
 #                       and 215-232; tests pick their own)
 #   RTT_HUB_FRAME_RATE  the learners' live views' frames per second, at most (default 20: a server's CPU is
@@ -100,9 +101,10 @@ c.Spawner.default_url = "/lab/tree/notebooks/00_setup_check.ipynb"
 c.Spawner.http_timeout = 60  # s: a 2-core server starting several learners at once is slow
 c.Spawner.start_timeout = 120
 # Each learner's limits (course/limits.py): what Step 6's camera notebook needs with room to spare (its kernel
-# peaks near 0.5 GiB), a fifth of the processes a fork bomb would want, and one of the server's cores.
+# peaks near 0.5 GiB), a fourth of the processes a fork bomb would want, and an equal share of the CPU.
 c.Spawner.mem_limit = os.environ.get("RTT_HUB_MEM_LIMIT", "2G")
-c.Spawner.cpu_limit = float(os.environ.get("RTT_HUB_CPU_LIMIT", "1.0"))
+if os.environ.get("RTT_HUB_CPU_LIMIT"):  # cores; by default an equal share each, and all when nobody else needs it
+    c.Spawner.cpu_limit = float(os.environ["RTT_HUB_CPU_LIMIT"])
 c.LimitedLocalProcessSpawner.pids_limit = int(os.environ.get("RTT_HUB_PIDS_LIMIT", "500"))
 c.Spawner.environment = {
     "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",  # a learner's nodes never look beyond this machine
@@ -110,6 +112,10 @@ c.Spawner.environment = {
     # Live views draw at most this many frames a second (tutorial/app/frame_clock.py; 60 on a learner's own
     # machine): each frame costs the server, and the book's Benchmarks page says how many learners it holds.
     "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
+    # One thread each for NumPy's BLAS and OpenMP (not one per core of a large server): threads count
+    # against a learner's processes (course/limits.py), and the lessons' arrays are small.
+    "OPENBLAS_NUM_THREADS": "1",
+    "OMP_NUM_THREADS": "1",
 }
 
 # nbgrader for the learners: the course and its exchange (fetch and submit, from the Assignments tab of
@@ -159,7 +165,9 @@ SHELL = "/bin/bash" if Path("/bin/bash").exists() else "/bin/sh"
                     "own_ports": True,
                 },
                 "terminado_settings": {"shell_command": [SHELL]},
-            }
+            },
+            # /proxy/HOST:PORT/ reaches no host: /proxy/PORT/ alone, checked by course/own_ports.py
+            "ServerProxy": {"host_allowlist": []},
         }
     )
     + "\n"
@@ -206,16 +214,20 @@ def give_learner_their_domain_and_notebooks(spawner):
     spawner.log.info("learner %s: ROS domain %d", name, domain)
     unix_user = UNIX_USERS
     home = Path(pwd.getpwnam(name).pw_dir) if unix_user else Path(spawner.home_dir)
-    for made in make_learner_home(home, SHOW_SOLUTIONS, ENV_BIN / "jupyter"):
-        _give_to_learner(made, name, unix_user)
+    make_learner_home(
+        home, SHOW_SOLUTIONS, ENV_BIN / "jupyter", give=lambda path: _give_to_learner(path, name, unix_user)
+    )
 
 
 def _give_to_learner(path: Path, name: str, unix_user: bool) -> None:
-    """Made by the hub (root) for a learner who is a Unix user: ``path`` and all in it are theirs from now on."""
+    """Made by the hub (root) for a learner who is a Unix user: ``path`` and all in it are theirs from now on.
+
+    Links are given as links (``lchown``), never followed: a link the learner planted in their home cannot
+    make the hub give them a file of the system's."""
     if unix_user and os.geteuid() == 0:
         entry = pwd.getpwnam(name)
         for each in [path, *path.rglob("*")]:
-            os.chown(each, entry.pw_uid, entry.pw_gid)
+            os.lchown(each, entry.pw_uid, entry.pw_gid)
 
 
 c.Spawner.pre_spawn_hook = give_learner_their_domain_and_notebooks

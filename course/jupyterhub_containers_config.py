@@ -14,7 +14,9 @@
 # - the limits are DockerSpawner's (mem_limit, cpu_limit, a pids limit), from the same figures as course/limits.py;
 # - no book of ROS domains: each container has a network namespace of its own, where discovery on localhost
 #   finds that learner's nodes only, so every learner uses the same domain (RTT_HUB_CONTAINER_DOMAIN, default 0).
-# Not here yet: nbgrader's exchange (a volume shared by every learner's container and the teacher).
+# Not here yet: nbgrader's exchange (a volume shared by every learner's container and the teacher).  Not
+# stopped: a learner's container reaching a port another learner's container serves on that network (the
+# learners' Jupyter servers ask for the hub's login; anything else a learner starts there does not).
 
 import os
 from pathlib import Path
@@ -22,7 +24,7 @@ from pathlib import Path
 c = get_config()  # noqa: F821 - JupyterHub provides it
 load_subconfig(str(Path(__file__).with_name("jupyterhub_config.py")))  # noqa: F821
 
-GATEWAY = os.environ.get("RTT_HUB_CONTAINER_GATEWAY", "127.0.0.1")
+GATEWAY = os.environ.get("RTT_HUB_CONTAINER_GATEWAY") or "127.0.0.1"  # never "": every address
 c.JupyterHub.hub_ip = GATEWAY  # the hub's API, for the learners' servers: on the containers' network only
 c.JupyterHub.hub_connect_ip = GATEWAY
 
@@ -43,4 +45,6 @@ c.Spawner.environment = {
     "ROS_DOMAIN_ID": os.environ.get("RTT_HUB_CONTAINER_DOMAIN", "0"),
     "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
     "JUPYTERHUB_ACTIVITY_INTERVAL": c.Spawner.environment["JUPYTERHUB_ACTIVITY_INTERVAL"],
+    "OPENBLAS_NUM_THREADS": "1",
+    "OMP_NUM_THREADS": "1",
 }

@@ -32,16 +32,21 @@ from assignments import learner_notebook  # noqa: E402 - course/ is on the path 
 COPIED = ("project", "model", "launch_py")
 
 
-def make_learner_home(home: Path, show_solutions: bool = False, jupyter: Path | None = None) -> list[Path]:
-    """Copy what is missing into ``home``; the folders made (for the caller to give to the learner).
+def make_learner_home(
+    home: Path, show_solutions: bool = False, jupyter: Path | None = None, give=lambda path: None
+) -> list[Path]:
+    """Copy what is missing into ``home``; the folders made.
 
     ``jupyter``: the ``jupyter`` program that trusts the notebooks, run with ``HOME=home`` (default: the one
-    beside this Python).  Raises ``OSError`` when ``home`` cannot be written.  Any thread.
+    beside this Python).  ``give(path)`` is called on each folder as soon as it is made (the hub gives it to
+    the learner), so a copy that fails later leaves nothing made that is not theirs.  Raises ``OSError`` when
+    ``home`` cannot be written.  Any thread.
     """
     made = []
     for folder in COPIED:
         if not (home / folder).exists():
             shutil.copytree(ROOT / folder, home / folder, ignore=shutil.ignore_patterns("__pycache__"))
+            give(home / folder)
             made.append(home / folder)
     target = home / "notebooks"
     if target.exists():
@@ -63,9 +68,11 @@ def make_learner_home(home: Path, show_solutions: bool = False, jupyter: Path | 
         timeout=120,
         check=False,
     )
+    give(making)
     making.rename(target)
     made.append(target)
     if (home / ".local").exists():
+        give(home / ".local")
         made.append(home / ".local")
     return made
 

@@ -6,6 +6,10 @@
 # networks: it is put back as it was.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if [ "$(id -u)" != "0" ]; then
+  echo "hub-containers: podman here runs as root: run make hub-containers as root (make hub needs no container)" >&2
+  exit 1
+fi
 bash scripts/ensure-podman.sh
 export CONTAINERS_CONF="$PWD/course/containers/containers.conf"
 state="${RTT_HUB_STATE:-$PWD/course/.hub-containers}"
@@ -31,6 +35,10 @@ fi
 # The network's bridge, and the hub's address on it, exist while a container is on it: one holds it up.
 podman run --detach --rm --name "$network-keeper" --network "$network" "$image" sleep infinity >/dev/null
 gateway=$(podman network inspect "$network" --format '{{range .Subnets}}{{.Gateway}}{{end}}')
+if [ -z "$gateway" ]; then
+  echo "hub-containers: network $network has no gateway address for the hub's API to listen on" >&2
+  exit 1
+fi
 for _ in $(seq 100); do [ -S "$socket" ] && break; sleep 0.1; done
 DOCKER_HOST="unix://$socket" RTT_HUB_STATE="$state" RTT_HUB_CONTAINER_GATEWAY="$gateway" \
   RTT_HUB_CONTAINER_NETWORK="$network" RTT_HUB_IMAGE="$image" RTT_HUB_PER_LEARNER_NETWORK=1 \

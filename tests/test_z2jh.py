@@ -55,7 +55,8 @@ def test_the_schema_catches_a_wrong_values_file():
 
 def test_the_learners_pods_have_the_class_limits_and_stay_apart():
     single = values()["singleuser"]
-    assert single["memory"]["limit"] == "2G" and single["cpu"]["limit"] == 1.0  # as course/limits.py
+    assert single["memory"]["limit"] == "2G"  # as course/limits.py
+    assert single["cpu"]["guarantee"] <= single["cpu"]["limit"] == 1.0
     assert single["extraEnv"]["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
     assert single["networkPolicy"]["enabled"] and not single["networkPolicy"]["egressAllowRules"]["privateIPs"]
     assert single["uid"] == 1000 and single["storage"]["homeMountPath"] == "/home/jovyan"

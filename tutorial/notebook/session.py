@@ -56,13 +56,16 @@ def init_ros() -> None:
             print(note, file=sys.stderr)
 
 
-def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory")) -> str:
-    """What to tell a learner whose server holds a kernel stopped at its memory limit; "" if none was.
+def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory"), seen: Path | None = None) -> str:
+    """What to tell a learner whose server holds a kernel stopped at its memory limit since they were last
+    told; "" if none was.
 
     On a class's hub each learner's server is in a memory cgroup of its own (``course/limits.py``, or the
-    learner's container), whose ``memory.oom_control`` counts the processes stopped for going over ``MEM_LIMIT``
-    bytes.  Any thread.
+    learner's container), whose ``memory.oom_control`` counts the processes stopped for going over
+    ``MEM_LIMIT`` bytes.  ``seen`` (default ``~/.cache/ros-tank-tutorial/memory-limit``) keeps the count
+    already told, so each stop is told once.  Any thread.
     """
+    seen = seen or Path.home() / ".cache" / "ros-tank-tutorial" / "memory-limit"
     try:
         line = next(x for x in Path("/proc/self/cgroup").read_text().splitlines() if x.split(":")[1] == "memory")
         group = cgroup_root / line.split(":", 2)[2].lstrip("/")
@@ -73,10 +76,22 @@ def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory")) -> str:
         limit = int(os.environ["MEM_LIMIT"])
     except (OSError, StopIteration, IndexError, KeyError, ValueError):
         return ""
+    told = f"{group} {killed}"
+    try:
+        before = seen.read_text().split()
+        if len(before) == 2 and before[0] == str(group) and int(before[1]) >= killed:
+            return ""
+    except (OSError, ValueError):
+        pass
     if not killed:
         return ""
+    try:
+        seen.parent.mkdir(parents=True, exist_ok=True)
+        seen.write_text(told)
+    except OSError:
+        pass  # told again next time: better than never
     return (
-        f"Note: {killed} process(es) of your server were stopped for using more than its memory limit "
+        f"Note: a process of your server was stopped for using more than its memory limit "
         f"({limit / 1024**3:.1f} GiB), and Jupyter restarted the kernel: that is why the earlier cells' "
         "results and runs are gone. Use less memory (smaller arrays, fewer runs at once, reset() between runs)."
     )

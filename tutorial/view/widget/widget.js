@@ -300,6 +300,16 @@ function render({ model, el }) {
     stats.page = win.rttPage;
     model.send({ type: "hello", id });
   });
+  // While this view is on a page someone can see, it says so now and then: a run that no page shows
+  // pauses, and goes on when one does (tutorial/notebook/runs.py); a still scene sends no frame to answer.
+  const here = setInterval(() => {
+    if (gone || document.visibilityState !== "visible") return;
+    try {
+      model.send({ type: "here" });
+    } catch (error) {
+      // a model cut off its kernel may refuse to send: its caption already says so
+    }
+  }, LIMITS.here_ms);
   viewerScript(model).then(
     (url) => {
       if (!gone) frame.srcdoc = page(url);
@@ -314,6 +324,7 @@ function render({ model, el }) {
   // The view ends when its output is replaced (it has left the page) or its widget is closed.
   return () => {
     gone = true;
+    clearInterval(here);
     model.off("msg:custom", onMessage);
     model.off("change:status", onStatus);
     model.off("comm_live_update", onCutOff);

@@ -52,6 +52,7 @@ LIMITS = {
     "max_path_parts": meshcat_batch.MAX_PATH_PARTS,
     "max_path_chars": meshcat_batch.MAX_PATH_CHARS,
     "ping_ms": 5000,  # a view cut off its kernel asks it this long for an answer before it says "not live"
+    "here_ms": 10000,  # a view on a visible page says so this often (a run no page shows pauses: runs.py)
 }
 
 
