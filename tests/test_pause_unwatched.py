@@ -7,7 +7,7 @@ loses nothing (simulated time stands still).  Pages are stood in for by the mess
 
 from __future__ import annotations
 
-from tutorial.notebook import runs
+from tutorial.notebook import views
 from tutorial.notebook.runs import BackgroundApp
 
 from conftest import wait_until
@@ -18,7 +18,7 @@ def page_says(run: BackgroundApp, message: dict) -> None:
 
 
 def test_a_run_no_page_shows_pauses_and_goes_on_when_one_does(ros, monkeypatch):
-    monkeypatch.setattr(runs, "UNWATCHED", 0.5)  # s: a class's server waits 30
+    monkeypatch.setattr(views, "UNWATCHED", 0.5)  # s: a class's server waits 30
     run = BackgroundApp("step2.yaml", node_name="rtt_unwatched", label="simulation /rtt_unwatched").start()
     try:
         assert run.wait_started(30), run.error

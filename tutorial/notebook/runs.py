@@ -18,16 +18,11 @@ the way a controller item is added in Choreonoid::
 
 from __future__ import annotations
 
-import os
 import threading
-import time
 from pathlib import Path
 
 from tutorial.core.project import Project, load_project
 from tutorial.notebook import session
-
-# s without a word from any page after which a shown run pauses (a class's server: RTT_PAUSE_UNWATCHED)
-UNWATCHED = float(os.environ.get("RTT_PAUSE_UNWATCHED", "30"))
 
 
 def load(project: str | Path | Project) -> Project:
@@ -234,7 +229,9 @@ class BackgroundApp:
             while not self._stop.is_set() and app.step():
                 if self.view is not None:
                     self.view.record(app.data)
-                    self._pause_while_unwatched(app)
+                    paused_or_not = self.view.pause_while_unwatched(app.sim)  # a run nobody watches costs nothing
+                    if paused_or_not:
+                        self._set_status(paused_or_not)
         except BaseException as exc:  # noqa: BLE001 - reported through .error and the status
             self.error = exc
         finally:
@@ -246,37 +243,6 @@ class BackgroundApp:
                     self.error = self.error or exc
             self._opened.set()
             self._set_status(self._ended_status())
-
-    def _pause_while_unwatched(self, app) -> None:
-        """Pause the simulation once no page has shown this run's view for :data:`UNWATCHED` s, and go on when
-        a page shows it again (owner thread).
-
-        A run nobody watches then costs nothing (a class's server, a learner who closed the page), and loses
-        nothing: simulated time stands still.  Only a run a page has shown pauses (a notebook run without a
-        browser, as the tests run them, never does), and never while a cell runs: a running cell is use,
-        and the page's answers wait behind it on the kernel's shell channel.
-        """
-        from tutorial.view.widget.widget import cell_running
-
-        sim, widget = app.sim, self.view.widget
-        if sim is None or widget.hellos == 0:
-            return
-        unwatched = time.monotonic() - widget.last_heard > UNWATCHED
-        if not sim.paused and unwatched and not cell_running():
-            sim.pause()
-            sim.wait_paused(1.0)
-            self._paused_since = time.monotonic()
-            self._set_status(
-                f"paused at t = {sim.sim_time:.2f} s: no page showed this view for {UNWATCHED:.0f} s "
-                "(it goes on when one does)"
-            )
-        elif sim.paused and not unwatched:
-            at = sim.sim_time
-            sim.resume()
-            self._set_status(
-                f"running (paused at t = {at:.2f} s for {time.monotonic() - self._paused_since:.0f} s "
-                "while no page showed it)"
-            )
 
     def _ended_status(self) -> str:
         if self.error is not None:

@@ -28,11 +28,15 @@ a lock guards them.
 from __future__ import annotations
 
 import html
+import os
 import threading
 import time
 from collections import deque
 
 from tutorial.notebook import replay, session
+
+# s without a word from any page after which a run a page has shown pauses (RTT_PAUSE_UNWATCHED)
+UNWATCHED = float(os.environ.get("RTT_PAUSE_UNWATCHED", "30"))
 
 
 class LiveView:
@@ -61,11 +65,43 @@ class LiveView:
         self._overlays = None
         self._frames: deque = deque(maxlen=int(self.FPS * self.SECONDS))  # (qpos, arrows or None)
         self._next_frame = 0.0
+        self._paused_since = 0.0  # when pause_while_unwatched paused the run (owner thread)
 
     # ---- the run's owner thread ---------------------------------------------------
     def visualizer(self):
         """A ``meshcat.Visualizer`` drawing into this view's widget, owned by the calling thread (one per run)."""
         return self.widget.visualizer()
+
+    def pause_while_unwatched(self, sim) -> str | None:
+        """Pause ``sim`` (a :class:`tutorial.core.simulator.Simulator`, or None) once no page has said anything
+        to this view for :data:`UNWATCHED` s, and resume it when a page does; the run's new status, or None
+        when nothing changed (owner thread).
+
+        A run nobody watches then costs nothing (a class's server, a learner who closed the page), and loses
+        nothing: simulated time stands still.  Only a run a page has shown pauses (a notebook run without a
+        browser, as the tests run them, never does), and never while a cell runs: a running cell is use,
+        and a page's messages wait behind it on the kernel's shell channel.  A view on a visible page says
+        so every few seconds (``widget.js``), even when nothing moves.
+        """
+        from tutorial.view.widget.widget import cell_running
+
+        if sim is None or self.widget.hellos == 0:
+            return None
+        unwatched = time.monotonic() - self.widget.last_heard > UNWATCHED
+        if not sim.paused and unwatched and not cell_running():
+            sim.pause()
+            sim.wait_paused(1.0)
+            self._paused_since = time.monotonic()
+            return (
+                f"paused at t = {sim.sim_time:.2f} s: no page showed this view for {UNWATCHED:.0f} s "
+                "(it goes on when one does)"
+            )
+        if sim.paused and not unwatched:
+            at = sim.sim_time
+            sim.resume()
+            held = time.monotonic() - self._paused_since
+            return f"running (paused at t = {at:.2f} s for {held:.0f} s while no page showed it)"
+        return None
 
     def begin(self, model, camera=None, overlays=None) -> None:
         """A run starts drawing ``model``: its recording starts afresh (owner thread).
