@@ -9,7 +9,7 @@
 #       make mutate (mutation testing of the lessons and the library's core: about 25 minutes),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
-#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 40 s),
+#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 80 s),
 #       make test-hub (the hub with learners as Unix users: slow), make test-robots (the UR5, SO-100 and Go2 in Chromium),
 #       make image (the learner image, podman), make hub-containers (the class on containers), make test-containers,
 #       make assignments (the class's nbgrader assignments from the notebooks, into course/),
