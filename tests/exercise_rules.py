@@ -722,6 +722,14 @@ HIDDEN_MISTAKES_06 = [
         "        self.node.destroy_publisher(self.info_publisher)\n        super().unconfigure()\n",
         "unconfigure() removes the CameraInfo publisher",
     ),
+    # the same, through the publisher's own destroy() (the check once saw only node.destroy_publisher's order)
+    (
+        "6.2",
+        "        super().unconfigure()  # the render thread has ended: nothing publishes now\n"
+        "        self.node.destroy_publisher(self.info_publisher)\n",
+        "        self.info_publisher.destroy()\n        super().unconfigure()\n",
+        "unconfigure() removes the CameraInfo publisher",
+    ),
 ]
 
 # ---- notebooks 07, 08 and 09 ----

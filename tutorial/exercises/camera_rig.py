@@ -63,18 +63,6 @@ def world(camera: Camera):
     return model, cam
 
 
-class _Node(CapturingNode):
-    """A capturing node that also keeps the publishers destroyed through it, in order (``destroyed``)."""
-
-    def __init__(self, node):
-        super().__init__(node)
-        self.destroyed: list = []
-
-    def destroy_publisher(self, publisher) -> bool:
-        self.destroyed.append(publisher)
-        return super().destroy_publisher(publisher)
-
-
 class Rig:
     """The learner's camera controller on the tank; the calling thread plays the simulation thread.
 
@@ -97,7 +85,7 @@ class Rig:
 
         self.name, self.camera = cls.__name__, camera
         self.model, self.camera_id = world(camera)
-        self.node = _Node(rclpy.create_node("exercise_check_camera"))
+        self.node = CapturingNode(rclpy.create_node("exercise_check_camera"))
         self.controller = cls()
         self.configured = False
         parameters = {name: default for name, (_, default, _) in cls.PARAMETERS.items()}

@@ -14,10 +14,17 @@ from __future__ import annotations
 class CapturingPublisher:
     """A publisher that forwards to a real one and keeps ``(topic, type, bytes)`` of each message."""
 
-    def __init__(self, real, msg_type, topic: str):
+    def __init__(self, real, msg_type, topic: str, noted: list | None = None):
         self.real, self.msg_type, self.topic = real, msg_type, topic
         self.sent: list[bytes] = []
         self.destroyed = False  # the controller gave it back (node.destroy_publisher), as unconfigure() should
+        self._noted = noted if noted is not None else []  # its node's publishers destroyed, in order
+
+    def note_destroyed(self) -> None:
+        """Noted once, however it was destroyed (its ``destroy()``, or its node's ``destroy_publisher``)."""
+        if not self.destroyed:
+            self.destroyed = True
+            self._noted.append(self)
 
     def publish(self, msg) -> None:
         from rclpy.serialization import serialize_message
@@ -27,7 +34,7 @@ class CapturingPublisher:
 
     def destroy(self) -> None:
         """Destroy the real publisher (rclpy's ``Publisher.destroy``), noted as ``node.destroy_publisher`` is."""
-        self.destroyed = True
+        self.note_destroyed()
         self.real.destroy()
 
     def require_destroyed(self, call: str, hint: str) -> None:
@@ -57,15 +64,17 @@ class CapturingNode:
     def __init__(self, node):
         self.node = node
         self.publishers: list[CapturingPublisher] = []
+        self.destroyed: list[CapturingPublisher] = []  # in the order they were destroyed, either way
 
     def create_publisher(self, msg_type, topic, qos_profile, **kwargs):
-        pub = CapturingPublisher(self.node.create_publisher(msg_type, topic, qos_profile, **kwargs), msg_type, topic)
+        real = self.node.create_publisher(msg_type, topic, qos_profile, **kwargs)
+        pub = CapturingPublisher(real, msg_type, topic, self.destroyed)
         self.publishers.append(pub)
         return pub
 
     def destroy_publisher(self, publisher) -> bool:
         if isinstance(publisher, CapturingPublisher):
-            publisher.destroyed = True
+            publisher.note_destroyed()
         return self.node.destroy_publisher(getattr(publisher, "real", publisher))
 
     def published(self, topic: str | None = None) -> list[CapturingPublisher]:
