@@ -40,11 +40,9 @@ c.Spawner.cmd = ["jupyterhub-singleuser"]  # the image's own environment, not th
 c.Spawner.args = []
 c.Spawner.ip = "0.0.0.0"  # inside the container: its own network namespace, on the containers' network
 c.Spawner.pre_spawn_hook = None  # no domain to give, no files to copy: the image and the volume hold them
+# The base's environment for the learners, but for what names this machine (its PATH, its Jupyter
+# configuration folder): the image has its own.  The domain: the same for every learner.
 c.Spawner.environment = {
-    "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+    **{k: v for k, v in c.Spawner.environment.items() if k not in ("PATH", "JUPYTER_CONFIG_PATH")},
     "ROS_DOMAIN_ID": os.environ.get("RTT_HUB_CONTAINER_DOMAIN", "0"),
-    "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
-    "JUPYTERHUB_ACTIVITY_INTERVAL": c.Spawner.environment["JUPYTERHUB_ACTIVITY_INTERVAL"],
-    "OPENBLAS_NUM_THREADS": "1",
-    "OMP_NUM_THREADS": "1",
 }

@@ -298,3 +298,33 @@ class Learner:
         if error is not None:
             raise RuntimeError(f"code in {self.name}'s kernel raised:\n{error}\n{''.join(out)}")
         return "".join(out)
+
+
+# ---- a learner in Chromium: what a browser of theirs does through the hub ----
+
+
+def open_live_notebook(browser, hub_url: str, name: str):
+    """A page of a new browser context (cookies of its own): ``name`` logs in through the hub's form and runs
+    the first cell of ``live.ipynb`` in their home (a live view: ``tests.lab_browser.step2_notebook``)."""
+    from tests.lab_browser import run_first_cell
+
+    page = browser.new_context(viewport={"width": 1000, "height": 800}).new_page()
+    page.goto(hub_url + "/hub/login")
+    page.fill("input[name=username]", name)
+    page.fill("input[name=password]", PASSWORD)
+    page.click("input[type=submit], button[type=submit]")
+    page.wait_for_url(f"**/user/{name}/**", timeout=60_000)
+    run_first_cell(page, f"{hub_url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
+    return page
+
+
+def require_live_view_draws(page, name: str) -> None:
+    """Wait until the page's live view has drawn its scene and frames; none dropped, and not blank."""
+    from tests.lab_browser import STATS
+
+    drawing = f"(() => {{ const s = ({STATS})(); return s && s.scenes >= 1 && s.frames > 5; }})()"
+    page.wait_for_function(drawing, timeout=90_000)
+    seen = page.evaluate(STATS)
+    assert seen["dropped"] == 0, (name, seen)
+    shot = page.locator("iframe.rtt-live-view").screenshot()
+    assert len(shot) > 10_000, f"{name}'s live view is blank"  # a drawn scene, not an empty canvas

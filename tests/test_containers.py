@@ -28,7 +28,7 @@ import pytest
 from conftest import ROOT
 
 sys.path.insert(0, str(Path(__file__).parent))
-from hub import PASSWORD, Learner, free_port_block  # noqa: E402
+from hub import PASSWORD, Learner, free_port_block, open_live_notebook, require_live_view_draws  # noqa: E402
 
 pytestmark = [pytest.mark.slow, pytest.mark.cross_process]
 
@@ -199,7 +199,7 @@ def test_a_class_on_containers(tmp_path):
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
-    from tests.lab_browser import STATS, run_first_cell, step2_notebook
+    from tests.lab_browser import step2_notebook
 
     names = ["learner-a", "learner-b"]
     with hub_on_containers(tmp_path, names) as hub:
@@ -248,18 +248,7 @@ def test_a_class_on_containers(tmp_path):
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
             try:
                 for name in names:
-                    page = browser.new_context(viewport={"width": 1000, "height": 800}).new_page()
-                    page.goto(hub.url + "/hub/login")
-                    page.fill("input[name=username]", name)
-                    page.fill("input[name=password]", PASSWORD)
-                    page.click("input[type=submit], button[type=submit]")
-                    page.wait_for_url(f"**/user/{name}/**", timeout=60_000)
-                    run_first_cell(page, f"{hub.url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
-                    drawing = f"(() => {{ const s = ({STATS})(); return s && s.scenes >= 1 && s.frames > 5; }})()"
-                    page.wait_for_function(drawing, timeout=90_000)
-                    assert page.evaluate(STATS)["dropped"] == 0, name
-                    shot = page.locator("iframe.rtt-live-view").screenshot()
-                    assert len(shot) > 10_000, f"{name}'s live view is blank"
+                    require_live_view_draws(open_live_notebook(browser, hub.url, name), name)
             finally:
                 browser.close()
         log = hub.log.read_text()

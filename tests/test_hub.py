@@ -25,7 +25,7 @@ from conftest import ROOT
 sys.path.insert(0, str(ROOT / "course"))
 
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
-from hub import PASSWORD, Hub, KernelDied, Learner  # noqa: E402
+from hub import Hub, KernelDied, Learner, open_live_notebook, require_live_view_draws  # noqa: E402
 
 from netns import net, on  # noqa: E402,F401 - net: the network tier's fixture
 
@@ -220,24 +220,16 @@ def both_live_views_draw(hub: Hub, names: list[str], rtt_run_page: tuple[str, st
     from playwright.sync_api import expect, sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
-    from tests.lab_browser import STATS, run_first_cell, step2_notebook
+    from tests.lab_browser import step2_notebook
 
     for name in names:
         step2_notebook(hub_state(hub) / "homes" / name / "live.ipynb")
     with sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
         try:
-            pages = {}
-            for name in names:
-                page = browser.new_context(viewport={"width": 1000, "height": 800}).new_page()
-                page.goto(hub.url + "/hub/login")
-                page.fill("input[name=username]", name)
-                page.fill("input[name=password]", PASSWORD)
-                page.click("input[type=submit], button[type=submit]")
-                page.wait_for_url(f"**/user/{name}/**", timeout=60_000)
-                run_first_cell(page, f"{hub.url}/user/{name}/lab/workspaces/live/tree/live.ipynb")
-                pages[name] = page
+            pages = {name: open_live_notebook(browser, hub.url, name) for name in names}
             # A learner's Nbgrader menu: their assignments, and none of the teacher's tools (no formgrader)
+            page = pages[names[-1]]
             page.locator(".lm-MenuBar-itemLabel", has_text="Nbgrader").click()
             menu = page.locator(".lm-Menu-itemLabel")
             expect(menu.filter(has_text="Assignment List")).to_have_count(1)
@@ -245,12 +237,7 @@ def both_live_views_draw(hub: Hub, names: list[str], rtt_run_page: tuple[str, st
             page.keyboard.press("Escape")
             assert page.locator(".jp-Toolbar-item", has_text="Validate").count() == 0, "a Validate button is shown"
             for name, page in pages.items():
-                drawing = f"(() => {{ const s = ({STATS})(); return s && s.scenes >= 1 && s.frames > 5; }})()"
-                page.wait_for_function(drawing, timeout=90_000)
-                seen = page.evaluate(STATS)
-                assert seen["dropped"] == 0, (name, seen)
-                shot = page.locator("iframe.rtt-live-view").screenshot()
-                assert len(shot) > 10_000, f"{name}'s live view is blank"  # a drawn scene, not an empty canvas
+                require_live_view_draws(page, name)
             owner, path = rtt_run_page
             page = pages[owner]
             page.goto(hub.url + path)
