@@ -8,7 +8,8 @@
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make mutate (mutation testing of the lessons and the library's core: about 25 minutes),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
-#       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three),
+#       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three; and a live
+#       view in Notebook 7 and in JupyterLab as Colab runs it),
 #       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 80 s),
 #       make test-hub (the hub with learners as Unix users: slow), make test-robots (the UR5, SO-100 and Go2 in Chromium),
 #       make image (the learner image, podman), make hub-containers (the class on containers), make test-containers,
@@ -127,7 +128,7 @@ test-robots: $(VENV)/.installed
 # setup check and the two notebooks a learner works in with the mouse, and nbval runs every notebook).
 test-lab: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
-	RTT_LAB_ALL=1 $(PY) -m pytest tests/test_jupyterlab.py -q
+	RTT_LAB_ALL=1 $(PY) -m pytest tests/test_jupyterlab.py tests/test_frontends.py -q
 
 # The property-based tests (hypothesis) of tests/test_fuzz_*.py at length: random examples, 100 times as
 # many as make test's fixed set (RTT_FUZZ_FACTOR=N changes that); failures are kept in .hypothesis/ and

@@ -46,5 +46,22 @@ def probe(seconds: float = 2.0) -> dict:
     }
 
 
+def gpu() -> str | None:
+    """The GPU the benchmarks' Chromium draws with, or None when it draws in software (SwiftShader).
+
+    None when the machine has no render node (``/dev/dri/renderD*``) or the
+    browser is launched with ``--disable-gpu`` (tests/jupyterlab.py's
+    ``CHROMIUM_FLAGS``, as on this project's machines).
+    """
+    from pathlib import Path
+
+    from tests.jupyterlab import CHROMIUM_FLAGS
+
+    nodes = sorted(Path("/dev/dri").glob("renderD*")) if Path("/dev/dri").is_dir() else []
+    if not nodes or "--disable-gpu" in CHROMIUM_FLAGS:
+        return None
+    return str(nodes[0])
+
+
 if __name__ == "__main__":
-    print(probe())
+    print(probe(), gpu())

@@ -7,14 +7,16 @@ import re
 from pathlib import Path
 
 
+def verdict(passed: bool | None) -> str:
+    """A row's verdict as the tables write it (None: a target not held in that run)."""
+    return "n/a" if passed is None else "pass" if passed else "**FAIL**"
+
+
 def targets_markdown(r: dict) -> str:
     """The targets as a Markdown table (the book's first table)."""
     lines = ["| target | measured | baseline, same run | ratio | |", "|---|---|---|---|---|"]
     for t in r["targets"]:
-        lines.append(
-            f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | "
-            f"{'pass' if t['pass'] else '**FAIL**'} |"
-        )
+        lines.append(f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | {verdict(t['pass'])} |")
     return "\n".join(lines) + "\n"
 
 
@@ -69,8 +71,8 @@ def runs_table(paths: list[str]) -> str:
     for i, t in enumerate(last["targets"]):
         rows = [r["targets"][i] for r in runs]
         shown = [u["ratio"] or u["measured"] for u in rows]
-        each = "; ".join(f"{v} {'pass' if u['pass'] else '**FAIL**'}" for v, u in zip(shown, rows))
-        met = sum(u["pass"] for u in rows)
+        each = "; ".join(f"{v} {verdict(u['pass'])}" for v, u in zip(shown, rows))
+        met = sum(bool(u["pass"]) for u in rows)
         lines.append(
             f"| {t['target']} | {t['measured']} | {t['baseline']} | {t['ratio']} | {spread(shown)} | "
             f"{met} of {len(rows)} | {each} |"
@@ -248,4 +250,4 @@ def print_targets(r: dict) -> None:
             + (f" vs {t['baseline']}" if t["baseline"] else "")
             + (f" ({t['ratio']})" if t["ratio"] else "")
         )
-        print(f"  [{'PASS' if t['pass'] else 'FAIL'}] {t['target']}: {figure}")
+        print(f"  [{verdict(t['pass']).strip('*').upper()}] {t['target']}: {figure}")

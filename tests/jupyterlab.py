@@ -55,6 +55,10 @@ def _off(host: str) -> re.Pattern:
 
 
 # The Jupyter configuration `make notebooks` gives a learner's JupyterLab (nbgrader left out).
+# The server as a plain `pip install` or Colab runs it: without the project's nodelay server extension
+# (tutorial/view/widget/nodelay.py), so the kernel's WebSocket keeps Nagle's algorithm, and Jupyter's
+# default IOPub limits.
+WITHOUT_NODELAY = ("--ServerApp.jpserver_extensions=tutorial.view.widget.nodelay=False",)
 LEARNER_CONFIG = Path(__file__).resolve().parents[1] / "jupyter-config" / "learner"
 
 # Settings for the test's JupyterLab, by extension and plugin.
@@ -82,6 +86,10 @@ class JupyterLab:
         env: extra environment for the server and its kernels; a value of
             None removes that variable (e.g. ``{"RTT_TEST_MODE": None}``).
         timeout: how long it may take to answer, s.
+        ip: the address it listens on.
+        prefix: a command it runs under (a test host's, tests/netns.py).
+        server_args: more command-line options of the server (``--ServerApp.x=y``).
+        app: ``"lab"`` (JupyterLab) or ``"notebook"`` (Notebook 7, the same server with its own pages).
 
     Raises:
         RuntimeError: it did not answer within ``timeout`` s.
@@ -98,7 +106,12 @@ class JupyterLab:
         timeout: float = 60.0,
         ip: str = "127.0.0.1",
         prefix=(),
+        server_args=(),
+        app: str = "lab",
     ):
+        if app not in ("lab", "notebook"):
+            raise ValueError(f"app: 'lab' or 'notebook', not {app!r}")
+        self.app = app
         self.root = Path(root)
         self.port = free_port()
         self.url = f"http://{ip}:{self.port}"
@@ -128,7 +141,7 @@ class JupyterLab:
             [
                 *prefix,  # e.g. a test host's command (tests/netns.py): the server runs on that host
                 jupyter,
-                "lab",
+                app,
                 "--allow-root",
                 "--no-browser",
                 f"--ip={ip}",
@@ -138,6 +151,7 @@ class JupyterLab:
                 "--ServerApp.port_retries=0",
                 "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
                 f"--ServerApp.root_dir={self.root}",
+                *server_args,
             ],
             env=self.env,
             stdout=subprocess.DEVNULL,
@@ -151,11 +165,13 @@ class JupyterLab:
                 break
             if self.proc.poll() is not None or time.monotonic() > deadline:
                 self.close()
-                raise RuntimeError(f"jupyter lab did not start on port {self.port}")
+                raise RuntimeError(f"jupyter {app} did not start on port {self.port}")
             time.sleep(0.2)  # polling a port that is not open yet: nothing to wait on
 
     def notebook_url(self, path: str, workspace: str | None = None) -> str:
-        """The page that opens ``path``; in a fresh named ``workspace`` (no other tab reopened) if given."""
+        """The page that opens ``path``; in a fresh named ``workspace`` (no other tab reopened) if given (lab)."""
+        if self.app == "notebook":
+            return f"{self.url}/notebooks/{path}"
         return f"{self.url}/lab/workspaces/{workspace}/tree/{path}" if workspace else f"{self.url}/lab/tree/{path}"
 
     def note_processes(self) -> None:

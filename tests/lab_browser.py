@@ -1,10 +1,18 @@
 """A learner's browser, as a program: open a notebook in JupyterLab, run it, and measure its live 3D view.
 
-``python -m tests.lab_browser URL HOST`` runs headless Chromium (it may
+``python -m tests.lab_browser URL HOST [BUSY_S]`` runs headless Chromium (it may
 load nothing but ``HOST``: the test's JupyterLab), opens ``URL`` (a notebook
 whose first cell starts a run with a live view and shows it, and whose
-second cell is trivial), runs the first cell and then checks, printing one
+last cell is trivial), runs the first cell and then checks, printing one
 JSON line of what it measured:
+
+- with ``BUSY_S`` (a notebook of :func:`step2_notebook` with that ``busy_s``), it
+  runs all cells instead, and while the busy cell runs measures
+  ``first_picture_s`` (from the view's output appearing to its scene
+  drawn), ``moved_busy`` and ``fps_busy``, then reloads the page and
+  measures ``reload_busy_s`` (from the reload to the scene) and whether
+  that came before the cell ended (``reload_busy_before_end``); then the
+  below, once the kernel is idle, but the reload (the page has had one);
 
 - ``moved``: the view draws, and its picture changes while the run drives
   (the pixels that changed between two screenshots 1 s apart);
@@ -35,8 +43,42 @@ VIEW = "iframe.rtt-live-view"
 STATS = f"() => {{ const f = document.querySelector('{VIEW}'); return f && f.parentElement.rttView || null; }}"
 
 
-def step2_notebook(path: Path, node: str = "rtt") -> None:
-    """Write the notebook this program runs: Step 2 with its live view (node ``node``), then a trivial cell."""
+# From now on, each live view on the page gets a record in window.rttViewTimes (by its id): its label, when
+# its output appeared, when it had its first scene from the kernel (drawn), and when it left the page; ms on
+# the page's clock (performance.now()), polled every 50 ms.
+WATCH_VIEWS = """() => {
+    if (window.rttViewWatch) clearInterval(window.rttViewWatch);
+    window.rttViewTimes = {};
+    window.rttViewWatch = setInterval(() => {
+        const now = performance.now(), seen = new Set();
+        for (const f of document.querySelectorAll('iframe.rtt-live-view')) {
+            const v = f.parentElement.rttView;
+            if (!v) continue;
+            seen.add(v.id);
+            const t = window.rttViewTimes[v.id] ||
+                (window.rttViewTimes[v.id] = {label: f.title, appeared: now, drawn: null, gone: null});
+            if (t.drawn === null && v.scenes > 0) t.drawn = now;
+        }
+        for (const [id, t] of Object.entries(window.rttViewTimes)) if (!seen.has(id) && t.gone === null) t.gone = now;
+    }, 50);
+}"""
+
+
+def views_slow_to_draw(times: dict, now: float, most_ms: float = 2000.0) -> list[str]:
+    """The views of ``window.rttViewTimes`` that had no scene within ``most_ms`` of their output appearing,
+    as of ``now`` (the page's ``performance.now()``); one that left the page sooner, undrawn, had no time to."""
+    slow = []
+    for t in times.values():
+        end = next((x for x in (t["drawn"], t["gone"]) if x is not None), now)
+        if end - t["appeared"] > most_ms:
+            what = "its scene" if t["drawn"] is not None else "gone, undrawn," if t["gone"] is not None else "undrawn"
+            slow.append(f"{t['label']}: {what} {end - t['appeared']:.0f} ms after its output appeared")
+    return slow
+
+
+def step2_notebook(path: Path, node: str = "rtt", busy_s: float = 0.0) -> None:
+    """Write the notebook this program runs: Step 2 with its live view (node ``node``), a cell that keeps the
+    kernel busy ``busy_s`` s if that is not 0 (standing in for a scripted drive), then a trivial cell."""
     import nbformat
 
     nb = nbformat.v4.new_notebook()
@@ -48,6 +90,7 @@ def step2_notebook(path: Path, node: str = "rtt") -> None:
             f'sim = BackgroundApp(load("step2.yaml"), node_name="{node}", label="simulation /{node}").start()\n'
             "sim.show(height=320)"
         ),
+        *([nbformat.v4.new_code_cell(f"import time\n\ntime.sleep({busy_s})")] if busy_s else []),
         nbformat.v4.new_code_cell("1 + 1"),
     ]
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
@@ -84,8 +127,9 @@ def moving(page) -> int:
     return n if n > 200 else 0
 
 
-def run_first_cell(page, url: str, most_s: float = 90.0) -> None:
-    """Open the notebook at ``url`` in JupyterLab, wait until its kernel is idle, and run its first cell.
+def run_first_cell(page, url: str, most_s: float = 90.0, run_all: bool = False) -> None:
+    """Open the notebook at ``url`` in JupyterLab, wait until its kernel is idle, and run its first cell
+    (every cell, with ``run_all``, as the Run menu's Run All Cells).
 
     Raises:
         playwright's TimeoutError: the notebook or its kernel was not ready within ``most_s`` s.
@@ -96,15 +140,46 @@ def run_first_cell(page, url: str, most_s: float = 90.0) -> None:
     page.wait_for_function(
         "document.querySelector('#jp-main-statusbar').innerText.includes('Idle')", timeout=most_s * 1000
     )
+    if run_all:
+        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+        page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click()
+        return
     cells.first.click()
     page.keyboard.press("Control+Enter")
 
 
-def main(url: str, host: str) -> None:
+def while_busy(page, out: dict, busy_s: float) -> None:
+    """Run All has begun: the view draws and moves while the busy cell (``busy_s`` s) runs, and after a reload in it."""
+    cells = page.locator(".jp-Notebook .jp-Cell")
+    busy = cells.nth(1).locator(".jp-InputPrompt")
+    wait_for(page, lambda: page.locator(VIEW).count() > 0, "the live view's output", 90)
+    shown = time.monotonic()
+    wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the live view's scene while a cell runs", 60)
+    out["first_picture_s"] = round(time.monotonic() - shown, 2)
+    out["moved_busy"] = wait_for(page, lambda: moving(page), "the view moving while a cell runs", 10)
+    f0, t0 = page.evaluate(STATS)["frames"], time.monotonic()
+    page.wait_for_timeout(2000)
+    out["fps_busy"] = round((page.evaluate(STATS)["frames"] - f0) / (time.monotonic() - t0), 1)
+    assert "[*]" in busy.inner_text(), "the busy cell ended before the view was measured: make it longer"
+    page.keyboard.press("Control+s")  # the view's output is in the file the reload opens
+    page.wait_for_timeout(1000)  # saved: JupyterLab has no event for it a page can wait on
+    start = time.monotonic()
+    page.reload()
+    wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the scene after a reload in a busy cell", 60)
+    out["reload_busy_s"] = round(time.monotonic() - start, 2)
+    # the busy cell began as the view's output came (the cell before it ends with it): what it had left then
+    out["busy_left_at_reload_s"] = round(busy_s - (start - shown), 2)
+    out["reload_busy_before_end"] = out["reload_busy_s"] < out["busy_left_at_reload_s"]
+    wait_for(page, lambda: "Idle" in page.locator("#jp-main-statusbar").inner_text(), "the busy cell's end", 60)
+
+
+def main(url: str, host: str, busy: str = "") -> None:
     out: dict = {}
     with browser(width=1100, height=900, host=host) as page:
-        run_first_cell(page, url)
+        run_first_cell(page, url, run_all=bool(busy))
         cells = page.locator(".jp-Notebook .jp-Cell")
+        if busy:
+            while_busy(page, out, float(busy))
         wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the live view's scene", 90)
         wait_for(page, lambda: (page.evaluate(STATS) or {}).get("frames", 0) > 10, "frames in the view", 60)
         out["moved"] = wait_for(page, lambda: moving(page), "the view moving", 30)
@@ -112,26 +187,38 @@ def main(url: str, host: str) -> None:
         page.wait_for_timeout(3000)
         out["fps"] = round((page.evaluate(STATS)["frames"] - f0) / (time.monotonic() - t0), 1)
         out["cell_ms"] = []
-        trivial = cells.nth(1)
-        for k in range(5):
+        trivial = cells.last
+        for _ in range(5):
             trivial.click()
+            before = trivial.locator(".jp-InputPrompt").inner_text()
             start = time.monotonic()
             page.keyboard.press("Control+Enter")
-            wait_for(page, lambda k=k: f"[{k + 2}]" in trivial.locator(".jp-InputPrompt").inner_text(), "the cell", 30)
+            wait_for(
+                page,
+                lambda before=before: (p := trivial.locator(".jp-InputPrompt").inner_text()) != before and "*" not in p,
+                "the cell",
+                30,
+            )
             out["cell_ms"].append(round(1000 * (time.monotonic() - start)))
-        page.keyboard.press("Control+s")
-        page.wait_for_timeout(1000)  # saved: JupyterLab has no event for it a page can wait on
-        start = time.monotonic()
-        page.reload()
-        wait_for(page, lambda: page.locator(VIEW).count() > 0, "the view's page after a reload", 60)
-        shown = time.monotonic()
-        wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the scene after a reload", 60)
-        out["reload_s"] = round(time.monotonic() - start, 2)
-        out["scene_after_view_s"] = round(time.monotonic() - shown, 2)  # JupyterLab's own loading left out
-        out["moved_after"] = wait_for(page, lambda: moving(page), "moving after reload", 30)
+        if not busy:  # (with busy, the page has been reloaded already, in the busy cell)
+            reload_idle(page, out)
         out["dropped"] = page.evaluate(STATS)["dropped"]
     print(json.dumps(out), flush=True)
 
 
+def reload_idle(page, out: dict) -> None:
+    """Save, reload the page with the kernel idle, and time the view's scene coming back; it moves again."""
+    page.keyboard.press("Control+s")
+    page.wait_for_timeout(1000)  # saved: JupyterLab has no event for it a page can wait on
+    start = time.monotonic()
+    page.reload()
+    wait_for(page, lambda: page.locator(VIEW).count() > 0, "the view's page after a reload", 60)
+    shown = time.monotonic()
+    wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the scene after a reload", 60)
+    out["reload_s"] = round(time.monotonic() - start, 2)
+    out["scene_after_view_s"] = round(time.monotonic() - shown, 2)  # JupyterLab's own loading left out
+    out["moved_after"] = wait_for(page, lambda: moving(page), "moving after reload", 30)
+
+
 if __name__ == "__main__":
-    main(*sys.argv[1:3])
+    main(*sys.argv[1:4])

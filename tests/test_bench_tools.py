@@ -212,3 +212,21 @@ def test_a_failed_experiments_targets_read_n_a_and_fail():
         targets({})
     quick = targets({"quick": True})  # a smoke test's run lacks sizes on purpose: n/a, fails
     assert quick and all(row["measured"] == "n/a" and not row["pass"] for row in quick)
+
+
+def test_a_gpu_only_target_reads_n_a_without_a_gpu_and_is_held_with_one():
+    from benchmarks.report import verdict
+    from benchmarks.targets import BROWSER_TARGETS, GPU_ONLY
+
+    gpu_only = [t for t in BROWSER_TARGETS if t.gpu_only]
+    assert len(gpu_only) == len(GPU_ONLY) and all("ms (two 60 Hz frames)" in t.label for t in gpu_only)
+    case = {"tutorial": {"publish_to_drawn": {"p99": 50.0}}, "bare": {"sent_to_drawn": {"p99": 451.0}}}
+    run = {"browser": dict.fromkeys(GPU_ONLY, case)}
+    for t in gpu_only:
+        row = t.row(run)  # no GPU: not held, not a miss
+        assert row["pass"] is None and row["measured"].startswith("n/a: no GPU"), row
+        assert t.row({**run, "gpu": "/dev/dri/renderD128"})["pass"] is False  # with one: 50 ms misses 33.3 ms
+    assert verdict(None) == "n/a" and verdict(False) == "**FAIL**" and verdict(True) == "pass"
+    # the same cases' ratio to the bare page is held without a GPU (50 ms against 451 ms: met)
+    ratios = [t for t in BROWSER_TARGETS if not t.gpu_only and "x the bare page" in t.label and "arm" in t.label]
+    assert len(ratios) == 1 and ratios[0].row(run)["pass"] is True

@@ -19,7 +19,9 @@ What a learner does and sees, checked on the page itself:
   and the two above; every notebook ``notebooks/[0-9][0-9]_*.ipynb`` with
   ``RTT_LAB_ALL=1`` (``make test-lab``).  Run All
   runs every cell once, in order, with no error output and no stderr
-  output but the committed notebook's; every 3D view draws the tank (never
+  output but the committed notebook's; every live view has its scene from
+  the kernel within 2 s of its output appearing, while the notebook still
+  runs (``tests/lab_browser.py``'s ``WATCH_VIEWS``); every 3D view draws the tank (never
   blank, never the browser's error page), in each of its panes; a caption
   says "live" only under a live page whose server answers, and a live page
   always has such a caption; and, the notebooks ending with ``reset()``,
@@ -67,6 +69,8 @@ pytest.importorskip("psutil", reason="psutil is not installed (pip install -e .[
 
 from playwright.sync_api import Error as PlaywrightError  # noqa: E402
 from playwright.sync_api import expect
+
+from tests.lab_browser import WATCH_VIEWS, views_slow_to_draw  # noqa: E402
 
 from jupyterlab import CHROMIUM, JupyterLab, browser  # noqa: E402 - after the skips
 
@@ -632,6 +636,7 @@ def run_notebook(lane: Lane, notebook: Path, outcome: dict) -> None:
             lane.log(f"{stem}: {check}: {'passed' if outcome[f'{stem}: {check}'] is None else 'FAILED'}")
         first = lane.count + 1
         out_of_sight(lane)
+        lane.page.evaluate(WATCH_VIEWS)  # each live view, timed while the notebook still runs
         run(
             lane,
             "runmenu:run-all",
@@ -639,6 +644,10 @@ def run_notebook(lane: Lane, notebook: Path, outcome: dict) -> None:
             f"{stem}: Run All",
             120,
         )
+        times, now = lane.page.evaluate("[window.rttViewTimes, performance.now()]")
+        slow = views_slow_to_draw(times, now)
+        assert not slow, f"{stem}: live views slow to draw while the notebook ran: {slow}"
+        lane.log(f"{stem}: {len(times)} live view(s) drew within 2 s of appearing, while the notebook ran")
         saved = save(lane, name)
         check_outputs(saved, committed, stem, first)
         seen = check_views(lane, stem)

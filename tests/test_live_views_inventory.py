@@ -68,3 +68,86 @@ def test_the_live_plot_and_the_camera_picture_are_live_outputs():
     from tutorial.notebook.live_plot import LivePlot
 
     assert issubclass(LivePlot, LiveOutput) and issubclass(LiveImage, LiveOutput)
+
+
+# Every way the notebooks, the book, the README and the docstrings show a run's 3D view, each run below.
+VIEW_FORMS = {
+    "app.show()": "sim.show(height=300)",  # BackgroundApp.show: sim, viewer, viewer_app in the notebooks
+    "views.show(app.view, ...)": "views.show(sim.view, height=320)",
+    "views.show(a.view, b.view, ...)": "views.show(sim.view, viewer.view, height=320)",
+    "display(app.view)": "display(sim.view)",
+    "app.view, as a cell's last expression": "sim.view",
+}
+# What else is shown with .show() in those texts, and is not a run's 3D view.
+OTHER_SHOWN = {"plt", "plot", "camera_view", "page"}  # matplotlib, LivePlot, LiveImage, MeshcatPage (its own test)
+RUNS = {"sim", "viewer", "viewer_app", "self"}  # BackgroundApps in the notebooks; self: runs.py's own show()
+
+
+def documented_texts():
+    import json
+
+    root = NOTEBOOK_LAYER.parents[1]
+    for path in sorted((root / "notebooks").glob("*.ipynb")):
+        for cell in json.loads(path.read_text(encoding="utf-8"))["cells"]:
+            yield path.name, "".join(cell["source"])
+    for path in [
+        root / "README.md",
+        *sorted((root / "book").rglob("*.md")),
+        *sorted((root / "tutorial").rglob("*.py")),
+    ]:
+        if "_build" not in path.parts:
+            yield str(path.relative_to(root)), path.read_text(encoding="utf-8")
+
+
+def test_every_way_the_texts_show_a_view_is_one_tested_here():
+    unknown = set()
+    for where, text in documented_texts():
+        for receiver in re.findall(r"\b(\w+)\.show\(", text):
+            if receiver not in RUNS | OTHER_SHOWN | {"views"}:
+                unknown.add(f"{where}: {receiver}.show(")
+        for shown in re.findall(r"views\.show\(([^)]*)\)", text):
+            for arg in filter(None, (a.strip() for a in shown.split(","))):
+                if "=" not in arg and not (arg.startswith("*") or re.fullmatch(r"\w+\.view", arg)):
+                    unknown.add(f"{where}: views.show({shown})")
+        for shown in re.findall(r"display\((\w+\.view)\)", text):
+            if shown.split(".")[0] not in RUNS:
+                unknown.add(f"{where}: display({shown})")
+    assert not unknown, "a way to show a view that VIEW_FORMS does not run:\n" + "\n".join(sorted(unknown))
+
+
+@pytest.fixture(scope="module")
+def shell():
+    from IPython.core.interactiveshell import InteractiveShell
+
+    ip = InteractiveShell.instance()
+    setup = ip.run_cell(
+        "from tutorial.notebook.runs import BackgroundApp, load\n"
+        "from tutorial.notebook import views\n"
+        "sim = BackgroundApp(load('step2.yaml'), node_name='shown')\n"
+        "viewer = BackgroundApp(load('step3.yaml'), node_name='shown_viewer')\n"
+    )
+    assert setup.success, setup.error_in_exec
+    yield ip
+    ip.run_cell("sim.stop(); viewer.stop()")
+
+
+@pytest.mark.parametrize("form", sorted(VIEW_FORMS))
+def test_each_way_to_show_a_view_shows_its_live_widget(shell, form):
+    from IPython.utils.capture import capture_output
+
+    with capture_output() as shown:
+        result = shell.run_cell(VIEW_FORMS[form])
+    assert result.success, f"{form}: {result.error_in_exec!r}"
+    widgets = [
+        o.data["application/vnd.jupyter.widget-view+json"]["model_id"]
+        for o in shown.outputs
+        if "application/vnd.jupyter.widget-view+json" in o.data
+    ]
+    assert len(widgets) == 1, f"{form} showed {[list(o.data) for o in shown.outputs]}, not one live view"
+    sim, viewer = shell.user_ns["sim"], shell.user_ns["viewer"]
+    display_ = sim.view._displays[-1]  # the output this form made
+    if "viewer" in VIEW_FORMS[form]:  # side by side: one box of both views' widgets
+        assert display_._box is not None and widgets == [display_._box.model_id]
+        assert list(display_._box.children) == [sim.view.widget, viewer.view.widget]
+    else:
+        assert widgets == [sim.view.widget.model_id]

@@ -10,11 +10,16 @@ nothing else.  The hosts are the network tier's (tests/netns.py):
   robot host's Jupyter port and nothing else on it (the kernel's and ROS's
   sockets are the robot host's own).
 
-A notebook starts Step 2 with its live view (``BackgroundApp(...).show()``):
-the view gets its scene, draws, and moves while the joystick drives; a
-trivial cell answers while the view is live; after a page reload the view
-has its scene again and moves.  The same then runs with the browser on the
-robot host, the kernel's own.  The figures are printed (``-s``).
+A notebook starts Step 2 with its live view (``BackgroundApp(...).show()``),
+run with Run All, then keeps the kernel busy for 12 s: the view draws its
+first picture within 2 s of its output appearing and moves while the
+joystick drives, while the cell runs; a page reload in that cell has the
+scene back (once the cell ends: JupyterLab restores widgets through the
+kernel's main shell).  Then, with the kernel idle: the view moves, and a
+trivial cell answers while the view is live.  The same without the busy
+cell, with the browser on the robot host, the kernel's own, and an idle
+page reload that has the scene back within 5 s, is a ``more`` case.
+The figures are printed (``-s``).
 """
 
 from __future__ import annotations
@@ -36,10 +41,15 @@ pytestmark = pytest.mark.network
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def browse(host, url: str, address: str) -> dict:
+# The busy cell of the Run All notebook (a scripted drive or a wait_until, as a learner's): long enough that the
+# view is measured and the page reloaded while it runs (the browser checks that it still ran).
+BUSY_S = 12
+
+
+def browse(host, url: str, address: str, busy_s: float = 0) -> dict:
     """tests/lab_browser.py on ``host``; what it measured."""
     done = subprocess.run(
-        host.command([sys.executable, "-m", "tests.lab_browser", url, address]),
+        host.command([sys.executable, "-m", "tests.lab_browser", url, address, *([str(busy_s)] if busy_s else [])]),
         cwd=ROOT,
         env=host.env(PYTHONPATH=str(ROOT)),
         capture_output=True,
@@ -50,10 +60,11 @@ def browse(host, url: str, address: str) -> dict:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def test_a_live_view_reaches_a_browser_through_jupyters_port_alone(net, procs, tmp_path):  # noqa: F811
-    robot, operator = net["robot"], net["operator"]
-    step2_notebook(tmp_path / "remote.ipynb", "rtt")
-    step2_notebook(tmp_path / "local.ipynb", "rtt_local")
+def lab_run(hosts, procs, tmp_path, where: str, busy_s: float = 0) -> dict:
+    """Step 2's notebook in a JupyterLab on the robot host, the demo joystick driving, the browser on
+    ``where`` ("operator": another host; "robot": the kernel's own); what the browser measured."""
+    robot, host = hosts["robot"], hosts[where]
+    step2_notebook(tmp_path / "step2.ipynb", f"rtt_{where}", busy_s=busy_s)
     on(procs, robot, "tutorial.tools.rtt_joy", "--demo")
     env = {
         "ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET",  # the robot host's own subnet: nothing else is on it
@@ -61,15 +72,34 @@ def test_a_live_view_reaches_a_browser_through_jupyters_port_alone(net, procs, t
         "RTT_TEST_MODE": None,  # a run lasts until the kernel stops, as for a learner
     }
     with JupyterLab(tmp_path, env=env, ip=robot.address, prefix=robot.command([])) as lab:
-        results = {}
-        for where, host, name in (("another host", operator, "remote"), ("the kernel's host", robot, "local")):
-            got = browse(host, lab.notebook_url(f"{name}.ipynb", workspace=name), robot.address)
-            print(f"browser on {where}: {got}")
-            results[where] = got
-            lab.note_processes()
-    for where, got in results.items():
-        assert got["moved"] > 200 and got["moved_after"] > 200, f"{where}: the view did not move: {got}"
-        assert got["fps"] >= 10, f"{where}: the view drew {got['fps']} frames/s from the kernel"
-        assert max(got["cell_ms"]) < 1000, f"{where}: a trivial cell took {got['cell_ms']} ms"
-        assert got["reload_s"] < 5, f"{where}: the scene came {got['reload_s']} s after the reload"
-        assert got["dropped"] == 0, f"{where}: the view dropped {got['dropped']} frames"
+        got = browse(host, lab.notebook_url("step2.ipynb", workspace=where), robot.address, busy_s)
+        print(f"browser on {where}: {got}")
+        lab.note_processes()
+    assert got["moved"] > 200, f"the view did not move: {got}"
+    assert got["fps"] >= 10, f"the view drew {got['fps']} frames/s from the kernel"
+    assert max(got["cell_ms"]) < 1000, f"a trivial cell took {got['cell_ms']} ms"
+    assert got["dropped"] == 0, f"the view dropped {got['dropped']} frames"
+    if not busy_s:  # with a busy cell, the page was reloaded in it (measured by the busy test)
+        assert got["moved_after"] > 200, f"the view did not move after a reload: {got}"
+        assert got["reload_s"] < 5, f"the scene came {got['reload_s']} s after the reload"
+    return got
+
+
+def test_a_live_view_draws_through_jupyters_port_alone_while_run_all_keeps_the_kernel_busy(
+    net,  # noqa: F811
+    procs,
+    tmp_path,
+):
+    got = lab_run(net, procs, tmp_path, "operator", busy_s=BUSY_S)
+    assert got["first_picture_s"] < 2, f"the view's first picture came {got['first_picture_s']} s after its output"
+    assert got["moved_busy"] > 200, f"the view did not move while a cell ran: {got}"
+    assert got["fps_busy"] >= 20, f"the view drew {got['fps_busy']} frames/s while a cell ran"
+    # A reload while a cell runs: JupyterLab restores the page's widgets through the kernel's main shell
+    # (comm_info_request), which answers once the cell ends.  Its time is printed, not held to 2 s (the
+    # README, "While a cell runs"); the scene must come back, and the view move, once the cell has ended.
+    assert got["reload_busy_s"] < BUSY_S + 10, f"no scene after a reload in the busy cell: {got}"
+
+
+@pytest.mark.more
+def test_a_live_view_in_a_browser_on_the_kernels_host(net, procs, tmp_path):  # noqa: F811
+    lab_run(net, procs, tmp_path, "robot")

@@ -18,7 +18,10 @@ side's samples pooled over its rounds; each round's p99s kept beside):
   handed -> drawn is the kernel's ``put`` of the state -> the view's
   animation frame after the frame holding it (``window.rttProbe``).  A
   state that a newer one replaced before it went out is not counted, as a
-  state the page never drew is not.
+  state the page never drew is not;
+- **widget_plain**: the same, on a server without the project's nodelay
+  extension, as Colab or a plain ``pip install`` runs it (each frame waits
+  for Nagle's algorithm on the kernel's WebSocket).
 
 The tape comes from ``browser.tutorial_run``, whose publisher runs
 ``browser.SLIDE`` times slower than its case (49.9 Hz for 50 Hz), so its
@@ -112,12 +115,16 @@ IFRAME_RAFS = """() => {
 }"""
 
 
-def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
-    """Replay ``tape`` into a MeshcatWidget in a JupyterLab kernel, shown in Chromium; the raw records."""
+def widget_run(tape: list, directory: Path, timeout_s: float = 120.0, nodelay: bool = True) -> dict:
+    """Replay ``tape`` into a MeshcatWidget in a JupyterLab kernel, shown in Chromium; the raw records.
+
+    ``nodelay=False``: the server as Colab or a plain ``pip install`` runs it, without the project's
+    nodelay extension (``tests.jupyterlab.WITHOUT_NODELAY``).
+    """
     import nbformat
     from playwright.sync_api import sync_playwright
 
-    from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS, JupyterLab
+    from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS, WITHOUT_NODELAY, JupyterLab
     from tests.lab_browser import STATS, run_first_cell
 
     tape_file, out = directory / "tape.json", directory / "widget_out.json"
@@ -126,7 +133,8 @@ def widget_run(tape: list, directory: Path, timeout_s: float = 120.0) -> dict:
     nb.cells = [nbformat.v4.new_code_cell(REPLAY_CELL.format(tape=str(tape_file), out=str(out)))]
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
     nbformat.write(nb, directory / "replay.ipynb")
-    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}) as lab, sync_playwright() as pw:
+    args = () if nodelay else WITHOUT_NODELAY
+    with JupyterLab(directory, env={"PYTHONPATH": str(ROOT)}, server_args=args) as lab, sync_playwright() as pw:
         browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
         try:
             page = browser.new_page(viewport={"width": 1000, "height": 800})
@@ -221,43 +229,131 @@ def summarise_page(rounds: list[dict]) -> dict:
     return out
 
 
-def widget_vs_page(cases: list[str], seconds: float, warmup: float, rounds: int = WIDGET_ROUNDS) -> dict:
-    """Every case: the taped viewer replayed to the WebSocket page and to the widget, ``rounds`` times each.
+SIDES = ("page", "widget", "widget_plain")  # widget_plain: the server without the nodelay extension (Colab)
 
-    The two replays alternate (page first in even rounds, the widget first
-    in odd ones), so a drift of the machine over the minutes of a case
-    falls on both sides, and each side's samples are pooled over its rounds:
-    a p99 of one replay's 300 states is its third-latest state (one run's
-    three rounds gave eight tanks 1.26x, 1.26x and 1.14x the page: the
-    Benchmarks page, "Live views in the notebook").  Each round's own p99s
-    and their ratio are kept in ``rounds``, to show that spread.
+
+def widget_vs_page(cases: list[str], seconds: float, warmup: float, rounds: int = WIDGET_ROUNDS) -> dict:
+    """Every case: the taped viewer replayed to the WebSocket page, to the widget, and to the widget on a
+    server without the project's nodelay extension (as Colab or a plain ``pip install`` runs it), ``rounds``
+    times each.
+
+    The replays rotate (round r starts at side r of :data:`SIDES`), so a
+    drift of the machine over the minutes of a case falls on every side,
+    and each side's samples are pooled over its rounds: a p99 of one
+    replay's 300 states is its third-latest state (one run's three rounds
+    gave eight tanks 1.26x, 1.26x and 1.14x the page: the Benchmarks page,
+    "Live views in the notebook").  Each round's own p99s and their ratios
+    are kept in ``rounds``, to show that spread.
     """
     out = {}
     for case in cases:
-        pages, widgets, each = [], [], []
+        got: dict[str, list] = {side: [] for side in SIDES}
+        each = []
         with tempfile.TemporaryDirectory() as d:
             tape = tutorial_run(case, seconds, Path(d))["tape"]
             for r in range(rounds):
-                order = ("page", "widget") if r % 2 == 0 else ("widget", "page")
+                order = SIDES[r % len(SIDES) :] + SIDES[: r % len(SIDES)]
                 for side in order:
                     if side == "page":
-                        pages.append(bare_samples(*bare_run(tape, batch=True), warmup))
+                        got[side].append(bare_samples(*bare_run(tape, batch=True), warmup))
                     else:
-                        widgets.append(widget_samples(widget_run(tape, Path(tempfile.mkdtemp(dir=d))), warmup))
-                page_p99 = pct(pages[-1]["sent_to_drawn"], 1e-6)["p99"]
-                widget_p99 = pct(widgets[-1]["handed_to_drawn"], 1e-6)["p99"]
-                each.append(
-                    {
-                        "first": order[0],
-                        "page_p99_ms": page_p99,
-                        "widget_p99_ms": widget_p99,
-                        "ratio": round(widget_p99 / page_p99, 3) if page_p99 and widget_p99 else None,
-                        "widget_frames_per_s": widgets[-1]["frames_per_s"],
-                    }
-                )
-                print(f"widget {case}, round {r + 1} of {rounds}: {json.dumps(each[-1])}", flush=True)
-        out[case] = {"page": summarise_page(pages), "widget": summarise_widget(widgets), "rounds": each}
+                        run = widget_run(tape, Path(tempfile.mkdtemp(dir=d)), nodelay=side == "widget")
+                        got[side].append(widget_samples(run, warmup))
+                page_p99 = pct(got["page"][-1]["sent_to_drawn"], 1e-6)["p99"]
+                row = {"first": order[0], "page_p99_ms": page_p99}
+                for side in ("widget", "widget_plain"):
+                    p99 = pct(got[side][-1]["handed_to_drawn"], 1e-6)["p99"]
+                    row[f"{side}_p99_ms"] = p99
+                    row[f"{side}_ratio"] = round(p99 / page_p99, 3) if page_p99 and p99 else None
+                    row[f"{side}_frames_per_s"] = got[side][-1]["frames_per_s"]
+                each.append(row)
+                print(f"widget {case}, round {r + 1} of {rounds}: {json.dumps(row)}", flush=True)
+        out[case] = {
+            "page": summarise_page(got["page"]),
+            "widget": summarise_widget(got["widget"]),
+            "widget_plain": summarise_widget(got["widget_plain"]),
+            "rounds": each,
+        }
         print(f"widget {case}: {json.dumps(out[case])}", flush=True)
+    return out
+
+
+FIRST_PICTURE_CELLS = (
+    "import time\n\nimport meshcat.geometry as g\n\nfrom tutorial.view.widget.widget import MeshcatWidget\n\n\n"
+    "def view():\n"
+    '    w = MeshcatWidget("first picture", 300)\n'
+    '    w.visualizer()["box"].set_object(g.Box([0.2, 0.2, 0.2]))\n'
+    "    return w",
+    "view()",
+    "time.sleep(3)",  # the busy cell: Run Selected Cell and All Below runs it right after the view's cell
+)
+
+
+def _run_cell(page, cell, run) -> None:
+    """Select ``cell`` (a locator) and ``run()`` it; again, up to three times, until its prompt changes
+    (a page that has just loaded may miss the first keystroke)."""
+    from tests.lab_browser import wait_for
+
+    prompt = cell.locator(".jp-InputPrompt")
+    before = prompt.inner_text()
+    for _ in range(3):
+        cell.locator(".jp-InputArea-editor").click()
+        run()
+        try:
+            wait_for(page, lambda: prompt.inner_text() != before, "the cell to start", 5)
+            return
+        except TimeoutError:
+            continue
+    raise RuntimeError(f"the cell did not run: its prompt stayed {before!r}")
+
+
+def first_picture(tries: int = 10) -> dict:
+    """How long a new view's first picture takes, from its output appearing to its scene drawn, ms, with the
+    kernel idle (its cell alone) and busy (a 3 s cell queued right after it, as Run All does), ``tries``
+    of each, alternating, in one JupyterLab page (after one view not counted: the page's first fetches
+    meshcat's viewer script)."""
+    import nbformat
+
+    from tests.jupyterlab import JupyterLab, browser
+    from tests.lab_browser import WATCH_VIEWS, wait_for
+
+    times: dict[str, list[float]] = {"idle": [], "busy": []}
+    with tempfile.TemporaryDirectory() as d:
+        nb = nbformat.v4.new_notebook()
+        nb.cells = [nbformat.v4.new_code_cell(c) for c in FIRST_PICTURE_CELLS]
+        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+        nbformat.write(nb, Path(d) / "first.ipynb")
+        with JupyterLab(Path(d), env={"PYTHONPATH": str(ROOT)}) as lab, browser(1000, 800) as page:
+            page.goto(lab.notebook_url("first.ipynb", workspace="first"))
+            cells = page.locator(".jp-Notebook .jp-Cell")
+            idle = page.locator(".jp-Notebook-ExecutionIndicator[data-status='idle']")
+            idle.wait_for(timeout=90_000)
+            page.evaluate(WATCH_VIEWS)
+            _run_cell(page, cells.first, lambda: page.keyboard.press("Control+Enter"))
+
+            def run_and_sleep():
+                page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+                page.locator(".lm-Menu-itemLabel", has_text="Run Selected Cell and All Below").first.click()
+
+            for k in range(2 * tries + 1):
+                kind = "busy" if k % 2 else "idle"
+                idle.wait_for(timeout=60_000)
+                before = set(page.evaluate("Object.keys(window.rttViewTimes)"))
+                if kind == "idle":
+                    _run_cell(page, cells.nth(1), lambda: page.keyboard.press("Control+Enter"))
+                else:
+                    _run_cell(page, cells.nth(1), run_and_sleep)
+
+                def drawn(before=before):
+                    new = [t for i, t in page.evaluate("window.rttViewTimes").items() if i not in before]
+                    return new[0] if new and new[0]["drawn"] is not None else None
+
+                t = wait_for(page, drawn, f"a new view's picture ({kind})", 60)
+                if k:  # the first view of the page also fetches meshcat's viewer script: not counted
+                    times[kind].append(t["drawn"] - t["appeared"])
+            lab.note_processes()
+    out = {kind: {**pct(ms, 1.0), "ms": [round(x) for x in ms]} for kind, ms in times.items()}
+    print(f"first picture: {json.dumps(out)}", flush=True)
     return out
 
 
@@ -308,7 +404,11 @@ def main(argv=None) -> int:
     p.add_argument("--cases", nargs="+", choices=list(CASES), default=list(WIDGET_CASES))
     p.add_argument("--rounds", type=int, default=WIDGET_ROUNDS, help=f"replays per side (default {WIDGET_ROUNDS})")
     p.add_argument("--remote", action="store_true", help="also the browser on a second host over 5 Mbit/s (root)")
+    p.add_argument("--first-picture", action="store_true", help="only a new view's first picture, kernel idle/busy")
     args = p.parse_args(argv)
+    if args.first_picture:
+        print(json.dumps(first_picture(), indent=1))
+        return 0
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
     r = {"cases": widget_vs_page(args.cases, args.seconds, args.warmup, args.rounds)}

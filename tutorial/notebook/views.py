@@ -15,7 +15,9 @@ notebook (and the book) shows what happened.
 A kernel that is restarted or shut down takes its widgets with it: the
 page then says the view is not live any more (``widget.js``).
 
-:func:`show` puts one or more views side by side in one output.
+:func:`show` puts one or more views side by side in one output; a view
+shows itself the same way (``display(sim.view)``, or ``sim.view`` as a
+cell's last expression), and ``sim.show()`` shows a run's view.
 
 Threads: :func:`show` and :meth:`LiveView.close` run on the kernel
 thread; :meth:`LiveView.visualizer`, :meth:`LiveView.begin` and
@@ -79,8 +81,9 @@ class LiveView:
 
         A run nobody watches then costs nothing (a class's server, a learner who closed the page), and loses
         nothing: simulated time stands still.  Only a run a page has shown pauses (a notebook run without a
-        browser, as the tests run them, never does), and never while a cell runs: a running cell is use,
-        and a page's messages wait behind it on the kernel's shell channel.  A view on a visible page says
+        browser, as the tests run them, never does), and never while a cell runs: a running cell is use
+        (it may be waiting on this run), and where the views have no kernel subshell a page's messages wait
+        behind it.  A view on a visible page says
         so every few seconds (``widget.js``), even when nothing moves.
         """
         from tutorial.view.widget.widget import cell_running
@@ -135,6 +138,10 @@ class LiveView:
             self.widget.status = status
 
     # ---- kernel thread ---------------------------------------------------------------------
+    def _ipython_display_(self) -> None:
+        """``display(view)``, or a view as a cell's last expression: shown as :func:`show` shows it."""
+        show(self)
+
     def recording(self):
         """A :class:`tutorial.notebook.replay.ViewRecording` of the last run, or None if nothing was drawn."""
         with self._lock:

@@ -30,10 +30,12 @@ animation frame of its own, and less on a slow machine or a slow link.
   Unlike meshcat's server, a node keeps one value per property name (the
   newest), so a property set every frame does not grow the tree.
 
-While the kernel runs a cell, it reads no message from the browser: a
-view's ``drawn`` waits until the cell ends.  So while a cell runs
-(:meth:`take`'s ``busy``), the flow sends without waiting for answers, at
-most :data:`BUSY_RATE` frames a second and at most :data:`BUSY_UNANSWERED`
+Where the views have no kernel subshell of their own
+(``widget._ViewSubshell``: ipykernel before 7.4), the kernel reads no
+message from the browser while it runs a cell: a view's ``drawn`` waits
+until the cell ends.  So while a cell runs there (:meth:`take`'s
+``busy``), the flow sends without waiting for answers, at most
+:data:`BUSY_RATE` frames a second and at most :data:`BUSY_UNANSWERED`
 frames in a row: a run a cell waits on stays live in the page, and a page
 that closed meanwhile costs a bounded number of messages.
 

@@ -24,8 +24,9 @@ at most four frames in flight and the scene kept for a page that opens later are
 
 Threads: the visualizer (:meth:`visualizer`, :class:`WidgetWindow`) belongs to
 one thread, usually a run's owner thread; the browser's messages arrive on
-the kernel's thread.  Both end in a send, under one lock (see
-``MeshcatWidget._lock``).  The widget is shown, closed and displayed from
+the views' kernel subshell (:class:`_ViewSubshell`), a thread of its own,
+or on the kernel's thread where there is none.  Both end in a send, under
+one lock (see ``MeshcatWidget._lock``).  The widget is shown, closed and displayed from
 the kernel's thread.
 """
 
@@ -65,12 +66,16 @@ def _esm() -> str:
 class _CellWatch:
     """Whether the kernel is running a cell now (IPython's ``pre_run_cell`` and ``post_run_cell``).
 
-    While a cell runs, the kernel reads no message from the browser, so no
-    view can answer a frame: :class:`FrameFlow` then sends on a timer instead.
+    While a cell runs, the kernel's main shell reads no message from the
+    browser.  Where the views have no subshell of their own (:class:`_ViewSubshell`),
+    no view can answer a frame then: :class:`FrameFlow` sends on a timer instead.
     Outside IPython (a script) no cell ever runs.
     """
 
     busy = False
+    # the running cell's request and ipykernel's context of it, kept at its start: where output from threads goes
+    cell_request = None
+    cell_context = None
     _installed = False
 
     @classmethod
@@ -90,16 +95,115 @@ class _CellWatch:
 
     @classmethod
     def _begin(cls, *_args) -> None:
+        kernel = _kernel()
+        if kernel is not None:
+            cls.cell_request, cls.cell_context = kernel.get_parent(), getattr(kernel, "_shell_context", None)
         cls.busy = True
 
     @classmethod
     def _end(cls, *_args) -> None:
         cls.busy = False
+        cls.cell_request = cls.cell_context = None
+
+    @classmethod
+    def give_output_back(cls) -> None:
+        """Make the running cell, if any, the parent of output from threads again (a view message's thread).
+
+        ipykernel makes each message it handles the parent of all output
+        from threads (``print`` in a thread a cell started goes to the last
+        message's output).  A view's message handled while a cell runs would
+        take that output from the cell.  The message's own status messages
+        keep their parent.
+        """
+        kernel, request, context = _kernel(), cls.cell_request, cls.cell_context
+        if kernel is None or request is None or context is None or kernel.shell is None:
+            return
+        kernel._shell_context = context
+        kernel.shell.set_parent(request)
 
 
 def cell_running() -> bool:
     """Whether the kernel is running a cell now (False outside IPython); any thread."""
     return _CellWatch.busy
+
+
+def _kernel():
+    """The ipykernel kernel of this process, or None (a script, another kernel)."""
+    try:
+        from ipykernel.kernelbase import Kernel
+    except ImportError:
+        return None
+    return Kernel.instance() if Kernel.initialized() else None
+
+
+class _ViewSubshell:
+    """One kernel subshell that hears every live view's messages, so a busy kernel still answers its views.
+
+    A view's messages to the kernel (its hello, ``drawn``, the viewer script
+    it asks for) are comm messages on the kernel's shell channel.  The main
+    shell reads them only between cells: with Run All, behind every cell
+    already sent.  ipykernel 7 runs *subshells* (Jupyter's kernel subshells,
+    JEP 91), each a thread with its own queue, and sends a comm's messages to
+    the subshell the comm names (``BaseComm._reply_subshell_for``).  Every
+    view's comm names this one subshell, created once per kernel: a view
+    draws its first picture, and keeps drawing at its own rate, while a cell
+    runs.
+
+    What it costs: each view message makes the kernel say "busy" then "idle"
+    on its own (Jupyter's kernel indicator may show idle while a cell
+    runs); and while ipykernel handles one, output from threads a cell
+    started would go to that message, not to the cell, so the view's handler
+    hands them back (:meth:`MeshcatWidget._handle_msg`).
+
+    Where ipykernel has no subshells (before 7) or no comm routing (before
+    7.4), or outside a kernel, :meth:`id` is None and views wait for the
+    kernel to be idle, as before.  Any thread.
+    """
+
+    _id: str | None = None
+    _tried = False
+    _lock = threading.Lock()  # one subshell however many views are made, from whichever threads
+
+    @classmethod
+    def id(cls) -> str | None:
+        with cls._lock:
+            if not cls._tried:
+                cls._tried = True
+                cls._id = cls._create()
+            return cls._id
+
+    @staticmethod
+    def _create() -> str | None:
+        kernel = _kernel()
+        try:
+            from ipykernel.comm.comm import BaseComm
+        except ImportError:
+            return None
+        thread = getattr(kernel, "shell_channel_thread", None)
+        if not getattr(kernel, "_supports_kernel_subshells", False) or thread is None:
+            return None
+        if not hasattr(BaseComm, "_reply_subshell_for"):
+            return None
+        made: dict = {}
+        done = threading.Event()
+
+        def create() -> None:  # on the shell channel's thread, as ipykernel's own create_subshell_request
+            try:
+                made["id"] = thread.manager._create_subshell()
+            finally:
+                done.set()
+
+        thread.io_loop.add_callback(create)
+        return made.get("id") if done.wait(5.0) else None
+
+    @classmethod
+    def route(cls, comm) -> bool:
+        """Send ``comm``'s messages from the browser to the views' subshell; whether it could."""
+        subshell = cls.id()
+        if subshell is None or comm is None or not hasattr(comm, "_reply_subshell_for"):
+            return False
+        comm._reply_subshell_for = lambda _data, _default: subshell
+        return True
 
 
 class MeshcatWidget(anywidget.AnyWidget):
@@ -125,7 +229,7 @@ class MeshcatWidget(anywidget.AnyWidget):
     def __init__(self, label: str = "meshcat", height: int = 380):
         super().__init__(label=label, height=height)
         _CellWatch.install()
-        # The flow is touched by the visualizer's thread (commands, frames) and the kernel's thread
+        # The flow is touched by the visualizer's thread (commands, frames) and the browser's messages' thread
         # (a view's hello and drawn): the lock keeps each change of the flow and the send that follows
         # it together, so the messages leave in the order the flow made them.
         self._lock = threading.Lock()
@@ -136,6 +240,7 @@ class MeshcatWidget(anywidget.AnyWidget):
         self.last_heard = time.monotonic()  # when a page last said anything: a run unwatched pauses (runs.py)
         self.probe: list | None = None  # a benchmark's list: (frame number, monotonic ns when sent) of each frame
         self.on_msg(self._on_message)
+        self.off_main = _ViewSubshell.route(self.comm)  # the browser's messages come on the views' subshell
 
     def __repr__(self) -> str:  # the same text every run (a saved output's text/plain)
         return f"MeshcatWidget({self.label!r})"
@@ -163,14 +268,21 @@ class MeshcatWidget(anywidget.AnyWidget):
             self._send_frame()
 
     def _send_frame(self) -> None:  # with self._lock held
-        buffers = self.flow.take(time.monotonic(), busy=_CellWatch.busy)
+        buffers = self.flow.take(time.monotonic(), busy=_CellWatch.busy and not self.off_main)
         if buffers is not None:
             n = self.flow.frames_sent
             self.send({"type": "frame", "n": n}, buffers)
             if self.probe is not None:
                 self.probe.append((n, time.monotonic_ns()))
 
-    # ---- the kernel's thread: what the browser says ------------------------------------------------
+    # ---- the views' subshell (else the kernel's thread): what the browser says ---------------------------
+    def _handle_msg(self, msg) -> None:
+        try:
+            super()._handle_msg(msg)
+        finally:
+            if self.off_main:  # handled while a cell may run: its threads' output stays the cell's
+                _CellWatch.give_output_back()
+
     def _on_message(self, _widget, content, buffers) -> None:
         self.last_heard = time.monotonic()
         kind = content.get("type") if isinstance(content, dict) else None

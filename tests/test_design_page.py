@@ -1,0 +1,90 @@
+"""The book's design page and the layout page say what the code is: each figure measured from the code.
+
+``book/design.md`` names the definitions that hold the design, each row
+with "about N lines".  Each named file and definition must exist (a dotted
+name is a method of a class), and each row's figure must be within 10 % of
+the lines its definitions span (decorators included).  The page's total and
+the library's size are held the same way, and so are the lessons' library's
+figures in ``book/reference/layout.md`` (``scripts/library_size.py``).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.unit
+
+ROOT = Path(__file__).resolve().parents[1]
+DESIGN = ROOT / "book" / "design.md"
+LAYOUT = ROOT / "book" / "reference" / "layout.md"
+ROW = re.compile(r"^\| `(tutorial/[\w/]+\.py)`: (.+?) \(about (\d+) lines\) \|", re.MULTILINE)
+
+
+def span(path: Path, name: str) -> int:
+    """Lines of the definition ``name`` (``Class.method`` for a method) in ``path``.
+
+    Raises:
+        LookupError: there is no such definition.
+    """
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    scope, *rest = name.split(".")
+    kinds = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
+    node = next((n for n in ast.walk(tree) if isinstance(n, kinds) and n.name == scope), None)
+    if node is not None and rest:
+        node = next((n for n in node.body if isinstance(n, kinds) and n.name == rest[0]), None)
+    if node is None:
+        raise LookupError(f"{path.relative_to(ROOT)} has no {name}")
+    return node.end_lineno - min([node.lineno] + [d.lineno for d in node.decorator_list]) + 1
+
+
+def rows() -> list[tuple[str, list[str], int]]:
+    text = DESIGN.read_text(encoding="utf-8")
+    return [(path, re.findall(r"`([\w.]+)`", names), int(n)) for path, names, n in ROW.findall(text)]
+
+
+def near(measured: float, stated: float) -> bool:
+    return abs(measured - stated) <= 0.10 * measured
+
+
+def test_the_design_page_has_its_rows_and_names_where_call_later_is_wired():
+    found = rows()
+    assert len(found) >= 8, f"only {len(found)} rows of the form `file`: `name` (about N lines)"
+    assert "tutorial/app/app.py" in {path for path, _, _ in found}
+
+
+@pytest.mark.parametrize("path, names, stated", rows(), ids=[r[0] for r in rows()])
+def test_each_row_names_definitions_that_exist_and_spans_about_its_lines(path, names, stated):
+    measured = sum(span(ROOT / path, name) for name in names)
+    assert near(measured, stated), f"{path} {names}: {measured} lines, the page says about {stated}"
+
+
+def test_the_pages_total_and_the_librarys_size_are_measured():
+    text = DESIGN.read_text(encoding="utf-8")
+    total = sum(sum(span(ROOT / path, name) for name in names) for path, names, _ in rows())
+    stated_total = int(re.search(r"about (\d+) lines hold them", text).group(1))
+    assert near(total, stated_total), f"the rows span {total} lines; the page says about {stated_total}"
+    assert f"in {stated_total} lines" in text.splitlines()[0], "the title's figure is the total's"
+    library = sum(len(p.read_text(encoding="utf-8").splitlines()) for p in (ROOT / "tutorial").rglob("*.py"))
+    stated = int(re.search(r"The library is about ([\d,]+) lines", text).group(1).replace(",", ""))
+    assert near(library, stated), f"tutorial/ is {library} lines; the page says about {stated}"
+
+
+def test_the_layout_page_states_the_lessons_librarys_size_as_measured():
+    import sys
+
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        import library_size
+    finally:
+        sys.path.remove(str(ROOT / "scripts"))
+    m = library_size.measure()
+    text = LAYOUT.read_text(encoding="utf-8")
+    found = re.search(r"(\d+) modules, ([\d,]+) lines, ([\d,]+) of them code", text)
+    assert found, "the layout page does not state the lessons' library's size"
+    _, lines, code = (int(g.replace(",", "")) for g in found.groups())
+    measured = f"{len(m['modules'])} modules, {m['lines']} lines, {m['code']} of them code"
+    assert near(m["lines"], lines) and near(m["code"], code), f"the page: {found.group(0)}; measured: {measured}"
