@@ -31,6 +31,7 @@ so the browser reaches the kernel only through Jupyter's port.
 from __future__ import annotations
 
 import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -141,11 +142,28 @@ def run_first_cell(page, url: str, most_s: float = 90.0, run_all: bool = False) 
         "document.querySelector('#jp-main-statusbar').innerText.includes('Idle')", timeout=most_s * 1000
     )
     if run_all:
-        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
-        page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click()
+        run_all_cells(page)
         return
     cells.first.click()
     page.keyboard.press("Control+Enter")
+
+
+def run_all_cells(page, tries: int = 3) -> None:
+    """Run > Run All Cells, until the first cell has started (a page that has just loaded may drop the click).
+
+    Raises:
+        TimeoutError: the first cell had not started after ``tries`` clicks, 10 s apart.
+    """
+    prompt = page.locator(".jp-Notebook .jp-Cell").first.locator(".jp-InputPrompt")
+    for _ in range(tries):
+        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+        page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click()
+        try:
+            wait_for(page, lambda: re.search(r"\[[*\d]", prompt.inner_text()), "the first cell to start", 10)
+            return
+        except TimeoutError:
+            page.keyboard.press("Escape")  # a menu left open
+    raise TimeoutError(f"Run All Cells: the first cell had not started after {tries} tries")
 
 
 def while_busy(page, out: dict, busy_s: float) -> None:
@@ -170,7 +188,13 @@ def while_busy(page, out: dict, busy_s: float) -> None:
     # the busy cell began as the view's output came (the cell before it ends with it): what it had left then
     out["busy_left_at_reload_s"] = round(busy_s - (start - shown), 2)
     out["reload_busy_before_end"] = out["reload_busy_s"] < out["busy_left_at_reload_s"]
-    wait_for(page, lambda: "Idle" in page.locator("#jp-main-statusbar").inner_text(), "the busy cell's end", 60)
+    # the busy cell's end: the trivial cell, run now, answers only after it (the kernel's indicator is no sign:
+    # each of the view's messages says busy, then idle, from the views' subshell)
+    trivial = page.locator(".jp-Notebook .jp-Cell").last
+    trivial.click()
+    page.keyboard.press("Control+Enter")
+    answered = lambda: re.search(r"\[\d+\]", trivial.locator(".jp-InputPrompt").inner_text())  # noqa: E731
+    wait_for(page, answered, "the busy cell's end", 60)
 
 
 def main(url: str, host: str, busy: str = "") -> None:

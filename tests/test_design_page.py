@@ -33,7 +33,10 @@ def span(path: Path, name: str) -> int:
     tree = ast.parse(path.read_text(encoding="utf-8"))
     scope, *rest = name.split(".")
     kinds = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
-    node = next((n for n in ast.walk(tree) if isinstance(n, kinds) and n.name == scope), None)
+    found = [n for n in ast.walk(tree) if isinstance(n, kinds) and n.name == scope]
+    if len(found) > 1 and not rest:
+        raise LookupError(f"{path.relative_to(ROOT)} defines {name} {len(found)} times: name it Class.{name}")
+    node = found[0] if found else None
     if node is not None and rest:
         node = next((n for n in node.body if isinstance(n, kinds) and n.name == rest[0]), None)
     if node is None:
@@ -85,6 +88,12 @@ def test_the_layout_page_states_the_lessons_librarys_size_as_measured():
     text = LAYOUT.read_text(encoding="utf-8")
     found = re.search(r"(\d+) modules, ([\d,]+) lines, ([\d,]+) of them code", text)
     assert found, "the layout page does not state the lessons' library's size"
-    _, lines, code = (int(g.replace(",", "")) for g in found.groups())
+    modules, lines, code = (int(g.replace(",", "")) for g in found.groups())
     measured = f"{len(m['modules'])} modules, {m['lines']} lines, {m['code']} of them code"
-    assert near(m["lines"], lines) and near(m["code"], code), f"the page: {found.group(0)}; measured: {measured}"
+    stated = (modules, lines, code)
+    assert all(near(a, b) for a, b in zip((len(m["modules"]), m["lines"], m["code"]), stated)), (
+        f"the page: {found.group(0)}; measured: {measured}"
+    )
+    rest = sum(len(p.read_text(encoding="utf-8").splitlines()) for p in (ROOT / "tutorial").rglob("*.py")) - m["lines"]
+    said = int(re.search(r"The rest of\s+`tutorial/`, about ([\d,]+) lines", text).group(1).replace(",", ""))
+    assert near(rest, said), f"the rest of tutorial/ is {rest} lines; the page says about {said}"

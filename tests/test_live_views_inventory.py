@@ -80,7 +80,7 @@ VIEW_FORMS = {
 }
 # What else is shown with .show() in those texts, and is not a run's 3D view.
 OTHER_SHOWN = {"plt", "plot", "camera_view", "page"}  # matplotlib, LivePlot, LiveImage, MeshcatPage (its own test)
-RUNS = {"sim", "viewer", "viewer_app", "self"}  # BackgroundApps in the notebooks; self: runs.py's own show()
+RUNS = {"sim", "viewer", "viewer_app"}  # BackgroundApps in the notebooks
 
 
 def documented_texts():
@@ -135,6 +135,7 @@ def shell():
 def test_each_way_to_show_a_view_shows_its_live_widget(shell, form):
     from IPython.utils.capture import capture_output
 
+    displays = len(shell.user_ns["sim"].view._displays)
     with capture_output() as shown:
         result = shell.run_cell(VIEW_FORMS[form])
     assert result.success, f"{form}: {result.error_in_exec!r}"
@@ -145,6 +146,7 @@ def test_each_way_to_show_a_view_shows_its_live_widget(shell, form):
     ]
     assert len(widgets) == 1, f"{form} showed {[list(o.data) for o in shown.outputs]}, not one live view"
     sim, viewer = shell.user_ns["sim"], shell.user_ns["viewer"]
+    assert len(sim.view._displays) == displays + 1, f"{form} made no output of its own"
     display_ = sim.view._displays[-1]  # the output this form made
     if "viewer" in VIEW_FORMS[form]:  # side by side: one box of both views' widgets
         assert display_._box is not None and widgets == [display_._box.model_id]

@@ -17,17 +17,21 @@ import pytest
 
 pytestmark = pytest.mark.cross_process
 
-SETUP = """
+# The first cell makes the view (its cell watch is installed inside that cell), the second is a later one;
+# each starts a thread that prints later, says it is sleeping, and sleeps.
+FIRST = """
+import threading, time
 import meshcat.geometry as g
 from tutorial.view.widget.widget import MeshcatWidget
 view = MeshcatWidget("subshell test")
 view.visualizer()["box"].set_object(g.Box([0.1, 0.2, 0.3]))
-print("routed", view.off_main, view.comm.comm_id)
-"""
-
-BUSY = """
-import threading, time
 threading.Timer(2.5, lambda: print("from the cell's thread", flush=True)).start()
+print("sleeping", view.off_main, view.comm.comm_id, flush=True)
+time.sleep(5)
+"""
+LATER = """
+threading.Timer(2.5, lambda: print("from the cell's thread", flush=True)).start()
+print("sleeping", view.off_main, view.comm.comm_id, flush=True)
 time.sleep(5)
 """
 
@@ -41,53 +45,44 @@ def messages(kc, until: float):
             continue
 
 
+def hello_while_the_cell_sleeps(kc, code: str) -> dict:
+    """Run ``code``; once it says it sleeps, say hello to its view as a page does; what came, and when."""
+    cell = kc.execute(code)
+    started = time.monotonic()
+    got = {"scene_at": None, "thread_output_parent": None, "cell_done_at": None, "asked": None}
+    for m in messages(kc, started + 30):
+        content, parent = m["content"], m["parent_header"].get("msg_id")
+        if m["msg_type"] == "stream" and content["text"].startswith("sleeping"):
+            _, routed, comm_id = content["text"].split()
+            assert routed == "True", f"the view's comm is not routed to a subshell: {content['text']}"
+            data = {"method": "custom", "content": {"type": "hello", "id": "t"}}
+            kc.shell_channel.send(kc.session.msg("comm_msg", {"comm_id": comm_id, "data": data}))
+            got["asked"] = time.monotonic()
+        elif m["msg_type"] == "comm_msg" and content["data"].get("content", {}).get("type") == "scene":
+            got["scene_at"] = time.monotonic()
+            assert m.get("buffers"), "the scene came without its commands"
+        elif m["msg_type"] == "stream" and "from the cell's thread" in content["text"]:
+            got["thread_output_parent"] = parent
+        elif m["msg_type"] == "status" and parent == cell and content["execution_state"] == "idle":
+            got["cell_done_at"] = time.monotonic()
+            break
+    got["cell"] = cell
+    return got
+
+
 def test_a_view_gets_its_scene_while_a_cell_runs_and_thread_output_stays_the_cells(tmp_path):
     from jupyter_client.manager import start_new_kernel
 
     km, kc = start_new_kernel(kernel_name="python3", cwd=str(tmp_path))
     try:
-        said = []
-        kc.execute_interactive(
-            SETUP,
-            timeout=60,
-            output_hook=lambda m: said.append(m["content"]["text"]) if m["msg_type"] == "stream" else None,
-        )
-        words = "".join(said).split()
-        assert words[:2] == ["routed", "True"], f"the view's comm is not routed to a subshell: {said}"
-        comm_id = words[2]
-
-        cell = kc.execute(BUSY)
-        started = time.monotonic()
-        hello = kc.session.msg(
-            "comm_msg", {"comm_id": comm_id, "data": {"method": "custom", "content": {"type": "hello", "id": "t"}}}
-        )
-        for m in messages(kc, started + 20):  # the cell has begun: the main shell reads nothing until it ends
-            if m["msg_type"] == "execute_input" and m["parent_header"].get("msg_id") == cell:
-                break
-        else:
-            raise AssertionError("the cell did not begin within 20 s")
-        kc.shell_channel.send(hello)
-        asked = time.monotonic()
-        scene_at = thread_output_parent = cell_done_at = None
-        for m in messages(kc, started + 20):
-            content = m["content"]
-            if m["msg_type"] == "comm_msg" and content["data"].get("content", {}).get("type") == "scene":
-                scene_at = time.monotonic()
-                assert m.get("buffers"), "the scene came without its commands"
-            elif m["msg_type"] == "stream" and "from the cell's thread" in content["text"]:
-                thread_output_parent = m["parent_header"].get("msg_id")
-            elif (
-                m["msg_type"] == "status"
-                and m["parent_header"].get("msg_id") == cell
-                and content["execution_state"] == "idle"
-            ):
-                cell_done_at = time.monotonic()
-                break
-        assert cell_done_at is not None, "the sleeping cell did not end"
-        assert scene_at is not None, "no scene came for the view's hello"
-        assert scene_at < cell_done_at, "the scene waited for the cell to end"
-        assert scene_at - asked < 2.0, f"the scene came {scene_at - asked:.2f} s after the hello"
-        assert thread_output_parent == cell, "output from the cell's thread went to the view's message, not the cell"
+        for which, code in (("the cell that makes the view", FIRST), ("a later cell", LATER)):
+            got = hello_while_the_cell_sleeps(kc, code)
+            assert got["cell_done_at"] is not None and got["asked"] is not None, f"{which}: it did not run: {got}"
+            assert got["scene_at"] is not None, f"{which}: no scene came for the view's hello"
+            assert got["scene_at"] < got["cell_done_at"], f"{which}: the scene waited for the cell to end"
+            late = got["scene_at"] - got["asked"]
+            assert late < 2.0, f"{which}: the scene came {late:.2f} s after the hello"
+            assert got["thread_output_parent"] == got["cell"], f"{which}: its thread's output went to the view's hello"
     finally:
         kc.stop_channels()
         km.shutdown_kernel(now=True)

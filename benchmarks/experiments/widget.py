@@ -335,9 +335,11 @@ def first_picture(tries: int = 10) -> dict:
                 page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
                 page.locator(".lm-Menu-itemLabel", has_text="Run Selected Cell and All Below").first.click()
 
+            prompts = page.locator(".jp-Notebook .jp-Cell .jp-InputPrompt")
             for k in range(2 * tries + 1):
                 kind = "busy" if k % 2 else "idle"
-                idle.wait_for(timeout=60_000)
+                # no cell running or queued (not the kernel's indicator: each view message says busy, then idle)
+                wait_for(page, lambda: not any("*" in p for p in prompts.all_inner_texts()), "the kernel idle", 60)
                 before = set(page.evaluate("Object.keys(window.rttViewTimes)"))
                 if kind == "idle":
                     _run_cell(page, cells.nth(1), lambda: page.keyboard.press("Control+Enter"))

@@ -257,3 +257,16 @@ def expect_numbers(call: str, got, expected: Sequence[float] | float, tol: float
     """Raise :class:`CaseFailed` unless ``got`` equals ``expected`` within ``tol``."""
     if not same_numbers(got, expected, tol):
         raise CaseFailed(f"{call} returned {show(got)}, expected {show(expected)}.", hint)
+
+
+QOS_POLICIES = ("reliability", "durability", "history", "depth")  # what the statements name of a topic's QoS
+
+
+def expect_qos(call: str, got, expected, hint: str = "") -> None:
+    """Raise :class:`CaseFailed` unless QoS profile ``got`` has ``expected``'s :data:`QOS_POLICIES`, naming each."""
+
+    def said(q) -> str:
+        return ", ".join(f"{p} {getattr(getattr(q, p), 'name', getattr(q, p))}".lower() for p in QOS_POLICIES)
+
+    if any(getattr(got, p) != getattr(expected, p) for p in QOS_POLICIES):
+        raise CaseFailed(f"{call}: its QoS is {said(got)}; expected {said(expected)}.", hint)

@@ -94,7 +94,7 @@ def check_release_times(func) -> Result:
 
         return Case(call, run, hint, hidden)
 
-    def drawn(label, kind):
+    def drawn(rng, label, kind):
         """A hidden case: a bag drawn by ``kind``'s rules, its releases found by the statement's rule."""
         messages = _random_joy_bag(rng, kind)
         return bag(label, messages, _releases(messages), "follow each rule of the statement, for every Joy.", True)
@@ -102,12 +102,12 @@ def check_release_times(func) -> Result:
     rng = hidden_random("7.1")  # while grading: this learner's own bags, by the statement's rules
     hidden = (
         [
-            drawn("a D-pad or trigger axis pushed alone", "dpad"),
-            drawn("an axis barely off centre, which is not released", "tiny"),
-            drawn("two axes pushed opposite ways at once", "opposite"),
-            drawn("another gamepad's Joys and joint states between the Joys", "topics"),
-            drawn("a bag whose first Joy is released and comes after other topics", "late"),
-            drawn("a long drive of pushes, repeats and releases over several seconds", "long"),
+            drawn(rng, "a D-pad or trigger axis pushed alone", "dpad"),
+            drawn(rng, "an axis barely off centre, which is not released", "tiny"),
+            drawn(rng, "two axes pushed opposite ways at once", "opposite"),
+            drawn(rng, "another gamepad's Joys and joint states between the Joys", "topics"),
+            drawn(rng, "a bag whose first Joy is released and comes after other topics", "late"),
+            drawn(rng, "a long drive of pushes, repeats and releases over several seconds", "long"),
         ]
         if rng
         else []
@@ -278,7 +278,7 @@ def check_peak_speed(func) -> Result:
 
         return Case(call, run, hint, hidden)
 
-    def drawn(label, kind):
+    def drawn(rng, label, kind):
         """A hidden case: a series drawn by ``kind``'s rules, its peak found by the statement's rule."""
         s, joint = _random_series(rng, kind)
         return case(label, s, joint, _peak(s.stamp, s.positions[joint]), "follow each rule of the statement.", True)
@@ -286,13 +286,13 @@ def check_peak_speed(func) -> Result:
     rng = hidden_random("7.2")  # while grading: this learner's own series, by the statement's rules
     hidden = (
         [
-            drawn("states stamped a second or more into the simulation, unevenly spaced", "late"),
-            drawn("a drive of many states, stamped a second or more in", "late"),
-            drawn("several pairs tied at the top speed", "ties"),
-            drawn("states without the joint at the ends and in a row", "nan"),
-            drawn("several states sharing a stamp", "repeats"),
-            drawn("only one state carries the joint", "one"),
-            drawn("a joint that stood still, stamped a second or more in", "still"),
+            drawn(rng, "states stamped a second or more into the simulation, unevenly spaced", "late"),
+            drawn(rng, "a drive of many states, stamped a second or more in", "late"),
+            drawn(rng, "several pairs tied at the top speed", "ties"),
+            drawn(rng, "states without the joint at the ends and in a row", "nan"),
+            drawn(rng, "several states sharing a stamp", "repeats"),
+            drawn(rng, "only one state carries the joint", "one"),
+            drawn(rng, "a joint that stood still, stamped a second or more in", "still"),
         ]
         if rng
         else []

@@ -34,7 +34,7 @@ import math
 import numpy as np
 
 from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, show
 
 DURATION = 3.0  # s of simulated time per checked run: the tank hits the wall at about 2.05 s
 TIME_STEP_NS = 1_000_000  # the tank world's 1 ms step
@@ -188,8 +188,7 @@ def _imu_qos(publisher, call: str) -> None:
     """CaseFailed unless ``publisher`` was made with the QoS of ``imu_qos()`` (the statement's)."""
     from tutorial.interfaces.imu import imu_qos
 
-    if publisher.qos_profile != imu_qos():
-        raise CaseFailed(f"{call}: the publisher of {publisher.topic} has the QoS {publisher.qos_profile}.")
+    expect_qos(f"{call}: the publisher of {publisher.topic}", publisher.qos_profile, imu_qos())
 
 
 def _half_step(rng, low: int, high: int) -> float:

@@ -81,7 +81,7 @@ def check_lookup(func) -> Result:
 
         return Case(call, run, hint, hidden)
 
-    def drawn(label: str, kind: str) -> Case:
+    def drawn(rng, label: str, kind: str) -> Case:
         """A hidden case: a tree drawn by ``kind``'s rules, its frame's pose found by the statement's rules."""
         transforms, frame = _random_tree(rng, kind)
         hint = "follow each rule of the statement: (x, y, z, w), pose(parent) @ transform, the newest counts."
@@ -90,12 +90,12 @@ def check_lookup(func) -> Result:
     rng = hidden_random("9.1")  # while grading: this learner's own trees, by the statement's rules
     hidden = (
         [
-            drawn("a chain of frames tilted about every axis", "tilted"),
-            drawn("a tree whose root is not world", "root"),
-            drawn("a child sent several times, its stamps a second or more apart", "newest"),
-            drawn("the root of a random tree", "the root"),
-            drawn("a frame no transform names, in a random tree", "missing"),
-            drawn("a random tree, listed in any order, tilted", "any"),
+            drawn(rng, "a chain of frames tilted about every axis", "tilted"),
+            drawn(rng, "a tree whose root is not world", "root"),
+            drawn(rng, "a child sent several times, its stamps a second or more apart", "newest"),
+            drawn(rng, "the root of a random tree", "the root"),
+            drawn(rng, "a frame no transform names, in a random tree", "missing"),
+            drawn(rng, "a random tree, listed in any order, tilted", "any"),
         ]
         if rng
         else []

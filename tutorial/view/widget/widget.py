@@ -32,7 +32,9 @@ the kernel's thread.
 
 from __future__ import annotations
 
+import contextvars
 import json
+import logging
 import threading
 import time
 from pathlib import Path
@@ -73,13 +75,18 @@ class _CellWatch:
     """
 
     busy = False
-    # the running cell's request and ipykernel's context of it, kept at its start: where output from threads goes
+    # The running cell's request and its context (ipykernel's parent of output), kept at its start on the
+    # kernel's thread, where output from threads goes.  The lock keeps the views' subshell from putting back
+    # a cell that has just ended (its read and its write of ipykernel's parent, against _begin and _end).
     cell_request = None
     cell_context = None
+    _lock = threading.Lock()
     _installed = False
 
     @classmethod
     def install(cls) -> None:
+        """Watch cells from now on; installed from inside a running cell (the first view's), that cell counts
+        as begun (kernel thread)."""
         if cls._installed:
             return
         try:
@@ -92,18 +99,36 @@ class _CellWatch:
         shell.events.register("pre_run_cell", cls._begin)
         shell.events.register("post_run_cell", cls._end)
         cls._installed = True
+        kernel = _kernel()
+        parent = getattr(kernel, "get_parent", lambda: {})() or {}
+        asked = (parent.get("header") or {}).get("msg_type")
+        if threading.current_thread() is threading.main_thread() and asked == "execute_request":
+            cls._begin()  # the cell that made the first view: its pre_run_cell has passed
 
     @classmethod
     def _begin(cls, *_args) -> None:
-        kernel = _kernel()
-        if kernel is not None:
-            cls.cell_request, cls.cell_context = kernel.get_parent(), getattr(kernel, "_shell_context", None)
         cls.busy = True
+        kernel = _kernel()
+        get_parent = getattr(kernel, "get_parent", None)  # ipykernel 6 on; before, no views' subshell either
+        if get_parent is None or getattr(kernel, "shell", None) is None:
+            return
+        with cls._lock:
+            # On the kernel's thread, in the cell's own context: its parent, whatever a view's message
+            # made ipykernel's since the cell began (put back at once).
+            cls.cell_request, cls.cell_context = get_parent(), contextvars.copy_context()
+            cls._put_back(kernel)
 
     @classmethod
     def _end(cls, *_args) -> None:
-        cls.busy = False
-        cls.cell_request = cls.cell_context = None
+        with cls._lock:
+            cls.busy = False
+            cls.cell_request = cls.cell_context = None
+
+    @classmethod
+    def _put_back(cls, kernel) -> None:  # with cls._lock held
+        if cls.cell_request and cls.cell_context is not None and hasattr(kernel, "_shell_context"):
+            kernel._shell_context = cls.cell_context
+            kernel.shell.set_parent(cls.cell_request)
 
     @classmethod
     def give_output_back(cls) -> None:
@@ -112,14 +137,17 @@ class _CellWatch:
         ipykernel makes each message it handles the parent of all output
         from threads (``print`` in a thread a cell started goes to the last
         message's output).  A view's message handled while a cell runs would
-        take that output from the cell.  The message's own status messages
-        keep their parent.
+        take that output from the cell; this gives it back once the message
+        is handled.  Output from threads *while* ipykernel handles a view's
+        message (well under a millisecond, more while it sends a whole
+        scene) can still go to that message.  The message's own status
+        messages keep their parent.
         """
-        kernel, request, context = _kernel(), cls.cell_request, cls.cell_context
-        if kernel is None or request is None or context is None or kernel.shell is None:
+        kernel = _kernel()
+        if kernel is None or getattr(kernel, "shell", None) is None:
             return
-        kernel._shell_context = context
-        kernel.shell.set_parent(request)
+        with cls._lock:
+            cls._put_back(kernel)
 
 
 def cell_running() -> bool:
@@ -151,9 +179,10 @@ class _ViewSubshell:
 
     What it costs: each view message makes the kernel say "busy" then "idle"
     on its own (Jupyter's kernel indicator may show idle while a cell
-    runs); and while ipykernel handles one, output from threads a cell
-    started would go to that message, not to the cell, so the view's handler
-    hands them back (:meth:`MeshcatWidget._handle_msg`).
+    runs); and ipykernel makes each message it handles the parent of
+    output from threads, so the view's handler gives that back to the
+    running cell (:meth:`_CellWatch.give_output_back`: all but what a
+    thread prints while a view's message is being handled).
 
     Where ipykernel has no subshells (before 7) or no comm routing (before
     7.4), or outside a kernel, :meth:`id` is None and views wait for the
@@ -194,7 +223,12 @@ class _ViewSubshell:
                 done.set()
 
         thread.io_loop.add_callback(create)
-        return made.get("id") if done.wait(5.0) else None
+        if not done.wait(5.0) or "id" not in made:
+            logging.getLogger("rtt.views").warning(
+                "no kernel subshell for the live views: they draw only while no cell runs"
+            )
+            return None
+        return made["id"]
 
     @classmethod
     def route(cls, comm) -> bool:
