@@ -25,14 +25,14 @@ import meshcat.geometry as g
 from tutorial.view.widget.widget import MeshcatWidget
 view = MeshcatWidget("subshell test")
 view.visualizer()["box"].set_object(g.Box([0.1, 0.2, 0.3]))
-threading.Timer(2.5, lambda: print("from the cell's thread", flush=True)).start()
+threading.Timer(1.5, lambda: print("from the cell's thread", flush=True)).start()
 print("sleeping", view.off_main, view.comm.comm_id, flush=True)
-time.sleep(5)
+time.sleep(3)
 """
 LATER = """
-threading.Timer(2.5, lambda: print("from the cell's thread", flush=True)).start()
+threading.Timer(1.5, lambda: print("from the cell's thread", flush=True)).start()
 print("sleeping", view.off_main, view.comm.comm_id, flush=True)
-time.sleep(5)
+time.sleep(3)
 """
 
 
