@@ -148,13 +148,28 @@ def run_first_cell(page, url: str, most_s: float = 90.0, run_all: bool = False) 
     page.keyboard.press("Control+Enter")
 
 
+# The page's notebook has a kernel, started and idle, by the server's own word (JupyterLab's and Notebook 7's
+# indicators read idle before a kernel exists, and Run All then asks which kernel to start).
+KERNEL_READY = """async () => {
+    const sessions = await (await fetch('/api/sessions', {credentials: 'same-origin'})).json();
+    return sessions.some(s => s.kernel && s.kernel.execution_state === 'idle');
+}"""
+
+
+def kernel_ready(page, most: float = 90.0) -> None:
+    """Wait until the server has a session whose kernel is idle (the page's notebook's: the tests open one)."""
+    wait_for(page, lambda: page.evaluate(KERNEL_READY), "the notebook's kernel", most)
+
+
 def run_all_cells(page, tries: int = 3) -> None:
-    """Run > Run All Cells, until the first cell has started (a page that has just loaded may drop the click).
+    """Run > Run All Cells once the notebook's kernel is ready, until the first cell has started (a page that
+    has just loaded may drop the click).
 
     Raises:
         TimeoutError: the first cell had not started after ``tries`` clicks, 10 s apart.
     """
     prompt = page.locator(".jp-Notebook .jp-Cell").first.locator(".jp-InputPrompt")
+    kernel_ready(page)
     for _ in range(tries):
         page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
         page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click()

@@ -65,15 +65,9 @@ def run_all_with_a_busy_cell(app: str, tmp_path: Path, server_args=()) -> dict:
     with JupyterLab(tmp_path, env=env, server_args=server_args, app=app) as lab, browser(1100, 900) as page:
         page.goto(lab.notebook_url("step2.ipynb", workspace="frontends"))
         page.locator(".jp-Notebook .jp-Cell").first.wait_for(timeout=90_000)
-        # the kernel is up (both front ends show this indicator in the notebook's toolbar)
-        page.locator(".jp-Notebook-ExecutionIndicator[data-status='idle']").wait_for(timeout=90_000)
         page.evaluate(WATCH_VIEWS)
         run_all_cells(page)
-        try:
-            wait_for(page, lambda: page.locator(VIEW).count() > 0, "the view's output", 120)
-        except TimeoutError:
-            page.screenshot(path=str(tmp_path / "no_view.png"))
-            raise
+        wait_for(page, lambda: page.locator(VIEW).count() > 0, "the view's output", 120)
         shown = time.monotonic()
         wait_for(page, lambda: (page.evaluate(STATS) or {}).get("scenes"), "the view's scene", 30)
         out["first_picture_s"] = round(time.monotonic() - shown, 2)

@@ -315,7 +315,7 @@ def first_picture(tries: int = 10) -> dict:
     import nbformat
 
     from tests.jupyterlab import JupyterLab, browser
-    from tests.lab_browser import WATCH_VIEWS, wait_for
+    from tests.lab_browser import WATCH_VIEWS, kernel_ready, wait_for
 
     times: dict[str, list[float]] = {"idle": [], "busy": []}
     with tempfile.TemporaryDirectory() as d:
@@ -326,8 +326,7 @@ def first_picture(tries: int = 10) -> dict:
         with JupyterLab(Path(d), env={"PYTHONPATH": str(ROOT)}) as lab, browser(1000, 800) as page:
             page.goto(lab.notebook_url("first.ipynb", workspace="first"))
             cells = page.locator(".jp-Notebook .jp-Cell")
-            idle = page.locator(".jp-Notebook-ExecutionIndicator[data-status='idle']")
-            idle.wait_for(timeout=90_000)
+            kernel_ready(page)
             page.evaluate(WATCH_VIEWS)
             _run_cell(page, cells.first, lambda: page.keyboard.press("Control+Enter"))
 
