@@ -31,9 +31,16 @@ LIMITS = {"lines": 8000, "code": 4500}
 
 def _imports_of_code(source: str) -> set[str]:
     """The ``tutorial`` modules a cell's code imports (lines of IPython magics and shell commands left out)."""
+    if source.lstrip().startswith("%%"):  # a cell magic: the cell is not Python
+        return set()
     code = "\n".join(line for line in source.splitlines() if not line.lstrip().startswith(("%", "!")))
+    try:
+        tree = ast.parse(code)
+    except SyntaxError:  # IPython's own syntax (x = !cmd, x?): its import statements alone
+        imports = [line.strip() for line in code.splitlines() if line.lstrip().startswith(("import ", "from "))]
+        tree = ast.parse("\n".join(i for i in imports if not i.endswith(("(", "\\"))))
     found = set()
-    for node in ast.walk(ast.parse(code)):
+    for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             found |= {a.name for a in node.names if a.name.split(".")[0] == "tutorial"}
         elif isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "tutorial":
