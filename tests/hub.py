@@ -252,6 +252,29 @@ class Learner:
             self.api("DELETE", f"api/terminals/{name}")
         return out
 
+    def _kernel_answers(self, ws, deadline: float) -> None:
+        """Ask the kernel for its info until it answers, as JupyterLab does on connecting (after a death,
+        Jupyter restarts it, and what is sent to it meanwhile can be lost).
+
+        Raises:
+            RuntimeError: no answer before the monotonic time ``deadline``.
+        """
+        while time.monotonic() < deadline:
+            ask = uuid.uuid4().hex
+            header = {"msg_id": ask, "msg_type": "kernel_info_request", "username": self.name,
+                      "session": uuid.uuid4().hex, "version": "5.3"}  # fmt: skip
+            ws.send(json.dumps({"header": header, "parent_header": {}, "metadata": {}, "content": {},
+                                "channel": "shell"}))  # fmt: skip
+            again = min(deadline, time.monotonic() + 10.0)
+            while (left := again - time.monotonic()) > 0:
+                try:
+                    msg = json.loads(ws.recv(timeout=left))
+                except TimeoutError:
+                    break
+                if msg["header"]["msg_type"] == "kernel_info_reply" and msg["parent_header"].get("msg_id") == ask:
+                    return
+        raise RuntimeError(f"{self.name}'s kernel did not answer")
+
     def run(self, code: str, timeout: float = 120.0) -> str:
         """Run ``code`` in this learner's kernel (started on first use); its stdout and stderr as text.
 
@@ -277,6 +300,7 @@ class Learner:
         out, error = [], None
         deadline = time.monotonic() + timeout
         with connect(url, additional_headers={"Authorization": f"token {self.token}"}, open_timeout=30) as ws:
+            self._kernel_answers(ws, deadline)
             ws.send(json.dumps(request))
             while True:
                 left = deadline - time.monotonic()
