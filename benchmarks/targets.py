@@ -258,7 +258,7 @@ WIDGET_TARGETS = tuple(
     ),
     Target(
         "notebook view without the nodelay extension (as in Colab), 8 tanks: the view's page keeps >= {limit} "
-        "frames/s (its handed -> drawn p99, about 3x the page's, is in latest.json: the README's Live views)",
+        "frames/s (its handed -> drawn p99, about 3x the page's, is in latest.json: the README's Front ends)",
         20.0,
         AT_LEAST,
         read("widget", "tanks_8", "widget_plain", "frames_per_s"),

@@ -161,24 +161,40 @@ def kernel_ready(page, most: float = 90.0) -> None:
     wait_for(page, lambda: page.evaluate(KERNEL_READY), "the notebook's kernel", most)
 
 
-def run_all_cells(page, tries: int = 3) -> None:
-    """Run > Run All Cells once the notebook's kernel is ready, until the first cell has started (a page that
-    has just loaded may drop the click).
+def run_menu(page, item: str) -> None:
+    """Run > ``item`` (e.g. "Run All Cells") from JupyterLab's or Notebook 7's menu bar."""
+    page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+    page.locator(".lm-Menu-itemLabel", has_text=item).first.click()
+
+
+def run_cell(page, cell, run, tries: int = 3) -> None:
+    """Select ``cell`` (a locator) and ``run()`` (a keystroke, a menu item); again, up to ``tries`` times,
+    10 s apart, until its prompt changes (a page that has just loaded may drop a keystroke or a click).
 
     Raises:
-        TimeoutError: the first cell had not started after ``tries`` clicks, 10 s apart.
+        TimeoutError: its prompt had not changed after ``tries`` tries.
     """
-    prompt = page.locator(".jp-Notebook .jp-Cell").first.locator(".jp-InputPrompt")
-    kernel_ready(page)
+    prompt = cell.locator(".jp-InputPrompt")
+    before = prompt.inner_text()
     for _ in range(tries):
-        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
-        page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click()
+        cell.locator(".jp-InputArea-editor").click()
+        run()
         try:
-            wait_for(page, lambda: re.search(r"\[[*\d]", prompt.inner_text()), "the first cell to start", 10)
+            wait_for(page, lambda: prompt.inner_text() != before, "the cell to start", 10)
             return
         except TimeoutError:
             page.keyboard.press("Escape")  # a menu left open
-    raise TimeoutError(f"Run All Cells: the first cell had not started after {tries} tries")
+    raise TimeoutError(f"the cell did not start after {tries} tries: its prompt stayed {before!r}")
+
+
+def run_all_cells(page) -> None:
+    """Run > Run All Cells once the notebook's kernel is ready, until the first cell has started.
+
+    Raises:
+        TimeoutError: the first cell had not started after three tries.
+    """
+    kernel_ready(page)
+    run_cell(page, page.locator(".jp-Notebook .jp-Cell").first, lambda: run_menu(page, "Run All Cells"))
 
 
 def while_busy(page, out: dict, busy_s: float) -> None:

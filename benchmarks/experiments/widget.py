@@ -289,24 +289,6 @@ FIRST_PICTURE_CELLS = (
 )
 
 
-def _run_cell(page, cell, run) -> None:
-    """Select ``cell`` (a locator) and ``run()`` it; again, up to three times, until its prompt changes
-    (a page that has just loaded may miss the first keystroke)."""
-    from tests.lab_browser import wait_for
-
-    prompt = cell.locator(".jp-InputPrompt")
-    before = prompt.inner_text()
-    for _ in range(3):
-        cell.locator(".jp-InputArea-editor").click()
-        run()
-        try:
-            wait_for(page, lambda: prompt.inner_text() != before, "the cell to start", 5)
-            return
-        except TimeoutError:
-            continue
-    raise RuntimeError(f"the cell did not run: its prompt stayed {before!r}")
-
-
 def first_picture(tries: int = 10) -> dict:
     """How long a new view's first picture takes, from its output appearing to its scene drawn, ms, with the
     kernel idle (its cell alone) and busy (a 3 s cell queued right after it, as Run All does), ``tries``
@@ -315,7 +297,7 @@ def first_picture(tries: int = 10) -> dict:
     import nbformat
 
     from tests.jupyterlab import JupyterLab, browser
-    from tests.lab_browser import WATCH_VIEWS, kernel_ready, wait_for
+    from tests.lab_browser import WATCH_VIEWS, kernel_ready, run_cell, run_menu, wait_for
 
     times: dict[str, list[float]] = {"idle": [], "busy": []}
     with tempfile.TemporaryDirectory() as d:
@@ -328,11 +310,7 @@ def first_picture(tries: int = 10) -> dict:
             cells = page.locator(".jp-Notebook .jp-Cell")
             kernel_ready(page)
             page.evaluate(WATCH_VIEWS)
-            _run_cell(page, cells.first, lambda: page.keyboard.press("Control+Enter"))
-
-            def run_and_sleep():
-                page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
-                page.locator(".lm-Menu-itemLabel", has_text="Run Selected Cell and All Below").first.click()
+            run_cell(page, cells.first, lambda: page.keyboard.press("Control+Enter"))
 
             prompts = page.locator(".jp-Notebook .jp-Cell .jp-InputPrompt")
             for k in range(2 * tries + 1):
@@ -341,9 +319,9 @@ def first_picture(tries: int = 10) -> dict:
                 wait_for(page, lambda: not any("*" in p for p in prompts.all_inner_texts()), "the kernel idle", 60)
                 before = set(page.evaluate("Object.keys(window.rttViewTimes)"))
                 if kind == "idle":
-                    _run_cell(page, cells.nth(1), lambda: page.keyboard.press("Control+Enter"))
+                    run_cell(page, cells.nth(1), lambda: page.keyboard.press("Control+Enter"))
                 else:
-                    _run_cell(page, cells.nth(1), run_and_sleep)
+                    run_cell(page, cells.nth(1), lambda: run_menu(page, "Run Selected Cell and All Below"))
 
                 def drawn(before=before):
                     new = [t for i, t in page.evaluate("window.rttViewTimes").items() if i not in before]
