@@ -239,8 +239,11 @@ def test_cut_off_from_its_kernel_the_view_says_it_is_not_live_and_an_answer_take
     page, _ = view
     caption = page.locator(".rtt-caption")
     assert caption.inner_text().startswith("test view (live): running")
+    before = page.evaluate("window.sent.length")
     page.evaluate("window.trigger('comm_live_update')")
-    assert page.evaluate("window.sent.at(-1)")["type"] == "ping"
+    # one ping for the cut-off (a frame's lone answer, two animation frames late, may be sent beside it)
+    asked = page.evaluate(f"window.sent.slice({before}).map(m => m.type)")
+    assert asked.count("ping") == 1 and set(asked) <= {"ping", "drawn"}, asked
     notice = page.locator(".rtt-not-live")
     notice.wait_for(timeout=10_000)
     assert "Not live any more" in notice.inner_text()
