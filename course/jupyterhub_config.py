@@ -44,6 +44,7 @@ ROOT = COURSE.parent
 sys.path.insert(0, str(COURSE))
 
 from domains import BOOK_NAME, DomainBook, DomainError, hub_state  # noqa: E402
+from idle_stops import IdleStops, remembering_last_use  # noqa: E402
 from learner_home import make_learner_home  # noqa: E402 - course/ is on the path only from here
 from limits import LimitedLocalProcessSpawner, LimitedSimpleLocalProcessSpawner  # noqa: E402
 
@@ -85,13 +86,16 @@ c.Authenticator.allowed_users = set(LEARNERS)
 # In a container or pod each learner has a network namespace of their own: set RTT_HUB_PER_LEARNER_NETWORK=1.
 # The local spawners here keep each learner's server in cgroups of its own (course/limits.py): memory, processes
 # and CPU, so one learner cannot take the class's server down.  Containers and pods get theirs from
-# DockerSpawner's or KubeSpawner's mem_limit and cpu_limit.
+# DockerSpawner's or KubeSpawner's mem_limit and cpu_limit.  Whichever spawner, remembering_last_use(...) lets a
+# learner the idle culler stopped be told so (course/idle_stops.py).
 UNIX_USERS = os.environ.get("RTT_HUB_SPAWNER", "simple") == "users"
 if UNIX_USERS:
-    c.JupyterHub.spawner_class = LimitedLocalProcessSpawner  # each learner's server runs as their Unix user
+    # each learner's server runs as their Unix user
+    c.JupyterHub.spawner_class = remembering_last_use(LimitedLocalProcessSpawner)
     c.LocalProcessSpawner.notebook_dir = "~"
 else:
-    c.JupyterHub.spawner_class = LimitedSimpleLocalProcessSpawner  # a trial: no isolation between learners' files
+    # a trial: no isolation between learners' files
+    c.JupyterHub.spawner_class = remembering_last_use(LimitedSimpleLocalProcessSpawner)
     c.SimpleLocalProcessSpawner.home_dir_template = str(STATE / "homes" / "{username}")
     if os.geteuid() == 0:  # a trial started as root (a container): Jupyter refuses root without this
         c.Spawner.args = ["--allow-root"]
@@ -217,6 +221,7 @@ def give_learner_their_domain_and_notebooks(spawner):
     make_learner_home(
         home, SHOW_SOLUTIONS, ENV_BIN / "jupyter", give=lambda path: _give_to_learner(path, name, unix_user)
     )
+    IDLE_STOPS.before_spawn(spawner)
 
 
 def _give_to_learner(path: Path, name: str, unix_user: bool) -> None:
@@ -240,6 +245,8 @@ c.Spawner.pre_spawn_hook = give_learner_their_domain_and_notebooks
 IDLE_TIMEOUT = int(os.environ.get("RTT_HUB_IDLE_TIMEOUT", "3600"))
 ACTIVITY_INTERVAL = int(os.environ.get("RTT_HUB_ACTIVITY_INTERVAL", "300"))
 c.JupyterHub.last_activity_interval = ACTIVITY_INTERVAL
+IDLE_STOPS = IdleStops(STATE / "idle-stops.json", IDLE_TIMEOUT)  # told in the learner's next first init_ros()
+c.Spawner.post_stop_hook = IDLE_STOPS.after_stop
 c.Spawner.environment["JUPYTERHUB_ACTIVITY_INTERVAL"] = str(ACTIVITY_INTERVAL)
 c.JupyterHub.load_roles = [
     {

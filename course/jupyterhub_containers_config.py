@@ -28,7 +28,10 @@ GATEWAY = os.environ.get("RTT_HUB_CONTAINER_GATEWAY") or "127.0.0.1"  # never ""
 c.JupyterHub.hub_ip = GATEWAY  # the hub's API, for the learners' servers: on the containers' network only
 c.JupyterHub.hub_connect_ip = GATEWAY
 
-c.JupyterHub.spawner_class = "docker"
+from dockerspawner import DockerSpawner  # noqa: E402
+from idle_stops import remembering_last_use  # noqa: E402 - course/ is on the path: the base put it there
+
+c.JupyterHub.spawner_class = remembering_last_use(DockerSpawner)
 c.DockerSpawner.image = os.environ.get("RTT_HUB_IMAGE", "localhost/ros-tank-tutorial:learner")
 c.DockerSpawner.network_name = os.environ.get("RTT_HUB_CONTAINER_NETWORK", "rtt-learners")
 c.DockerSpawner.use_internal_ip = True  # the proxy reaches each container at its address on that network
@@ -39,7 +42,9 @@ c.DockerSpawner.extra_host_config = {"pids_limit": int(os.environ.get("RTT_HUB_P
 c.Spawner.cmd = ["jupyterhub-singleuser"]  # the image's own environment, not this machine's
 c.Spawner.args = []
 c.Spawner.ip = "0.0.0.0"  # inside the container: its own network namespace, on the containers' network
-c.Spawner.pre_spawn_hook = None  # no domain to give, no files to copy: the image and the volume hold them
+# No domain to give, no files to copy (the image and the volume hold them); a learner the culler stopped is
+# told, as on the base (course/idle_stops.py, whose IdleStops the base's post_stop_hook belongs to).
+c.Spawner.pre_spawn_hook = c.Spawner.post_stop_hook.__self__.before_spawn
 # The base's environment for the learners, but for what names this machine (its PATH, its Jupyter
 # configuration folder): the image has its own.  The domain: the same for every learner.
 c.Spawner.environment = {

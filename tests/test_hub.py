@@ -666,9 +666,75 @@ def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
             "os.path.exists(os.path.expanduser('~/notebooks/03_step3_viewer.ipynb')))"
         )
         assert again.split() == [domain, "mine", "True"], again
+        # ... and their first init_ros() says why their runs are gone, once
+        told = c.run("from tutorial.notebook.session import init_ros\ninit_ros()")
+        assert re.fullmatch(
+            r"Note: your last server was stopped at [-0-9]+ [:0-9]+ UTC after (\d+) s without use \(this class "
+            rf"stops a server after {idle} s\), with every simulation, joystick and view it ran\. .*\n",
+            told,
+        ), told
+        assert int(re.search(r"after (\d+) s without", told).group(1)) >= idle, told
+        c.kernel_id = None
+        assert c.run("from tutorial.notebook.session import init_ros\ninit_ros()") == ""  # a new kernel: not again
     finally:
         hub.close()
     assert hub.cgroups_left == []
+
+
+@pytest.mark.unit
+def test_a_server_stopped_idle_is_told_once_in_its_next_server(tmp_path, monkeypatch):
+    """The hub writes down a stop after the timeout without use, and only such a stop; the next server is told
+    once, whichever of its kernels asks first."""
+    import asyncio
+    import datetime
+    import logging
+    from types import SimpleNamespace
+
+    from idle_stops import VARIABLE, IdleStops, remembering_last_use
+
+    from tutorial.notebook.session import idle_stop_note
+
+    def spawner(name, idle_s):
+        last = datetime.datetime.now(datetime.UTC).replace(tzinfo=None) - datetime.timedelta(seconds=idle_s)
+        return SimpleNamespace(
+            user=SimpleNamespace(name=name), last_use_before_stop=last, environment={}, log=logging.getLogger("test")
+        )
+
+    class Stopped:  # a spawner whose last use the hub sets to "now" as it stops, as JupyterHub does
+        orm_spawner = SimpleNamespace(last_activity="before")
+
+        async def stop(self, now=False):
+            self.orm_spawner.last_activity = "now"
+
+    kept = remembering_last_use(Stopped)()
+    asyncio.run(kept.stop())
+    assert kept.last_use_before_stop == "before" and type(kept).__name__ == "Stopped"
+
+    stops = IdleStops(tmp_path / "idle-stops.json", timeout_s=3600)
+    stops.after_stop(spawner("a", 3599))  # stopped by hand before the timeout: nothing to tell
+    stops.after_stop(spawner("b", 3700))
+    stops.after_stop(SimpleNamespace())  # it stopped by itself: the hub never asked it to
+    nobody, a, b = spawner("c", 0), spawner("a", 0), spawner("b", 0)
+    for each in (nobody, a, b):
+        stops.before_spawn(each)
+    assert nobody.environment == a.environment == {}
+    when, idle_s, timeout_s = b.environment[VARIABLE].split()
+    assert 3700 <= int(idle_s) <= 3760 and timeout_s == "3600", b.environment
+    again = spawner("b", 0)
+    stops.before_spawn(again)  # told in the environment once: the next server after is not
+    assert again.environment == {}
+
+    seen = tmp_path / "home" / "idle-stop"
+    monkeypatch.setenv(VARIABLE, b.environment[VARIABLE])
+    said = idle_stop_note(seen)
+    assert said.startswith(f"Note: your last server was stopped at {when[:10]} {when[11:19]} UTC after 62 min ")
+    assert "(this class stops a server after 60 min)" in said, said
+    assert idle_stop_note(seen) == ""  # the server's next kernel
+    monkeypatch.setenv(VARIABLE, "2026-11-26T21:40:00Z 90 60")  # a later stop is told, in seconds when short
+    assert "after 90 s without use (this class stops a server after 60 s)" in idle_stop_note(seen)
+    for bad in ("", "soon", "2026-11-26T21:40:00Z many 60", "a b c d"):
+        monkeypatch.setenv(VARIABLE, bad)
+        assert idle_stop_note(seen) == "", bad
 
 
 @pytest.mark.unit

@@ -41,7 +41,7 @@ def init_ros() -> None:
     the notebook's "interrupt" button.  Calling it again does nothing.  On a class's hub it warns (stderr)
     when ``ROS_DOMAIN_ID`` is not the learner's own domain (:func:`tutorial.ros.env.assigned_domain_warning`),
     and says when a kernel of this server was stopped for going over its memory limit
-    (:func:`memory_limit_note`).
+    (:func:`memory_limit_note`) or the learner's last server was stopped for want of use (:func:`idle_stop_note`).
     """
     import rclpy
     from rclpy.signals import SignalHandlerOptions
@@ -51,9 +51,9 @@ def init_ros() -> None:
         # a domain set by hand since the kernel started (a learner's shutdown() and init again) is said here
         ros_env.warn_if_not_assigned_domain()
         rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
-        note = memory_limit_note()
-        if note:
-            print(note, file=sys.stderr)
+        for note in (memory_limit_note(), idle_stop_note()):
+            if note:
+                print(note, file=sys.stderr)
 
 
 def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory"), seen: Path | None = None) -> str:
@@ -94,6 +94,39 @@ def memory_limit_note(cgroup_root: Path = Path("/sys/fs/cgroup/memory"), seen: P
         f"Note: a process of your server was stopped for using more than its memory limit "
         f"({limit / 1024**3:.1f} GiB), and Jupyter restarted the kernel: that is why the earlier cells' "
         "results and runs are gone. Use less memory (smaller arrays, fewer runs at once, reset() between runs)."
+    )
+
+
+def idle_stop_note(seen: Path | None = None) -> str:
+    """What to tell a learner whose last server the class's idle culler stopped, once; "" otherwise.
+
+    The hub puts the stop into the server's environment (``RTT_IDLE_STOP``: ISO time, seconds idle, the
+    class's timeout in seconds; ``course/idle_stops.py``).  ``seen`` (default
+    ``~/.cache/ros-tank-tutorial/idle-stop``) keeps the stop already told, so the server's later kernels
+    say nothing.  Any thread.
+    """
+    seen = seen or Path.home() / ".cache" / "ros-tank-tutorial" / "idle-stop"
+    stop = os.environ.get("RTT_IDLE_STOP", "")
+    try:
+        when, idle_s, timeout_s = stop.split()
+        idle, timeout = (f"{int(x)} s" if int(x) < 120 else f"{round(int(x) / 60)} min" for x in (idle_s, timeout_s))
+    except ValueError:
+        return ""  # none, or not the hub's
+    try:
+        if seen.read_text() == stop:
+            return ""
+    except OSError:
+        pass
+    try:
+        seen.parent.mkdir(parents=True, exist_ok=True)
+        seen.write_text(stop)
+    except OSError:
+        pass  # told again next time: better than never
+    when = when.replace("T", " ").removesuffix("Z")
+    return (
+        f"Note: your last server was stopped at {when} UTC after {idle} without use (this class stops a server "
+        f"after {timeout}), with every simulation, joystick and view it ran. Your notebooks and "
+        "files are as you last saved them: run the cells again to start over."
     )
 
 
