@@ -628,10 +628,16 @@ def test_one_learner_cannot_take_the_others_down(tmp_path):
 @pytest.mark.slow
 @pytest.mark.cross_process
 def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
-    """C starts a simulation and leaves: the hub's idle culler stops C's server and all it ran; C comes back."""
+    """C closes their page on a simulation and its live view: the run pauses, C's server costs next to
+    nothing, the hub's idle culler stops it and all it ran, and C comes back to their work, told why."""
     import time
 
-    idle = 20  # s: the test's timeout (a class's: an hour)
+    from playwright.sync_api import sync_playwright
+
+    from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
+    from tests.lab_browser import step2_notebook
+
+    idle = 75  # s: the test's timeout (a class's: an hour); past the 30 s a run shown in no page takes to pause
     hub = Hub(
         tmp_path / "hub",
         ["learner-c"],
@@ -643,21 +649,41 @@ def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
         assert c.log_in().status_code == 302, hub.log()[-2000:]
         c.start_server()
         said = c.run(
-            "import os, subprocess, sys\n"
+            "import os, subprocess\n"
             "open(os.path.expanduser('~/my_notes.txt'), 'w').write('mine')\n"
-            "sim = subprocess.Popen([os.path.join(os.path.dirname(sys.executable), 'rtt-run'), "
-            f"'{ROOT}/project/step2.yaml', '--headless', '--duration', '600'])\n"
-            "print(os.environ['ROS_DOMAIN_ID'], sim.pid)"
+            "left = subprocess.Popen(['sleep', '600'])  # a program C leaves running\n"
+            "print(os.environ['ROS_DOMAIN_ID'], left.pid)"
         )
-        domain, sim = said.split()
+        domain, program = said.split()
+        path = tmp_path / "live.ipynb"
+        step2_notebook(path)
+        r = c.api("PUT", "api/contents/live.ipynb", json={"type": "notebook", "format": "json",
+                                                          "content": json.loads(path.read_text())})  # fmt: skip
+        assert r.status_code in (200, 201), r.text[:500]
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+            try:
+                page = open_live_notebook(browser, hub.url, "learner-c")
+                require_live_view_draws(page, "learner-c")
+                page.context.close()  # C leaves: the simulation and its view run on in C's kernel
+            finally:
+                browser.close()
         left = time.monotonic()
+        # Within 60 s of the page closing, C's server (kernel, Jupyter server, all C started) costs <= 0.02 cores:
+        # measured over the 20 s before that deadline, the run having paused 30 s after the page went.
+        time.sleep(40)  # waiting for the pause's 30 s to pass: a duration under test, not a synchronisation
+        used, since = cpu_used("learner-c"), time.monotonic()
+        time.sleep(20)  # the measuring window
+        cores = (cpu_used("learner-c") - used) / 1e9 / (time.monotonic() - since)
+        print(f"C's server {time.monotonic() - left:.0f} s after C's page closed: {cores:.4f} cores")
+        assert cores <= 0.02, cores
         while c.server() and time.monotonic() - left < idle + 60:  # the culler's timeout, its period, slack
             time.sleep(1)  # polling the hub's record of C's server, within the deadline
         assert not c.server(), f"C's server still runs {time.monotonic() - left:.0f} s after C left"
         waited = time.monotonic() - left
-        assert waited >= idle - 1, waited  # not before the timeout
+        assert waited >= idle - 10, waited  # not before the timeout (less the activity interval's lag)
         assert "idle-culler" in hub.log() and "learner-c" in hub.log()
-        assert not running(int(sim)), "the simulation C left running outlived C's server"
+        assert not running(int(program)), "the program C left running outlived C's server"
         # C comes back: their notebooks, their file and their domain are there.
         c.kernel_id = None  # that kernel went with the server
         c.start_server()
