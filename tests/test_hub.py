@@ -25,7 +25,7 @@ from conftest import ROOT
 sys.path.insert(0, str(ROOT / "course"))
 
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
-from hub import Hub, KernelDied, Learner, open_live_notebook, require_live_view_draws  # noqa: E402
+from hub import PASSWORD, Hub, KernelDied, Learner, open_live_notebook, require_live_view_draws  # noqa: E402
 
 from netns import net, on  # noqa: E402,F401 - net: the network tier's fixture
 
@@ -625,6 +625,21 @@ def test_one_learner_cannot_take_the_others_down(tmp_path):
     assert hub.cgroups_left == []
 
 
+def refused_page_says_why(browser, hub_url: str, name: str) -> None:
+    """``name`` logs in with a browser while no domain is left: their page says why, and gives no server."""
+    page = browser.new_context().new_page()
+    page.goto(hub_url + "/hub/login")
+    page.fill("input[name=username]", name)
+    page.fill("input[name=password]", PASSWORD)
+    page.click("input[type=submit], button[type=submit]")
+    page.get_by_text(f"no ROS domain left for {name}: this server gives each learner one of its 1 domains").wait_for(
+        timeout=60_000
+    )  # JupyterHub's spawn page, from the pre-spawn hook's refusal (course/jupyterhub_config.py)
+    shown = page.inner_text("body")
+    assert "Unhandled error" not in shown and "/user/" not in page.url, (page.url, shown[-2000:])
+    page.context.close()
+
+
 @pytest.mark.slow
 @pytest.mark.cross_process
 def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
@@ -640,8 +655,8 @@ def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
     idle = 75  # s: the test's timeout (a class's: an hour); past the 30 s a run shown in no page takes to pause
     hub = Hub(
         tmp_path / "hub",
-        ["learner-c"],
-        DOMAINS[:1],
+        ["learner-c", "learner-d"],
+        DOMAINS[:1],  # C takes the one domain: D is refused
         extra_env={"RTT_HUB_IDLE_TIMEOUT": str(idle), "RTT_HUB_ACTIVITY_INTERVAL": "5"},
     )
     try:
@@ -665,6 +680,7 @@ def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
             try:
                 page = open_live_notebook(browser, hub.url, "learner-c")
                 require_live_view_draws(page, "learner-c")
+                refused_page_says_why(browser, hub.url, "learner-d")
                 page.context.close()  # C leaves: the simulation and its view run on in C's kernel
             finally:
                 browser.close()
