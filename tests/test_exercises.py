@@ -91,19 +91,21 @@ EXERCISES = [
 
 
 @pytest.mark.parametrize("number", EXERCISES)
-def test_the_worked_solution_passes(ros, number):
+def test_the_worked_solution_passes(ros, snapshot, number):
     ex = exercise(number)
     result = grade(ex, ex["stub"], ex["solution"])
     assert result.passed, str(result)
     assert str(result).startswith(f"\u2713 Exercise {number}")
+    assert str(result) == snapshot  # what the learner is told, word for word (tests/__snapshots__)
 
 
 @pytest.mark.parametrize("number", EXERCISES)
-def test_the_empty_stub_fails_as_not_done(ros, number):
+def test_the_empty_stub_fails_as_not_done(ros, snapshot, number):
     result = grade(exercise(number), exercise(number)["stub"])
     assert not result.passed
     assert str(result).startswith(f"\u2717 Exercise {number}")
     assert "not done yet" in result.message and "NotImplementedError" in result.message
+    assert str(result) == snapshot
 
 
 # (exercise, text of the solution, the mistake put in its place, the case that must catch it)
@@ -499,7 +501,7 @@ MISTAKES = [
 
 
 @pytest.mark.parametrize("number,right,wrong,caught_by", MISTAKES, ids=[f"{m[0]}-{k}" for k, m in enumerate(MISTAKES)])
-def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught_by):
+def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wrong, caught_by):
     ex = exercise(number)
     assert right in ex["solution"], f"the solution of {number} no longer has {right!r}: update this test"
     result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
@@ -510,6 +512,7 @@ def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught
     assert "Hint:" in result.message, f"the line for {wrong!r} gives no hint: {result}"
     if "speeds.max() == 0" in wrong:
         assert "stood still" in result.message, str(result)
+    assert str(result) == snapshot  # its case, its values and its hint, word for word
 
 
 @pytest.mark.parametrize(
@@ -527,7 +530,7 @@ def test_a_wrong_answer_fails_naming_the_input(ros, number, right, wrong, caught
         ("8.2", "return 15.0, 70", "return {'rate': 15.0, 'jpeg_quality': 70}", "camera_settings()"),
     ],
 )
-def test_a_wrongly_shaped_answer_is_told_so_not_judged_on_a_value(ros, number, right, wrong, function):
+def test_a_wrongly_shaped_answer_is_told_so_not_judged_on_a_value(ros, snapshot, number, right, wrong, function):
     """An answer of the wrong type fails on its own case (the function's name alone), saying what came back."""
     ex = exercise(number)
     assert right in ex["solution"], f"the solution of {number} no longer has {right!r}: update this test"
@@ -536,6 +539,7 @@ def test_a_wrongly_shaped_answer_is_told_so_not_judged_on_a_value(ros, number, r
     assert result.case == function, str(result)
     assert "returned" in result.message and "expected" in result.message, str(result)
     assert "Hint:" in result.message, str(result)
+    assert str(result) == snapshot
 
 
 LOCKED_COUNT = (
@@ -690,7 +694,9 @@ FIRST_HIDDEN_MISTAKES = [m for m in {m[0]: m for m in reversed(HIDDEN_MISTAKES)}
     "number, right, wrong, caught_by",
     [m if m in FIRST_HIDDEN_MISTAKES else pytest.param(*m, marks=pytest.mark.more) for m in HIDDEN_MISTAKES],
 )
-def test_a_mistake_only_the_hidden_cases_catch_fails_on_its_case(ros, grading_seed, number, right, wrong, caught_by):
+def test_a_mistake_only_the_hidden_cases_catch_fails_on_its_case(
+    ros, grading_seed, snapshot, number, right, wrong, caught_by
+):
     ex = exercise(number)
     assert ex["solution"].count(right) == 1, right
     result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
@@ -698,6 +704,7 @@ def test_a_mistake_only_the_hidden_cases_catch_fails_on_its_case(ros, grading_se
     assert caught_by in result.case, (caught_by, str(result))
     if "a hidden case failed" in result.message:
         assert not any(c.isdigit() for c in result.message.split("failed")[1]), result.message  # no values
+    assert str(result) == snapshot
 
 
 def test_every_exercise_has_its_rules_and_an_answer_for_the_visible_cases_alone():
