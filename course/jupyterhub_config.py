@@ -34,6 +34,7 @@
 import json
 import os
 import pwd
+import stat
 import sys
 from pathlib import Path
 
@@ -184,6 +185,23 @@ SHELL = "/bin/bash" if Path("/bin/bash").exists() else "/bin/sh"
 for path in (LEARNER_CONFIG, LEARNER_CONFIG / "labconfig"):
     path.chmod(0o755)
 c.Spawner.environment["JUPYTER_CONFIG_PATH"] = str(LEARNER_CONFIG)
+
+
+def closed_to_others(path: Path) -> Path | None:
+    """The first folder on the way to ``path`` that other users cannot enter; None if they can reach it."""
+    return next((f for f in [*reversed(path.parents), path] if not f.stat().st_mode & stat.S_IXOTH), None)
+
+
+# Learners who are Unix users must reach these, or their servers would start without them, silently: no
+# nbgrader, and a proxy to every port of the machine.  The hub refuses to start instead.
+for what, path in (("their Jupyter configuration", LEARNER_CONFIG), ("nbgrader's exchange", EXCHANGE),
+                   ("course/own_ports.py", COURSE)):  # fmt: skip
+    if UNIX_USERS and (closed := closed_to_others(path)):
+        raise SystemExit(
+            f"learners as Unix users cannot reach {what} ({path}): other users cannot enter {closed}. Put the "
+            "hub's state (RTT_HUB_STATE) or the exchange (RTT_NBGRADER_EXCHANGE) where every user can, or "
+            f"chmod o+x {closed}."
+        )
 
 DOMAINS = DomainBook(
     STATE / BOOK_NAME,

@@ -281,6 +281,39 @@ def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
     assert "nothing in" in capsys.readouterr().err
 
 
+@pytest.mark.skipif(not ROOT_USER, reason="handing a folder to another user needs root")
+def test_a_submission_handed_in_under_another_learners_name_is_refused(tmp_path, capsys):
+    """A learner can name anyone in ``nbgrader submit --student``: where learners are Unix users, a submission
+    not owned by the user of the name it bears is moved out of the exchange and never graded."""
+    import pwd
+
+    exchange, course = tmp_path / "exchange", tmp_path / "course"
+    inbound = exchange / "ros-tank-tutorial" / "inbound"
+    inbound.mkdir(parents=True)
+    course.mkdir()
+    (course / "nbgrader_config.py").write_text(
+        f"c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\nc.Exchange.root = {str(exchange)!r}\n"
+    )
+    nobody, daemon = pwd.getpwnam("nobody").pw_uid, pwd.getpwnam("daemon").pw_uid
+    handed = {  # the name it bears -> who handed it in
+        "daemon+hello+2026-11-26 10:00:00.000000 UTC+abc": daemon,  # their own
+        "daemon+hello+2026-11-26 11:00:00.000000 UTC+def": nobody,  # nobody's, under daemon's name: newer
+        "learner-x+hello+2026-11-26 10:00:00.000000 UTC+ghi": nobody,  # no Unix user of that name
+    }
+    for name, uid in handed.items():
+        (inbound / name).mkdir()
+        (inbound / name / "hello.ipynb").write_text("{}")
+        os.chown(inbound / name, uid, uid)
+    refused, unchecked = grade.refuse_forged(course)
+    forged = "daemon+hello+2026-11-26 11:00:00.000000 UTC+def"
+    assert refused == [f"{forged}: handed in by nobody, not daemon (refused/, not graded)"], refused
+    assert unchecked == ["learner-x"]
+    assert sorted(p.name for p in inbound.iterdir()) == sorted(set(handed) - {forged})
+    assert (course / "refused" / forged / "hello.ipynb").read_text() == "{}"  # kept for the teacher, out of reach
+    assert (course / "refused").stat().st_mode & 0o077 == 0
+    assert grade.refuse_forged(course) == ([], ["learner-x"])  # nothing left to refuse
+
+
 def test_a_class_hub_gives_learners_the_notebooks_without_the_worked_solutions():
     """Each notebook as the hub copies it to a learner: every cell but the folded solutions, outputs and all."""
     for name in ALL:

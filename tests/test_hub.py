@@ -24,6 +24,7 @@ from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "course"))
 
+import grade  # noqa: E402 - course/ is not a package
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
 from hub import PASSWORD, Hub, KernelDied, Learner, open_live_notebook, require_live_view_draws  # noqa: E402
 
@@ -206,7 +207,8 @@ def both_submit_under_their_own_names(hub: Hub, learners: list[Learner]) -> None
 
     course = hub_state(hub) / "exchange" / "ros-tank-tutorial"
     (course / "outbound" / "hello").mkdir(parents=True)
-    (course / "inbound").mkdir()
+    (course / "inbound").mkdir(mode=0o733)  # as nbgrader's release makes it: learners write, only the teacher lists
+    (course / "inbound").chmod(0o733)  # past the umask
     nbformat.write(nbformat.v4.new_notebook(), course / "outbound" / "hello" / "hello.ipynb")
     for learner in learners:
         assert learner.run(SUBMIT, timeout=180).strip().endswith("submitted")
@@ -404,12 +406,16 @@ def unix_learners():
 @pytest.mark.slow
 @pytest.mark.cross_process
 def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environment, unix_learners):
-    hub = Hub(
-        tmp_path / "hub",
-        unix_learners,
-        DOMAINS,
-        extra_env={"RTT_HUB_SPAWNER": "users", "RTT_HUB_PYTHON": str(shared_environment)},
-    )
+    import stat
+
+    # A hub whose state the learners cannot reach (their Jupyter configuration, nbgrader's exchange) refuses
+    # to start, rather than start their servers without them.
+    users = {"RTT_HUB_SPAWNER": "users", "RTT_HUB_PYTHON": str(shared_environment)}
+    said = rf"learners as Unix users cannot reach their Jupyter configuration .* other users cannot enter {tmp_path}\."
+    with pytest.raises(RuntimeError, match=said):
+        Hub(tmp_path / "closed", unix_learners, DOMAINS, extra_env=users)
+    tmp_path.chmod(tmp_path.stat().st_mode | stat.S_IXOTH)  # its parents are open: shared_environment opened them
+    hub = Hub(tmp_path / "hub", unix_learners, DOMAINS, extra_env=users)
     try:
         a, b = (Learner(hub, name) for name in unix_learners)
         for learner in (a, b):
@@ -431,6 +437,24 @@ def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environme
         assert moved["a"] > 0.2 and moved["b"] < 0.001, (moved, results)
         assert results["a"]["domain"] != results["b"]["domain"]
         assert "rtt_joy" not in results["b"]["nodes"]
+        # Each submits under their own name; then A hands one in under B's name, newer than B's own.  The
+        # teacher's grading refuses A's and keeps B's (course/grade.py: refuse_forged).
+        both_submit_under_their_own_names(hub, [a, b])
+        forge = SUBMIT.replace(
+            '(["fetch_assignment", "hello"], ["submit", "hello"])', f'(["submit", "hello", "--student", "{b.name}"],)'
+        )
+        assert forge != SUBMIT and a.run(forge).strip() == "submitted"
+        teacher = tmp_path / "teacher"
+        teacher.mkdir()
+        (teacher / "nbgrader_config.py").write_text(
+            "c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\n"
+            f"c.Exchange.root = {str(hub_state(hub) / 'exchange')!r}\n"
+        )
+        refused, unchecked = grade.refuse_forged(teacher)
+        assert len(refused) == 1 and f": handed in by {a.name}, not {b.name} " in refused[0], refused
+        assert unchecked == []
+        inbound = hub_state(hub) / "exchange" / "ros-tank-tutorial" / "inbound"
+        assert sorted(p.name.split("+")[0] for p in inbound.iterdir()) == sorted([a.name, b.name])
     finally:
         hub.close()
 
