@@ -635,6 +635,39 @@ def test_a_failed_line_names_its_subject_once_and_wraps_for_nbgrader():
     assert " ".join(line.strip() for line in lines) == str(result)
 
 
+HEARD: list = []  # what the grading kernel's seal would hear of require() (an audit hook: one per process)
+
+
+def test_require_tells_the_seal_each_verdict_and_wraps_without_breaking_a_word(snapshot):
+    """``require()`` says each verdict to the seal (the ``rtt.verdict`` audit event, passed or not) before it
+    raises; its lines are indented after the first, and a word longer than a line (a path) stays whole."""
+    import sys
+
+    from tutorial.exercises.grader import WRAP, Case, CaseFailed
+    from tutorial.exercises.grader import grade as run_check
+
+    if not getattr(sys, "_rtt_test_hears_verdicts", False):
+        sys.addaudithook(lambda event, args: HEARD.append(args) if event == "rtt.verdict" else None)
+        sys._rtt_test_hears_verdicts = True
+    HEARD.clear()
+    path = "/home/learner/notebooks/" + "a_folder_with_a_long_name/" * 4 + "answer.py"
+    assert len(path) > WRAP
+
+    def wrong():
+        raise CaseFailed(f"read {path} and found nothing to run in it, although the statement asks for a class.")
+
+    passed = run_check("Exercise 9.9, a pose", [Case("a case", lambda: None)])
+    failed = run_check("Exercise 9.9, a pose", [Case("reading a file", wrong)])
+    assert passed.require() is passed
+    with pytest.raises(AssertionError) as raised:
+        failed.require()
+    assert HEARD == [(passed,), (failed,)]
+    lines = str(raised.value).splitlines()
+    assert path in lines[1:] or f"  {path}" in lines, lines  # on a line of its own, whole
+    assert all(line.startswith("  ") for line in lines[1:]), lines
+    assert str(raised.value) == snapshot
+
+
 # ---- hidden cases (grader.hidden_random): drawn while grading, by the statement's rules ----
 
 # Every check draws hidden cases while grading, after its visible ones: a wrong answer the visible cases catch
