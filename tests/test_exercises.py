@@ -702,10 +702,25 @@ def kept(numbers) -> list:
 
 
 @pytest.mark.parametrize("number", kept(EXERCISES))
-def test_the_worked_solution_passes_the_hidden_cases_too(ros, grading_seed, number):
+def test_the_worked_solution_passes_the_hidden_cases_too(ros, grading_seed, monkeypatch, snapshot, number):
+    """... and every case its check ran, visible and hidden, is the one written down (what it names and its
+    hint, in tests/__snapshots__): a teacher reads there what each check tries."""
+    import importlib
+
+    from tutorial.exercises import grader
+
     ex = exercise(number)
+    ran: list = []
+
+    def grade_and_keep(exercise, cases):
+        cases = list(cases)
+        ran.extend(cases)
+        return grader.grade(exercise, cases)
+
+    monkeypatch.setattr(importlib.import_module(f"tutorial.exercises.{ex['checks']}"), "grade", grade_and_keep)
     result = grade(ex, ex["stub"], ex["solution"])
     assert result.passed and "hidden ones)" in result.message, str(result)
+    assert [(c.call, c.hint, c.hidden) for c in ran] == snapshot
 
 
 @pytest.mark.parametrize("number", kept(sorted(VISIBLE_ONLY)))
