@@ -635,21 +635,27 @@ def test_a_failed_line_names_its_subject_once_and_wraps_for_nbgrader():
     assert " ".join(line.strip() for line in lines) == str(result)
 
 
-HEARD: list = []  # what the grading kernel's seal would hear of require() (an audit hook: one per process)
+HEARD: list = []  # what the grading kernel's seal would hear of the checks (an audit hook: one per process)
+
+
+def hear_the_checks() -> list:
+    """HEARD, emptied: from now on it gets each (event, args) of the checks' audit events for the seal."""
+    import sys
+
+    if not getattr(sys, "_rtt_test_hears_checks", False):
+        sys.addaudithook(lambda event, args: HEARD.append((event, args)) if event.startswith("rtt.") else None)
+        sys._rtt_test_hears_checks = True
+    HEARD.clear()
+    return HEARD
 
 
 def test_require_tells_the_seal_each_verdict_and_wraps_without_breaking_a_word(snapshot):
     """``require()`` says each verdict to the seal (the ``rtt.verdict`` audit event, passed or not) before it
     raises; its lines are indented after the first, and a word longer than a line (a path) stays whole."""
-    import sys
-
     from tutorial.exercises.grader import WRAP, Case, CaseFailed
     from tutorial.exercises.grader import grade as run_check
 
-    if not getattr(sys, "_rtt_test_hears_verdicts", False):
-        sys.addaudithook(lambda event, args: HEARD.append(args) if event == "rtt.verdict" else None)
-        sys._rtt_test_hears_verdicts = True
-    HEARD.clear()
+    heard = hear_the_checks()
     path = "/home/learner/notebooks/" + "a_folder_with_a_long_name/" * 4 + "answer.py"
     assert len(path) > WRAP
 
@@ -661,11 +667,45 @@ def test_require_tells_the_seal_each_verdict_and_wraps_without_breaking_a_word(s
     assert passed.require() is passed
     with pytest.raises(AssertionError) as raised:
         failed.require()
-    assert HEARD == [(passed,), (failed,)]
+    assert [h for h in heard if h[0] == "rtt.verdict"] == [("rtt.verdict", (passed,)), ("rtt.verdict", (failed,))]
     lines = str(raised.value).splitlines()
     assert path in lines[1:] or f"  {path}" in lines, lines  # on a line of its own, whole
     assert all(line.startswith("  ") for line in lines[1:]), lines
     assert str(raised.value) == snapshot
+
+
+def test_a_value_of_a_class_that_compares_as_it_likes_is_refused_and_told_to_the_seal():
+    """same_numbers and same_value refuse a value whose class is not exactly a number type or the expected one,
+    and tell the seal (``rtt.suspect``) when that class is an answer's own with a comparison of its own."""
+    import numpy as np
+
+    from tutorial.exercises.grader import same_numbers, same_value
+
+    class AlwaysEqual:
+        def __eq__(self, other):
+            return True
+
+    class MyFloat(float):
+        pass
+
+    class AClassWhoseNameIsLongerThanFortyCharactersByFar(int):
+        pass
+
+    heard = hear_the_checks()
+    assert not same_numbers(AlwaysEqual(), 1.0) and not same_value(AlwaysEqual(), "a")
+    assert not same_numbers(MyFloat(1.0), 1.0) and not same_value(MyFloat(2.0), 2)
+    assert not same_value(AClassWhoseNameIsLongerThanFortyCharactersByFar(3), 3)
+    assert not same_numbers("1.0", 1.0) and not same_value("1", 1) and not same_numbers(None, 1.0)  # builtins: untold
+    assert not same_value(np.str_("a"), "a")  # NumPy's own: not told
+    assert same_numbers(np.float32(1.0), 1.0) and same_value(np.int64(2), 2) and same_value(True, True)
+    own = "a class of its own that compares as it likes"
+    assert [h for h in heard if h[0] == "rtt.suspect"] == [
+        ("rtt.suspect", (f"a AlwaysEqual, {own}",)),
+        ("rtt.suspect", (f"a AlwaysEqual, {own}",)),
+        ("rtt.suspect", (f"a MyFloat, {own}",)),
+        ("rtt.suspect", (f"a MyFloat, {own}",)),
+        ("rtt.suspect", (f"a AClassWhoseNameIsLongerThanFortyCharacte, {own}",)),
+    ], heard
 
 
 # ---- hidden cases (grader.hidden_random): drawn while grading, by the statement's rules ----
