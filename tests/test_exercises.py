@@ -871,3 +871,67 @@ def test_the_hidden_stamps_of_5_2_are_never_negative_and_exactly_a_second_back_o
                     assert refused == [reason == "out_of_order"] * len(refused), (newest, stamp, refused, reason)
                 newest = after
     assert boundaries > 200, boundaries  # the exact second is drawn in the random runs too
+
+
+def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
+    """Every hidden message of 3.2 is one the statement's rules describe, and together they try each rule: known,
+    unknown and repeated names; a value in range, within the tolerance past the upper limit, past it below the
+    lower one (0.01 m for a slide, 0.05 rad for a hinge; an unlimited joint: within 10), non-finite or huge;
+    every length up to five; sometimes a position short, sometimes a name."""
+    import math
+    import random
+    from collections import Counter
+
+    from tutorial.exercises.step3_viewer import _crane, _random_message, _tank
+
+    rng = random.Random("the rules of 3.2")
+    bodies = (_tank().joint_infos, _crane().joint_infos)
+    lengths, bands, foreign, short = Counter(), Counter(), Counter(), Counter()
+    past = {"upper": [], "lower": []}  # how far past a limit, in tolerances
+    own = repeated = picks = 0
+    for _ in range(3000):
+        joints = rng.choice(bodies)
+        names, positions = _random_message(rng, joints)
+        assert abs(len(names) - len(positions)) <= 1 and len(names) <= 5 and len(positions) <= 5
+        lengths[max(len(names), len(positions))] += 1
+        if len(names) != len(positions):
+            short["names" if len(names) < len(positions) else "positions"] += 1
+        repeated += len(set(names)) < len(names)
+        by_name = {j.name: j for j in joints}
+        for name, q in zip(names, positions):
+            picks += 1
+            if name not in by_name:
+                foreign[name] += 1
+                continue
+            own += 1  # a name of the body: its value was drawn for that joint
+            j = by_name[name]
+            tol = 0.01 if j.kind == "slide" else 0.05
+            low, high = (j.lower, j.upper) if j.limited else (-10.0, 10.0)
+            if not math.isfinite(q) or q == 1e300:
+                band = "not finite, or huge"
+            elif low <= q <= high:
+                band = "in range"
+            elif high < q <= high + 0.9 * tol:
+                band = "within the tolerance past the upper limit"
+                past["upper"].append((q - high) / tol)
+            elif low - 3.0 * tol <= q <= low - 1.1 * tol:
+                band = "past the tolerance below the lower limit"
+                past["lower"].append((low - q) / tol)
+            else:
+                raise AssertionError(f"{q} for {name} ({j.kind}, {low}..{high}) follows no rule")
+            bands[(j.kind, j.limited, band)] += 1
+    assert sorted(lengths) == [0, 1, 2, 3, 4, 5], lengths
+    # each band is drawn across its whole width: up to 0.9 tolerances past the upper limit, 1.1 to 3 below
+    assert min(past["upper"]) < 0.05 and max(past["upper"]) > 0.85, past["upper"]
+    assert min(past["lower"]) < 1.15 and max(past["lower"]) > 2.9, past["lower"]
+    assert set(foreign) == {"GUN", "TURRET_Y", "SLEW"}, foreign  # each foreign to one body at least
+    assert repeated > 100 and short["names"] > 50 and short["positions"] > 50, (repeated, short)
+    assert 0.1 < sum(short.values()) / (3000 - lengths[0]) < 0.3  # about one message in five is short
+    # 4 in 7 draws are the joint's own name, and some foreign ones are the body's (TURRET_Y, SLEW): 0.72 here,
+    # 0.74 with 5 in 8
+    assert 0.70 < own / picks < 0.735, own / picks
+    for kind, limited in (("hinge", True), ("slide", True), ("hinge", False)):
+        drawn = {band for (k, lim, band), n in bands.items() if (k, lim) == (kind, limited) and n}
+        past_a_limit = {"within the tolerance past the upper limit", "past the tolerance below the lower limit"}
+        expected = {"in range", "not finite, or huge"} | (past_a_limit if limited else set())
+        assert expected <= drawn, (kind, limited, bands)
