@@ -6,8 +6,8 @@
 For each assignment (default: every one released into the exchange; with
 ``--no-collect``, every one somebody has in ``submitted/``):
 
-1. ``nbgrader collect``: the submissions from the exchange into ``submitted/``, but for those handed in
-   under another learner's name (:func:`refuse_forged`);
+1. ``nbgrader collect``: the submissions from the exchange into ``submitted/``, from a copy out of the
+   learners' reach, but for those handed in under another learner's name (:func:`stage_submissions`);
 2. ``nbgrader autograde``, one learner at a time per job, ``--jobs`` at once.
    Each job's kernel runs in a ROS domain of its own (the discovery range is
    this machine), so submissions graded at once never hear each other's
@@ -42,6 +42,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a package
 from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
 from sandboxing import Sandboxes, add_flags_column, clear, course_seed, learner_seed, settle, test_calls  # noqa: E402
+from submissions import stage  # noqa: E402
 
 
 def domains(text: str) -> list[int]:
@@ -90,45 +91,18 @@ def released(course: Path) -> list[str]:
     return sorted(m.group(1) for line in said[start + 1 :] if (m := re.search(r"\] \S+ (\S+)$", line)))
 
 
-def refuse_forged(course: Path) -> tuple[list[str], list[str]]:
-    """Submissions in the exchange handed in under another learner's name: moved out, one line each; and the
-    learners whose submissions' authors cannot be told.
-
-    nbgrader names a submission after the learner their own server says they are (``NAME+ASSIGNMENT+TIME+…``
-    in the exchange's ``inbound/``), and a learner can say anyone (``nbgrader submit --student NAME``): the
-    newest submission under a name is the one collected, so a forged one would replace another learner's
-    work.  Where learners are Unix users of this machine (the hub's ``users`` spawner), the folder's owner is
-    who handed it in: one not owned by the Unix user of the name it bears is moved to the course's
-    ``refused/`` (the teacher's alone) and never graded.  A name with no Unix user (the trial's spawner, where
-    every learner is one user; containers, where every learner is uid 1000) cannot be checked this way.
+def stage_submissions(course: Path) -> tuple[Path, list[str], list[str]]:
+    """The exchange's submissions, copied where only the teacher can write, each checked for who handed it in
+    (``course/submissions.py``).
 
     Returns:
-        (refused: "NAME+…: handed in by USER, not NAME", unchecked: names with no Unix user)
+        (the staged exchange's root, which ``nbgrader collect`` reads; one line per refused submission; the
+        names whose author cannot be told)
     """
-    import pwd
-
     from traitlets.config.loader import PyFileConfigLoader
 
     config = PyFileConfigLoader("nbgrader_config.py", path=str(course)).load_config()
-    inbound = Path(config.Exchange.root) / config.CourseDirectory.course_id / "inbound"
-    refused, unchecked = [], set()
-    for submission in sorted(inbound.iterdir()) if inbound.is_dir() else []:
-        name = submission.name.split("+")[0]
-        try:
-            expected = pwd.getpwnam(name).pw_uid
-        except KeyError:
-            unchecked.add(name)
-            continue
-        owner = submission.lstat().st_uid
-        if owner != expected:
-            try:
-                by = pwd.getpwuid(owner).pw_name
-            except KeyError:
-                by = f"uid {owner}"
-            (course / "refused").mkdir(mode=0o700, exist_ok=True)
-            os.replace(submission, course / "refused" / submission.name)
-            refused.append(f"{submission.name}: handed in by {by}, not {name} (refused/, not graded)")
-    return refused, sorted(unchecked)
+    return stage(Path(config.Exchange.root) / config.CourseDirectory.course_id, course)
 
 
 def learners(course: Path, assignment: str) -> list[str]:
@@ -162,17 +136,18 @@ def grade(
 def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: list[int], boxes) -> Path:
     failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
     keep_private(course)
+    staged = None
     if collect:
-        refused, unchecked = refuse_forged(course)
-        failed.extend(refused)
+        staged, refused, unchecked = stage_submissions(course)
+        failed.extend(f"{line} (not graded)" for line in refused)
         if unchecked:
             print(f"who handed in the submissions of {', '.join(unchecked)} cannot be told: no Unix user of this "
-                  "machine has their name (refuse_forged)", file=sys.stderr)  # fmt: skip
+                  "machine has their name", file=sys.stderr)  # fmt: skip
     if boxes:
         course_seed(course)  # made once, before the worker threads read it
     for assignment in assignments:
         if collect:
-            nbgrader(course, "collect", assignment, "--update")
+            nbgrader(course, "collect", assignment, "--update", f"--Exchange.root={staged}")
         who = learners(course, assignment)
         calls, checks = test_calls(course, assignment) if boxes else ([], [])  # the seal's, for every learner
 
@@ -236,7 +211,7 @@ def keep_private(course: Path) -> None:
     for name in (
         "source",
         "submitted",
-        "refused",
+        "staged-exchange",
         "autograded",
         "feedback",
         "gradebook.db",

@@ -128,7 +128,7 @@ c.Spawner.environment = {
 # assignments) in their JupyterLab.  Their servers read it from a Jupyter configuration folder of the hub's.
 EXCHANGE = Path(os.environ.get("RTT_NBGRADER_EXCHANGE", STATE / "exchange"))
 EXCHANGE.mkdir(parents=True, exist_ok=True)
-EXCHANGE.chmod(0o777)  # every learner writes their submissions into it
+EXCHANGE.chmod(0o1777)  # every learner writes their submissions into it; only its owner renames what is in it
 LEARNER_CONFIG = STATE / "learner_jupyter"
 (LEARNER_CONFIG / "labconfig").mkdir(parents=True, exist_ok=True)
 (LEARNER_CONFIG / "nbgrader_config.py").write_text(
@@ -188,19 +188,24 @@ c.Spawner.environment["JUPYTER_CONFIG_PATH"] = str(LEARNER_CONFIG)
 
 
 def closed_to_others(path: Path) -> Path | None:
-    """The first folder on the way to ``path`` that other users cannot enter; None if they can reach it."""
-    return next((f for f in [*reversed(path.parents), path] if not f.stat().st_mode & stat.S_IXOTH), None)
+    """The first folder on the way to ``path`` that other users cannot enter, or ``path`` if they cannot read it
+    (list it, for a folder); None if they can."""
+    closed = next((f for f in reversed(path.parents) if not f.stat().st_mode & stat.S_IXOTH), None)
+    needed = stat.S_IROTH | (stat.S_IXOTH if path.is_dir() else 0)
+    return closed or (None if path.stat().st_mode & needed == needed else path)
 
 
 # Learners who are Unix users must reach these, or their servers would start without them, silently: no
 # nbgrader, and a proxy to every port of the machine.  The hub refuses to start instead.
+for path in LEARNER_CONFIG.rglob("*"):  # written under the hub's umask: readable by every learner
+    path.chmod(0o755 if path.is_dir() else 0o644)
 for what, path in (("their Jupyter configuration", LEARNER_CONFIG), ("nbgrader's exchange", EXCHANGE),
-                   ("course/own_ports.py", COURSE)):  # fmt: skip
+                   ("course/own_ports.py", COURSE), ("course/own_ports.py", COURSE / "own_ports.py")):  # fmt: skip
     if UNIX_USERS and (closed := closed_to_others(path)):
         raise SystemExit(
-            f"learners as Unix users cannot reach {what} ({path}): other users cannot enter {closed}. Put the "
-            "hub's state (RTT_HUB_STATE) or the exchange (RTT_NBGRADER_EXCHANGE) where every user can, or "
-            f"chmod o+x {closed}."
+            f"learners as Unix users cannot reach {what} ({path}): other users cannot enter or read {closed}. "
+            "Put the hub's state (RTT_HUB_STATE) or the exchange (RTT_NBGRADER_EXCHANGE) where every user can, "
+            f"or chmod o+rx {closed}."
         )
 
 DOMAINS = DomainBook(

@@ -14,8 +14,9 @@
 # - the limits are DockerSpawner's (mem_limit, cpu_limit, a pids limit), from the same figures as course/limits.py;
 # - no book of ROS domains: each container has a network namespace of its own, where discovery on localhost
 #   finds that learner's nodes only, so every learner uses the same domain (RTT_HUB_CONTAINER_DOMAIN, default 0).
-# Not here yet: nbgrader's exchange (a volume shared by every learner's container and the teacher).  Not
-# stopped: a learner's container reaching a port another learner's container serves on that network (the
+# - nbgrader's exchange: released assignments and feedback read only, and an inbound folder of each learner's
+#   own (course/container_exchange.py).
+# Not stopped: a learner's container reaching a port another learner's container serves on that network (the
 # learners' Jupyter servers ask for the hub's login; anything else a learner starts there does not).
 
 import os
@@ -28,7 +29,9 @@ GATEWAY = os.environ.get("RTT_HUB_CONTAINER_GATEWAY") or "127.0.0.1"  # never ""
 c.JupyterHub.hub_ip = GATEWAY  # the hub's API, for the learners' servers: on the containers' network only
 c.JupyterHub.hub_connect_ip = GATEWAY
 
+from container_exchange import give_learner_their_exchange  # noqa: E402 - course/ is on the path: the base's
 from dockerspawner import DockerSpawner  # noqa: E402
+from domains import hub_state  # noqa: E402
 from idle_stops import remembering_last_use  # noqa: E402 - course/ is on the path: the base put it there
 
 c.JupyterHub.spawner_class = remembering_last_use(DockerSpawner)
@@ -42,9 +45,21 @@ c.DockerSpawner.extra_host_config = {"pids_limit": int(os.environ.get("RTT_HUB_P
 c.Spawner.cmd = ["jupyterhub-singleuser"]  # the image's own environment, not this machine's
 c.Spawner.args = []
 c.Spawner.ip = "0.0.0.0"  # inside the container: its own network namespace, on the containers' network
-# No domain to give, no files to copy (the image and the volume hold them); a learner the culler stopped is
-# told, as on the base (course/idle_stops.py, whose IdleStops the base's post_stop_hook belongs to).
-c.Spawner.pre_spawn_hook = c.Spawner.post_stop_hook.__self__.before_spawn
+# nbgrader's exchange, where the base's learners' configuration says it is (RTT_NBGRADER_EXCHANGE, else the
+# hub's state folder's), with an inbound folder per learner (course/container_exchange.py).
+EXCHANGE = Path(os.environ.get("RTT_NBGRADER_EXCHANGE", hub_state() / "exchange"))
+LEARNER_CONFIG = hub_state() / "learner_jupyter"  # the base's: its nbgrader_config.py, for the learners
+
+
+def prepare_learner(spawner):
+    """No domain to give, no files to copy (the image and the volume hold them): the learner's exchange, and
+    a learner the culler stopped is told, as on the base (course/idle_stops.py, whose IdleStops the base's
+    post_stop_hook belongs to)."""
+    give_learner_their_exchange(spawner, EXCHANGE, LEARNER_CONFIG)
+    c.Spawner.post_stop_hook.__self__.before_spawn(spawner)
+
+
+c.Spawner.pre_spawn_hook = prepare_learner
 # The base's environment for the learners, but for what names this machine (its PATH, its Jupyter
 # configuration folder): the image has its own.  The domain: the same for every learner.
 c.Spawner.environment = {

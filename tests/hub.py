@@ -327,6 +327,24 @@ class Learner:
 # ---- a learner in Chromium: what a browser of theirs does through the hub ----
 
 
+# A learner's cell: fetch the released assignment "hello" and submit it, with nbgrader's own commands.
+SUBMIT = """
+import os, subprocess, sys
+for args in (["fetch_assignment", "hello"], ["submit", "hello"]):
+    done = subprocess.run([os.path.join(os.path.dirname(sys.executable), "nbgrader"), *args],
+                          cwd=os.path.expanduser("~"), capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+print("submitted")
+"""
+
+
+def submit_as(name: str) -> str:
+    """A learner's cell that submits "hello" (fetched already) under another learner's ``name``."""
+    return SUBMIT.replace(
+        '(["fetch_assignment", "hello"], ["submit", "hello"])', f'(["submit", "hello", "--student", "{name}"],)'
+    )
+
+
 def open_live_notebook(browser, hub_url: str, name: str):
     """A page of a new browser context (cookies of its own): ``name`` logs in through the hub's form and runs
     the first cell of ``live.ipynb`` in their home (a live view: ``tests.lab_browser.step2_notebook``)."""

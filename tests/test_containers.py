@@ -28,7 +28,18 @@ import pytest
 from conftest import ROOT
 
 sys.path.insert(0, str(Path(__file__).parent))
-from hub import PASSWORD, Learner, free_port_block, open_live_notebook, require_live_view_draws  # noqa: E402
+sys.path.insert(0, str(ROOT / "course"))
+
+import grade  # noqa: E402 - course/ is not a package
+from hub import (  # noqa: E402
+    PASSWORD,
+    SUBMIT,
+    Learner,
+    free_port_block,
+    open_live_notebook,
+    require_live_view_draws,
+    submit_as,
+)
 
 pytestmark = [pytest.mark.slow, pytest.mark.cross_process]
 
@@ -196,6 +207,7 @@ def hub_on_containers(tmp_path: Path, learners: list[str]):
 
 
 def test_a_class_on_containers(tmp_path):
+    import nbformat
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
@@ -231,6 +243,31 @@ def test_a_class_on_containers(tmp_path):
         moved = {k: sum(x * x for x in r["root"][:2]) ** 0.5 for k, r in results.items()}
         assert moved["learner-a"] > 0.2 and moved["learner-b"] < 0.001, results
         assert a["rtf"] >= 0.99 and b["rtf"] >= 0.99, results
+        # nbgrader's exchange: each fetches and submits; A also submits under B's name.  B's container sees only
+        # B's submissions; grading gathers each one's own and refuses A's forgery (course/container_exchange.py).
+        exchange = tmp_path / "hub" / "exchange" / "ros-tank-tutorial"
+        (exchange / "outbound" / "hello").mkdir(parents=True, exist_ok=True)
+        nbformat.write(nbformat.v4.new_notebook(), exchange / "outbound" / "hello" / "hello.ipynb")
+        (exchange / "outbound" / "hello").chmod(0o755)
+        for learner in learners:
+            assert learner.run(SUBMIT, timeout=180).strip() == "submitted"
+        a, b = learners
+        assert a.run(submit_as(b.name)).strip() == "submitted"
+        seen_by_b = b.run(
+            f"import os\nprint(sorted(n.split('+')[0] for n in os.listdir({str(exchange / 'inbound')!r})))"
+        )
+        assert seen_by_b.strip() == "['learner-b']", seen_by_b
+        teacher = tmp_path / "teacher"
+        teacher.mkdir()
+        (teacher / "nbgrader_config.py").write_text(
+            "c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\n"
+            f"c.Exchange.root = {str(exchange.parent)!r}\n"
+        )
+        staged, refused, unchecked = grade.stage_submissions(teacher)
+        assert len(refused) == 1 and refused[0].endswith(": handed in by learner-a, not learner-b"), refused
+        assert unchecked == []
+        inbound = staged / "ros-tank-tutorial" / "inbound"
+        assert sorted(p.name.split("+")[0] for p in inbound.iterdir()) == ["learner-a", "learner-b"]
         stats = json.loads(podman("stats", "--no-stream", "--format", "json").stdout or "[]")
         for s in stats:
             if s.get("name", "").startswith("jupyter-learner"):

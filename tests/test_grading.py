@@ -281,37 +281,111 @@ def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
     assert "nothing in" in capsys.readouterr().err
 
 
-@pytest.mark.skipif(not ROOT_USER, reason="handing a folder to another user needs root")
-def test_a_submission_handed_in_under_another_learners_name_is_refused(tmp_path, capsys):
-    """A learner can name anyone in ``nbgrader submit --student``: where learners are Unix users, a submission
-    not owned by the user of the name it bears is moved out of the exchange and never graded."""
-    import pwd
-
+def exchange_and_course(tmp_path: Path) -> tuple[Path, Path]:
+    """An exchange with this course's folder (the teacher's, as nbgrader's release makes it) and a course
+    whose nbgrader configuration names it."""
     exchange, course = tmp_path / "exchange", tmp_path / "course"
-    inbound = exchange / "ros-tank-tutorial" / "inbound"
-    inbound.mkdir(parents=True)
+    (exchange / "ros-tank-tutorial").mkdir(parents=True, mode=0o755)
     course.mkdir()
     (course / "nbgrader_config.py").write_text(
         f"c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\nc.Exchange.root = {str(exchange)!r}\n"
     )
-    nobody, daemon = pwd.getpwnam("nobody").pw_uid, pwd.getpwnam("daemon").pw_uid
+    return exchange / "ros-tank-tutorial", course
+
+
+def staged_names(root: Path) -> list[str]:
+    return sorted(p.name for p in (root / "ros-tank-tutorial" / "inbound").iterdir())
+
+
+STAMP = "2026-11-26 10:00:00.000000 UTC"
+
+
+@pytest.mark.skipif(not ROOT_USER, reason="handing a folder to another user needs root")
+def test_a_submission_handed_in_under_another_learners_name_is_refused(tmp_path):
+    """A learner can name anyone in ``nbgrader submit --student``: where learners are Unix users, a submission
+    not owned by the user of the name it bears is left out of what grading collects."""
+    import pwd
+
+    exchange, course = exchange_and_course(tmp_path)
+    inbound = exchange / "inbound"
+    inbound.mkdir()
+    me = pwd.getpwnam("nobody")  # uid 65534: an account above the system ones, standing in for a learner
     handed = {  # the name it bears -> who handed it in
-        "daemon+hello+2026-11-26 10:00:00.000000 UTC+abc": daemon,  # their own
-        "daemon+hello+2026-11-26 11:00:00.000000 UTC+def": nobody,  # nobody's, under daemon's name: newer
-        "learner-x+hello+2026-11-26 10:00:00.000000 UTC+ghi": nobody,  # no Unix user of that name
+        f"nobody+hello+{STAMP}+abc": me.pw_uid,  # their own
+        "nobody+hello+2026-11-26 11:00:00.000000 UTC+def": 0,  # root's, under nobody's name, newer
+        f"learner-x+hello+{STAMP}+ghi": me.pw_uid,  # no account of that name
+        f"daemon+hello+{STAMP}+jkl": me.pw_uid,  # a system account's name: no learner, so not checked
     }
     for name, uid in handed.items():
         (inbound / name).mkdir()
-        (inbound / name / "hello.ipynb").write_text("{}")
+        (inbound / name / "hello.ipynb").write_text(name)
         os.chown(inbound / name, uid, uid)
-    refused, unchecked = grade.refuse_forged(course)
-    forged = "daemon+hello+2026-11-26 11:00:00.000000 UTC+def"
-    assert refused == [f"{forged}: handed in by nobody, not daemon (refused/, not graded)"], refused
-    assert unchecked == ["learner-x"]
-    assert sorted(p.name for p in inbound.iterdir()) == sorted(set(handed) - {forged})
-    assert (course / "refused" / forged / "hello.ipynb").read_text() == "{}"  # kept for the teacher, out of reach
-    assert (course / "refused").stat().st_mode & 0o077 == 0
-    assert grade.refuse_forged(course) == ([], ["learner-x"])  # nothing left to refuse
+    root, refused, unchecked = grade.stage_submissions(course)
+    forged = "nobody+hello+2026-11-26 11:00:00.000000 UTC+def"
+    assert refused == [f"{forged}: handed in by root, not nobody"], refused
+    assert unchecked == ["daemon", "learner-x"]
+    assert staged_names(root) == sorted(set(handed) - {forged})
+    staged = root / "ros-tank-tutorial" / "inbound" / f"nobody+hello+{STAMP}+abc"
+    assert (staged / "hello.ipynb").read_text() == f"nobody+hello+{STAMP}+abc" and staged.stat().st_uid == 0
+    assert root.stat().st_mode & 0o077 == 0  # out of the learners' reach
+    assert sorted(p.name for p in inbound.iterdir()) == sorted(handed)  # the exchange is left as it was
+
+
+def test_a_submission_holding_a_link_a_special_file_or_an_unreadable_time_is_refused(tmp_path):
+    """Grading copies a submission without following any link: one that holds a link (to another learner's
+    work, the teacher's solutions) or a special file is refused whole, as is one whose time nbgrader cannot
+    read (which would stop the collection of the whole class)."""
+    exchange, course = exchange_and_course(tmp_path)
+    inbound = exchange / "inbound"
+    inbound.mkdir()
+    secret = tmp_path / "solutions"
+    secret.mkdir()
+    (secret / "hello.ipynb").write_text("the teacher's")
+    good = f"learner-a+hello+{STAMP}+a"
+    (inbound / good / "sub").mkdir(parents=True)
+    (inbound / good / "sub" / "hello.ipynb").write_text("mine")
+    (inbound / f"learner-b+hello+{STAMP}+b").symlink_to(secret)  # the submission itself a link
+    (inbound / f"learner-c+hello+{STAMP}+c").mkdir()
+    (inbound / f"learner-c+hello+{STAMP}+c" / "hello.ipynb").symlink_to(secret / "hello.ipynb")  # a link in it
+    (inbound / f"learner-d+hello+{STAMP}+d").mkdir()
+    os.mkfifo(inbound / f"learner-d+hello+{STAMP}+d" / "hello.ipynb")  # a pipe: reading it would never end
+    (inbound / "learner-e+hello+yesterday+e").mkdir()
+    (inbound / "learner-f").mkdir()
+    root, refused, _ = grade.stage_submissions(course)
+    assert staged_names(root) == [good]
+    assert (root / "ros-tank-tutorial" / "inbound" / good / "sub" / "hello.ipynb").read_text() == "mine"
+    assert refused == [
+        f"learner-b+hello+{STAMP}+b: not a folder",
+        f"learner-c+hello+{STAMP}+c: holds 'hello.ipynb', a link or a special file",
+        f"learner-d+hello+{STAMP}+d: holds 'hello.ipynb', a link or a special file",
+        "learner-e+hello+yesterday+e: its time cannot be read",
+        "learner-f: not a submission's name",
+    ], refused
+
+
+def test_a_submission_handed_in_from_a_container_under_another_name_is_refused(tmp_path):
+    """Learners in containers hand in to folders of their own, named by the hub (course/container_exchange.py):
+    grading stages each one's own and refuses one bearing another learner's name."""
+    exchange, course = exchange_and_course(tmp_path)
+    by_learner = exchange / "inbound-by-learner"
+    by_learner.mkdir(mode=0o711)
+    handed = {  # folder (the hub's name) -> the submissions in it, by the names they bear
+        "learner-a": [f"learner-a+hello+{STAMP}+abc", "learner-b+hello+2026-11-26 11:00:00.000000 UTC+x"],
+        "learner-b": [f"learner-b+hello+{STAMP}+def"],
+    }
+    for folder, names in handed.items():
+        for name in names:
+            (by_learner / folder / name).mkdir(parents=True)
+            (by_learner / folder / name / "hello.ipynb").write_text(folder)
+    root, refused, unchecked = grade.stage_submissions(course)
+    forged = handed["learner-a"][1]
+    assert refused == [f"{forged}: handed in by learner-a, not learner-b"], refused
+    assert unchecked == []  # the folders said who handed each in
+    assert staged_names(root) == [handed["learner-a"][0], handed["learner-b"][0]]
+    # a course folder a learner could have put in place of the teacher's is not graded at all
+    os.chmod(exchange, 0o777)
+    with pytest.raises(RuntimeError, match="is not the teacher's"):
+        grade.stage_submissions(course)
 
 
 def test_a_class_hub_gives_learners_the_notebooks_without_the_worked_solutions():

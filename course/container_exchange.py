@@ -1,0 +1,44 @@
+"""nbgrader's exchange for a class on containers: each learner's container hands in to a folder of its own.
+
+In containers every learner is the same user (``jovyan``, uid 1000), so the owner of a submission cannot say
+who handed it in, as it does for learners who are Unix users (``course/submissions.py``), and a
+shared ``inbound/`` would let one learner read, or replace, another's work.  Instead each learner's container
+is given, at the exchange's own paths (so the hub's ``nbgrader_config.py`` for learners serves here too):
+
+- ``outbound/`` (the released assignments) and ``feedback/``, read only;
+- as ``inbound/``, the host's ``inbound-by-learner/NAME/``, NAME being the hub's name for that learner, which
+  the learner cannot change.
+
+``make grade`` stages those with the rest, refusing a submission whose name is not its folder's
+(``course/submissions.py``).  The hub's thread calls :func:`give_learner_their_exchange` (the pre-spawn hook).
+The folders are given to uid 1000 of this machine too, where that is an account: keep it no one's.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+COURSE_ID = "ros-tank-tutorial"
+BY_LEARNER = "inbound-by-learner"  # course/submissions.py reads it too
+JOVYAN = 1000  # the image's user (course/containers/Containerfile)
+
+
+def give_learner_their_exchange(spawner, exchange: Path, learner_config: Path) -> None:
+    """Add to ``spawner.volumes`` the exchange as ``spawner.user.name`` sees it, making their folder."""
+    course = exchange / COURSE_ID
+    name = spawner.user.name
+    (course / "outbound").mkdir(mode=0o755, parents=True, exist_ok=True)
+    (course / "feedback").mkdir(exist_ok=True)
+    (course / "feedback").chmod(0o711)  # as nbgrader makes it: a learner reads their own feedback, lists none
+    (course / BY_LEARNER).mkdir(mode=0o711, exist_ok=True)  # entered, never listed, by the containers' user
+    own = course / BY_LEARNER / name
+    own.mkdir(mode=0o700, exist_ok=True)
+    os.chown(own, JOVYAN, JOVYAN)
+    spawner.volumes = {
+        **spawner.volumes,
+        str(learner_config / "nbgrader_config.py"): {"bind": "/etc/jupyter/nbgrader_config.py", "mode": "ro"},
+        str(course / "outbound"): {"bind": str(course / "outbound"), "mode": "ro"},
+        str(course / "feedback"): {"bind": str(course / "feedback"), "mode": "ro"},
+        str(own): {"bind": str(course / "inbound"), "mode": "rw"},
+    }

@@ -1,0 +1,181 @@
+"""The submissions ``make grade`` collects, copied out of the learners' reach first, each checked for who handed
+it in.
+
+nbgrader names a submission after whoever the learner's own server says they are (``NAME+ASSIGNMENT+TIME+…``
+in the exchange's ``inbound/``), and a learner can say anyone (``nbgrader submit --student NAME``); the newest
+submission under a name is the one collected, so a forged one would replace another learner's work.  A
+learner also owns their submission's folder until it is collected, and could change it, or plant links in it,
+while the teacher's grading reads it.  So before ``nbgrader collect``, :func:`stage` copies every submission it
+accepts into a folder of the course that only the teacher can write (``staged-exchange/``), and ``collect``
+reads that copy:
+
+- the copy holds folders and regular files only, opened without following any link (a submission holding a
+  link or a special file is refused), at most ``MAX_BYTES``;
+- where learners are Unix users of this machine (the hub's ``users`` spawner), the submission's folder must be
+  owned by the user of the name it bears;
+- in containers, where every learner is uid 1000, each learner hands in to a folder of their own that the hub
+  named (``inbound-by-learner/NAME``, :mod:`container_exchange`): a submission in it must bear that name;
+- its time must be one nbgrader can read (one that is not would stop ``collect`` for the whole class).
+
+Where every learner is one user (the trial's spawner) and the name is no account of this machine, who handed
+it in cannot be told: the submission is staged, and its name reported.  Nothing in the exchange is moved or
+changed.  The teacher's thread calls all of it.
+"""
+
+from __future__ import annotations
+
+import os
+import pwd
+import shutil
+import stat
+from pathlib import Path
+
+STAGED = "staged-exchange"
+BY_LEARNER = "inbound-by-learner"  # the containers' inbound folders (course/container_exchange.py)
+MAX_BYTES = 100 * 1024**2  # nbgrader's own default limit of a submission (max_dir_size)
+FIRST_LEARNER_UID = 1000  # below: system accounts (Debian's), never a learner
+
+
+class Refused(Exception):
+    """A submission not staged; the message says why."""
+
+
+def stage(exchange_course: Path, course: Path) -> tuple[Path, list[str], list[str]]:
+    """Copy the submissions of ``exchange_course`` (the exchange's folder of this course) that pass into
+    ``course/staged-exchange/<course id>/inbound``.
+
+    Returns:
+        (the staged exchange's root, for ``nbgrader collect --Exchange.root``; one line per refused
+        submission, "NAME+…: why"; the names whose author cannot be told)
+    """
+    root = course / STAGED
+    shutil.rmtree(root, ignore_errors=True)
+    staged = root / exchange_course.name / "inbound"
+    staged.mkdir(mode=0o700, parents=True)
+    os.chmod(root, 0o700)
+    refused: list[str] = []
+    unchecked: set[str] = set()
+    if not exchange_course.is_dir():
+        return root, refused, []
+    _require_teachers(exchange_course)
+    inbound = exchange_course / "inbound"
+    if inbound.is_dir():
+        for name in sorted(os.listdir(inbound)):
+            learner = name.split("+")[0]
+            uid = _uid_of(learner)
+            try:
+                _stage_one(inbound, name, staged, uid)
+            except Refused as why:
+                refused.append(f"{name}: {why}")
+            else:
+                if uid is None:
+                    unchecked.add(learner)
+    folders = exchange_course / BY_LEARNER
+    if folders.is_dir():
+        _require_teachers(folders)
+        for learner in sorted(os.listdir(folders)):
+            own = folders / learner
+            if own.is_symlink() or not own.is_dir():
+                refused.append(f"{BY_LEARNER}/{learner}: not a folder")
+                continue
+            for name in sorted(os.listdir(own)):
+                try:
+                    if name.split("+")[0] != learner:
+                        raise Refused(f"handed in by {learner}, not {name.split('+')[0]}")
+                    _stage_one(own, name, staged, None)
+                except Refused as why:
+                    refused.append(f"{name}: {why}")
+    return root, refused, sorted(unchecked)
+
+
+def _uid_of(name: str) -> int | None:
+    """The uid of the learner account ``name``, if this machine has one (a system account is none)."""
+    try:
+        uid = pwd.getpwnam(name).pw_uid
+    except KeyError:
+        return None
+    return uid if uid >= FIRST_LEARNER_UID else None
+
+
+def _require_teachers(folder: Path) -> None:
+    """``folder`` must be the teacher's: not a link, owned by this user or root, writable by nobody else (a
+    learner could otherwise put a course folder of their own in its place)."""
+    st = folder.lstat()
+    if stat.S_ISLNK(st.st_mode) or st.st_uid not in (0, os.geteuid()) or st.st_mode & 0o022:
+        raise RuntimeError(
+            f"{folder} is not the teacher's (a link, or owned or writable by someone else): not graded; "
+            "release the assignment again with nbgrader, or make it the teacher's and writable by them alone"
+        )
+
+
+def _stage_one(folder: Path, name: str, staged: Path, owner: int | None) -> None:
+    """Copy submission ``name`` of ``folder`` into ``staged``, refusing it (:class:`Refused`) where it fails a
+    rule; ``owner``: the uid that must own it, if known."""
+    from nbgrader.utils import parse_utc
+
+    parts = name.split("+")
+    if len(parts) < 3:
+        raise Refused("not a submission's name")
+    try:
+        parse_utc(parts[2])
+    except Exception as exc:  # noqa: BLE001 - any failure to read it would stop nbgrader collect
+        raise Refused("its time cannot be read") from exc
+    parent = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        try:
+            fd = os.open(name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW, dir_fd=parent)
+        except OSError as exc:
+            raise Refused("not a folder") from exc
+        try:
+            if owner is not None and (got := os.fstat(fd).st_uid) != owner:
+                raise Refused(f"handed in by {_user_name(got)}, not {parts[0]}")
+            dest = staged / name
+            dest.mkdir(mode=0o700)
+            try:
+                _copy(fd, dest, [MAX_BYTES])
+            except Refused:
+                shutil.rmtree(dest)
+                raise
+        finally:
+            os.close(fd)
+    finally:
+        os.close(parent)
+
+
+def _user_name(uid: int) -> str:
+    try:
+        return pwd.getpwuid(uid).pw_name
+    except KeyError:
+        return f"uid {uid}"
+
+
+def _copy(src_fd: int, dest: Path, left: list[int]) -> None:
+    """Copy the folder open as ``src_fd`` into ``dest``: folders and regular files only, each opened relative
+    to its folder without following a link, so nothing the learner changes meanwhile leads outside it."""
+    for entry in os.scandir(src_fd):
+        st = os.stat(entry.name, dir_fd=src_fd, follow_symlinks=False)
+        if stat.S_ISDIR(st.st_mode):
+            fd = os.open(entry.name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW, dir_fd=src_fd)
+            try:
+                (dest / entry.name).mkdir(mode=0o700)
+                _copy(fd, dest / entry.name, left)
+            finally:
+                os.close(fd)
+        elif stat.S_ISREG(st.st_mode):
+            try:
+                fd = os.open(entry.name, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK, dir_fd=src_fd)
+            except OSError as exc:
+                raise Refused(f"holds {entry.name!r}, which could not be opened as a file") from exc
+            try:
+                if not stat.S_ISREG(os.fstat(fd).st_mode):
+                    raise Refused(f"holds {entry.name!r}, which is no regular file")
+                with open(dest / entry.name, "wb") as out, os.fdopen(os.dup(fd), "rb") as data:
+                    while chunk := data.read(1 << 20):
+                        left[0] -= len(chunk)
+                        if left[0] < 0:
+                            raise Refused(f"larger than {MAX_BYTES // 1024**2} MiB")
+                        out.write(chunk)
+            finally:
+                os.close(fd)
+        else:
+            raise Refused(f"holds {entry.name!r}, a link or a special file")
