@@ -7,7 +7,9 @@ is given, at the exchange's own paths (so the hub's ``nbgrader_config.py`` for l
 
 - ``outbound/`` (the released assignments) and ``feedback/``, read only;
 - as ``inbound/``, the host's ``inbound-by-learner/NAME/``, NAME being the hub's name for that learner, which
-  the learner cannot change.
+  the learner cannot change;
+- all under an exchange root of the learner's own (``container-roots/NAME/``), as nbgrader asks for one its
+  user can write.
 
 ``make grade`` stages those with the rest, refusing a submission whose name is not its folder's
 (``course/submissions.py``).  The hub's thread calls :func:`give_learner_their_exchange` (the pre-spawn hook).
@@ -21,6 +23,7 @@ from pathlib import Path
 
 COURSE_ID = "ros-tank-tutorial"
 BY_LEARNER = "inbound-by-learner"  # course/submissions.py reads it too
+ROOTS = "container-roots"  # each learner's exchange root, under which the folders above are mounted
 JOVYAN = 1000  # the image's user (course/containers/Containerfile)
 
 
@@ -33,11 +36,16 @@ def give_learner_their_exchange(spawner, exchange: Path, learner_config: Path) -
     (course / "feedback").chmod(0o711)  # as nbgrader makes it: a learner reads their own feedback, lists none
     (course / BY_LEARNER).mkdir(mode=0o711, exist_ok=True)  # entered, never listed, by the containers' user
     own = course / BY_LEARNER / name
-    own.mkdir(mode=0o700, exist_ok=True)
-    os.chown(own, JOVYAN, JOVYAN)
+    # nbgrader asks for an exchange root its user can write: one of the learner's own, under the rest
+    (course / ROOTS).mkdir(mode=0o711, exist_ok=True)
+    root = course / ROOTS / name
+    for folder in (own, root):
+        folder.mkdir(mode=0o700, exist_ok=True)
+        os.chown(folder, JOVYAN, JOVYAN)
     spawner.volumes = {
         **spawner.volumes,
         str(learner_config / "nbgrader_config.py"): {"bind": "/etc/jupyter/nbgrader_config.py", "mode": "ro"},
+        str(root): {"bind": str(exchange), "mode": "rw"},
         str(course / "outbound"): {"bind": str(course / "outbound"), "mode": "ro"},
         str(course / "feedback"): {"bind": str(course / "feedback"), "mode": "ro"},
         str(own): {"bind": str(course / "inbound"), "mode": "rw"},
