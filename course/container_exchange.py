@@ -32,6 +32,7 @@ def give_learner_their_exchange(spawner, exchange: Path, learner_config: Path) -
     course = exchange / COURSE_ID
     name = spawner.user.name
     (course / "outbound").mkdir(mode=0o755, parents=True, exist_ok=True)
+    course.chmod(0o755)  # the teacher's alone to write, whatever the hub's umask (course/submissions.py checks)
     (course / "feedback").mkdir(exist_ok=True)
     (course / "feedback").chmod(0o711)  # as nbgrader makes it: a learner reads their own feedback, lists none
     (course / BY_LEARNER).mkdir(mode=0o711, exist_ok=True)  # entered, never listed, by the containers' user

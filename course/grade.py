@@ -99,10 +99,12 @@ def stage_submissions(course: Path) -> tuple[Path, list[str], list[str]]:
         (the staged exchange's root, which ``nbgrader collect`` reads; one line per refused submission; the
         names whose author cannot be told)
     """
+    from nbgrader.coursedir import CourseDirectory
     from traitlets.config.loader import PyFileConfigLoader
 
     config = PyFileConfigLoader("nbgrader_config.py", path=str(course)).load_config()
-    return stage(Path(config.Exchange.root) / config.CourseDirectory.course_id, course)
+    limit = 1000 * CourseDirectory(config=config).max_dir_size  # as nbgrader's collect computes it
+    return stage(Path(config.Exchange.root) / config.CourseDirectory.course_id, course, limit)
 
 
 def learners(course: Path, assignment: str) -> list[str]:
@@ -147,7 +149,9 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
         course_seed(course)  # made once, before the worker threads read it
     for assignment in assignments:
         if collect:
-            nbgrader(course, "collect", assignment, "--update", f"--Exchange.root={staged}")
+            # the staged copies are the teacher's: nbgrader's owner check would warn of every one
+            nbgrader(course, "collect", assignment, "--update", f"--Exchange.root={staged}",
+                     "--ExchangeCollect.check_owner=False")  # fmt: skip
         who = learners(course, assignment)
         calls, checks = test_calls(course, assignment) if boxes else ([], [])  # the seal's, for every learner
 

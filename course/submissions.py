@@ -10,12 +10,13 @@ accepts into a folder of the course that only the teacher can write (``staged-ex
 reads that copy:
 
 - the copy holds folders and regular files only, opened without following any link (a submission holding a
-  link or a special file is refused), at most ``MAX_BYTES``;
+  link or a special file is refused), no larger than nbgrader allows; its ``timestamp.txt`` the time in its name;
 - where learners are Unix users of this machine (the hub's ``users`` spawner), the submission's folder must be
   owned by the user of the name it bears;
 - in containers, where every learner is uid 1000, each learner hands in to a folder of their own that the hub
   named (``inbound-by-learner/NAME``, :mod:`container_exchange`): a submission in it must bear that name;
-- its time must be one nbgrader can read (one that is not would stop ``collect`` for the whole class).
+- its name must read the same as nbgrader reads it, with a time nbgrader can read (one that is not would stop
+  ``collect`` for the whole class); one that cannot be copied (too deep, changed while copied) is refused.
 
 Where every learner is one user (the trial's spawner) and the name is no account of this machine, who handed
 it in cannot be told: the submission is staged, and its name reported.  Nothing in the exchange is moved or
@@ -32,7 +33,7 @@ from pathlib import Path
 
 STAGED = "staged-exchange"
 BY_LEARNER = "inbound-by-learner"  # the containers' inbound folders (course/container_exchange.py)
-MAX_BYTES = 100 * 1024**2  # nbgrader's own default limit of a submission (max_dir_size)
+MAX_BYTES = 100_000 * 1000  # nbgrader's own default limit of a submission (1000 * max_dir_size, in bytes)
 FIRST_LEARNER_UID = 1000  # below: system accounts (Debian's), never a learner
 
 
@@ -40,9 +41,10 @@ class Refused(Exception):
     """A submission not staged; the message says why."""
 
 
-def stage(exchange_course: Path, course: Path) -> tuple[Path, list[str], list[str]]:
+def stage(exchange_course: Path, course: Path, max_bytes: int = MAX_BYTES) -> tuple[Path, list[str], list[str]]:
     """Copy the submissions of ``exchange_course`` (the exchange's folder of this course) that pass into
-    ``course/staged-exchange/<course id>/inbound``.
+    ``course/staged-exchange/<course id>/inbound``; ``max_bytes``: the course's limit of one (nbgrader's
+    ``1000 * max_dir_size``: ``collect`` stops for the whole class on a larger one).
 
     Returns:
         (the staged exchange's root, for ``nbgrader collect --Exchange.root``; one line per refused
@@ -64,7 +66,7 @@ def stage(exchange_course: Path, course: Path) -> tuple[Path, list[str], list[st
             learner = name.split("+")[0]
             uid = _uid_of(learner)
             try:
-                _stage_one(inbound, name, staged, uid)
+                _stage_one(inbound, name, staged, uid, max_bytes)
             except Refused as why:
                 refused.append(f"{name}: {why}")
             else:
@@ -80,9 +82,10 @@ def stage(exchange_course: Path, course: Path) -> tuple[Path, list[str], list[st
                 continue
             for name in sorted(os.listdir(own)):
                 try:
-                    if name.split("+")[0] != learner:
-                        raise Refused(f"handed in by {learner}, not {name.split('+')[0]}")
-                    _stage_one(own, name, staged, None)
+                    named = _parts(name)[0]
+                    if named != learner:
+                        raise Refused(f"handed in by {learner}, not {named}")
+                    _stage_one(own, name, staged, None, max_bytes)
                 except Refused as why:
                     refused.append(f"{name}: {why}")
     return root, refused, sorted(unchecked)
@@ -108,18 +111,26 @@ def _require_teachers(folder: Path) -> None:
         )
 
 
-def _stage_one(folder: Path, name: str, staged: Path, owner: int | None) -> None:
-    """Copy submission ``name`` of ``folder`` into ``staged``, refusing it (:class:`Refused`) where it fails a
-    rule; ``owner``: the uid that must own it, if known."""
+def _parts(name: str) -> list[str]:
+    """NAME, ASSIGNMENT, TIME (and nbgrader's random part) of a submission's folder name, read as nbgrader's
+    ``collect`` reads them (``rsplit("+", 3)``); :class:`Refused` when the two readings could differ."""
     from nbgrader.utils import parse_utc
 
     parts = name.split("+")
-    if len(parts) < 3:
+    if len(parts) not in (3, 4):
         raise Refused("not a submission's name")
     try:
         parse_utc(parts[2])
     except Exception as exc:  # noqa: BLE001 - any failure to read it would stop nbgrader collect
         raise Refused("its time cannot be read") from exc
+    return parts
+
+
+def _stage_one(folder: Path, name: str, staged: Path, owner: int | None, max_bytes: int) -> None:
+    """Copy submission ``name`` of ``folder`` into ``staged``, refusing it (:class:`Refused`) where it fails a
+    rule; ``owner``: the uid that must own it, if known.  Its ``timestamp.txt`` is the time in its name (one
+    nbgrader cannot read would stop later collections)."""
+    parts = _parts(name)
     parent = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
     try:
         try:
@@ -132,10 +143,13 @@ def _stage_one(folder: Path, name: str, staged: Path, owner: int | None) -> None
             dest = staged / name
             dest.mkdir(mode=0o700)
             try:
-                _copy(fd, dest, [MAX_BYTES])
-            except Refused:
-                shutil.rmtree(dest)
-                raise
+                _copy(fd, dest, [max_bytes])
+                (dest / "timestamp.txt").write_text(parts[2])
+            except (Refused, OSError, RecursionError) as exc:
+                shutil.rmtree(dest, ignore_errors=True)
+                if isinstance(exc, Refused):
+                    raise
+                raise Refused(f"could not be copied ({type(exc).__name__})") from exc
         finally:
             os.close(fd)
     finally:
@@ -173,7 +187,7 @@ def _copy(src_fd: int, dest: Path, left: list[int]) -> None:
                     while chunk := data.read(1 << 20):
                         left[0] -= len(chunk)
                         if left[0] < 0:
-                            raise Refused(f"larger than {MAX_BYTES // 1024**2} MiB")
+                            raise Refused("larger than the course allows (nbgrader's max_dir_size)")
                         out.write(chunk)
             finally:
                 os.close(fd)

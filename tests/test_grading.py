@@ -351,16 +351,45 @@ def test_a_submission_holding_a_link_a_special_file_or_an_unreadable_time_is_ref
     os.mkfifo(inbound / f"learner-d+hello+{STAMP}+d" / "hello.ipynb")  # a pipe: reading it would never end
     (inbound / "learner-e+hello+yesterday+e").mkdir()
     (inbound / "learner-f").mkdir()
+    (inbound / f"learner-g+hello+{STAMP}+x+y").mkdir()  # nbgrader would read its time as "x": collect would stop
+    deep = inbound / f"learner-h+hello+{STAMP}+h"
+    deep.mkdir()
+    fd = os.open(deep, os.O_RDONLY)
+    for _ in range(17):  # a copy path past the 4096 bytes a path may have (made a folder at a time)
+        os.mkdir("d" * 250, dir_fd=fd)
+        fd, parent = os.open("d" * 250, os.O_RDONLY, dir_fd=fd), fd
+        os.close(parent)
+    os.close(fd)
+    (inbound / good / "timestamp.txt").write_text("soon")  # would stop every later collection
     root, refused, _ = grade.stage_submissions(course)
     assert staged_names(root) == [good]
-    assert (root / "ros-tank-tutorial" / "inbound" / good / "sub" / "hello.ipynb").read_text() == "mine"
+    copied = root / "ros-tank-tutorial" / "inbound" / good
+    assert (copied / "sub" / "hello.ipynb").read_text() == "mine"
+    assert (copied / "timestamp.txt").read_text() == STAMP  # the time in its name
     assert refused == [
         f"learner-b+hello+{STAMP}+b: not a folder",
         f"learner-c+hello+{STAMP}+c: holds 'hello.ipynb', a link or a special file",
         f"learner-d+hello+{STAMP}+d: holds 'hello.ipynb', a link or a special file",
         "learner-e+hello+yesterday+e: its time cannot be read",
         "learner-f: not a submission's name",
+        f"learner-g+hello+{STAMP}+x+y: not a submission's name",
+        f"learner-h+hello+{STAMP}+h: could not be copied (OSError)",
     ], refused
+    assert list((root / "ros-tank-tutorial" / "inbound").glob("learner-h*")) == []  # no part of it left
+
+
+def test_a_submission_larger_than_the_course_allows_is_refused(tmp_path):
+    """nbgrader's collect stops for the whole class on a submission over its limit: staging refuses it alone."""
+    exchange, course = exchange_and_course(tmp_path)
+    with open(course / "nbgrader_config.py", "a") as config:
+        config.write("c.CourseDirectory.max_dir_size = 1  # kB\n")
+    (exchange / "inbound" / f"learner-a+hello+{STAMP}+a").mkdir(parents=True)
+    (exchange / "inbound" / f"learner-a+hello+{STAMP}+a" / "big.bin").write_bytes(b"x" * 1001)
+    (exchange / "inbound" / f"learner-b+hello+{STAMP}+b").mkdir()
+    (exchange / "inbound" / f"learner-b+hello+{STAMP}+b" / "small.bin").write_bytes(b"x" * 900)
+    root, refused, _ = grade.stage_submissions(course)
+    assert refused == [f"learner-a+hello+{STAMP}+a: larger than the course allows (nbgrader's max_dir_size)"]
+    assert staged_names(root) == [f"learner-b+hello+{STAMP}+b"]
 
 
 def test_a_submission_handed_in_from_a_container_under_another_name_is_refused(tmp_path):
