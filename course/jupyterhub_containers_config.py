@@ -31,8 +31,8 @@ c.JupyterHub.hub_connect_ip = GATEWAY
 
 from container_exchange import give_learner_their_exchange  # noqa: E402 - course/ is on the path: the base's
 from dockerspawner import DockerSpawner  # noqa: E402
-from domains import hub_state  # noqa: E402
 from idle_stops import remembering_last_use  # noqa: E402 - course/ is on the path: the base put it there
+from traitlets.config.loader import PyFileConfigLoader  # noqa: E402
 
 c.JupyterHub.spawner_class = remembering_last_use(DockerSpawner)
 c.DockerSpawner.image = os.environ.get("RTT_HUB_IMAGE", "localhost/ros-tank-tutorial:learner")
@@ -45,10 +45,10 @@ c.DockerSpawner.extra_host_config = {"pids_limit": int(os.environ.get("RTT_HUB_P
 c.Spawner.cmd = ["jupyterhub-singleuser"]  # the image's own environment, not this machine's
 c.Spawner.args = []
 c.Spawner.ip = "0.0.0.0"  # inside the container: its own network namespace, on the containers' network
-# nbgrader's exchange, where the base's learners' configuration says it is (RTT_NBGRADER_EXCHANGE, else the
-# hub's state folder's), with an inbound folder per learner (course/container_exchange.py).
-EXCHANGE = Path(os.environ.get("RTT_NBGRADER_EXCHANGE", hub_state() / "exchange"))
-LEARNER_CONFIG = hub_state() / "learner_jupyter"  # the base's: its nbgrader_config.py, for the learners
+# nbgrader's exchange, where the base's configuration for the learners (its folder, before the environment
+# below drops it) says it is, with an inbound folder per learner (course/container_exchange.py).
+LEARNER_CONFIG = Path(c.Spawner.environment["JUPYTER_CONFIG_PATH"])
+EXCHANGE = Path(PyFileConfigLoader("nbgrader_config.py", path=str(LEARNER_CONFIG)).load_config().Exchange.root)
 
 
 def prepare_learner(spawner):

@@ -345,6 +345,30 @@ def submit_as(name: str) -> str:
     )
 
 
+def teacher_course(folder: Path, exchange_root: Path) -> Path:
+    """``folder``, made: a teacher's nbgrader course of this class, whose exchange is ``exchange_root``."""
+    folder.mkdir()
+    (folder / "nbgrader_config.py").write_text(
+        "c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\n"
+        f"c.Exchange.root = {str(exchange_root)!r}\n"
+    )
+    return folder
+
+
+def grading_leaves_out_the_forgery(teacher: Path, exchange_root: Path, forger: str, named: str) -> None:
+    """The teacher's grading (course/grade.py) stages ``forger``'s and ``named``'s own submissions and leaves
+    out the one ``forger`` handed in under ``named``'s name."""
+    if str(ROOT / "course") not in sys.path:
+        sys.path.insert(0, str(ROOT / "course"))
+    import grade  # course/ is not a package
+
+    staged, refused, unchecked = grade.stage_submissions(teacher_course(teacher, exchange_root))
+    assert len(refused) == 1 and refused[0].endswith(f": handed in by {forger}, not {named}"), refused
+    assert unchecked == []
+    inbound = staged / "ros-tank-tutorial" / "inbound"
+    assert sorted(p.name.split("+")[0] for p in inbound.iterdir()) == sorted([forger, named])
+
+
 def open_live_notebook(browser, hub_url: str, name: str):
     """A page of a new browser context (cookies of its own): ``name`` logs in through the hub's form and runs
     the first cell of ``live.ipynb`` in their home (a live view: ``tests.lab_browser.step2_notebook``)."""

@@ -284,13 +284,11 @@ def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
 def exchange_and_course(tmp_path: Path) -> tuple[Path, Path]:
     """An exchange with this course's folder (the teacher's, as nbgrader's release makes it) and a course
     whose nbgrader configuration names it."""
-    exchange, course = tmp_path / "exchange", tmp_path / "course"
+    from hub import teacher_course
+
+    exchange = tmp_path / "exchange"
     (exchange / "ros-tank-tutorial").mkdir(parents=True, mode=0o755)
-    course.mkdir()
-    (course / "nbgrader_config.py").write_text(
-        f"c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\nc.Exchange.root = {str(exchange)!r}\n"
-    )
-    return exchange / "ros-tank-tutorial", course
+    return exchange / "ros-tank-tutorial", teacher_course(tmp_path / "course", exchange)
 
 
 def staged_names(root: Path) -> list[str]:

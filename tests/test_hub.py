@@ -24,7 +24,6 @@ from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "course"))
 
-import grade  # noqa: E402 - course/ is not a package
 from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
 from hub import (  # noqa: E402
     PASSWORD,
@@ -32,6 +31,7 @@ from hub import (  # noqa: E402
     Hub,
     KernelDied,
     Learner,
+    grading_leaves_out_the_forgery,
     open_live_notebook,
     require_live_view_draws,
     submit_as,
@@ -440,17 +440,7 @@ def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environme
         # teacher's grading leaves A's out and stages B's (course/submissions.py).
         both_submit_under_their_own_names(hub, [a, b])
         assert a.run(submit_as(b.name)).strip() == "submitted"
-        teacher = tmp_path / "teacher"
-        teacher.mkdir()
-        (teacher / "nbgrader_config.py").write_text(
-            "c = get_config()\nc.CourseDirectory.course_id = 'ros-tank-tutorial'\n"
-            f"c.Exchange.root = {str(hub_state(hub) / 'exchange')!r}\n"
-        )
-        staged, refused, unchecked = grade.stage_submissions(teacher)
-        assert len(refused) == 1 and refused[0].endswith(f": handed in by {a.name}, not {b.name}"), refused
-        assert unchecked == []
-        inbound = staged / "ros-tank-tutorial" / "inbound"
-        assert sorted(p.name.split("+")[0] for p in inbound.iterdir()) == sorted([a.name, b.name])
+        grading_leaves_out_the_forgery(tmp_path / "teacher", hub_state(hub) / "exchange", a.name, b.name)
     finally:
         hub.close()
 
