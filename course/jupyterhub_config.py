@@ -129,6 +129,21 @@ c.Spawner.environment = {
 EXCHANGE = Path(os.environ.get("RTT_NBGRADER_EXCHANGE", STATE / "exchange"))
 EXCHANGE.mkdir(parents=True, exist_ok=True)
 EXCHANGE.chmod(0o1777)  # every learner writes their submissions into it; only its owner renames what is in it
+# The course's folder in it is made now, the hub's (the teacher's), before any learner can: one a learner made
+# first would be theirs, and grading refuses a course folder that is not the teacher's (course/submissions.py).
+COURSE_EXCHANGE = EXCHANGE / "ros-tank-tutorial"
+try:
+    COURSE_EXCHANGE.mkdir(mode=0o700)  # closed while it is made: nobody puts a folder in it meanwhile
+    COURSE_EXCHANGE.chmod(0o755)  # as nbgrader's release makes it, whatever the umask
+except FileExistsError:
+    pass
+_made = COURSE_EXCHANGE.lstat()
+if not stat.S_ISDIR(_made.st_mode) or _made.st_uid != os.geteuid() or _made.st_mode & 0o022:
+    raise SystemExit(
+        f"{COURSE_EXCHANGE} is not the hub's (a link, or someone else's, or writable by others): a learner may have "
+        "made it before the course was released. Move it away (its inbound holds any submissions), then start "
+        "the hub again."
+    )
 LEARNER_CONFIG = STATE / "learner_jupyter"
 (LEARNER_CONFIG / "labconfig").mkdir(parents=True, exist_ok=True)
 (LEARNER_CONFIG / "nbgrader_config.py").write_text(

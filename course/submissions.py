@@ -143,7 +143,7 @@ def _stage_one(folder: Path, name: str, staged: Path, owner: int | None, max_byt
             dest = staged / name
             dest.mkdir(mode=0o700)
             try:
-                _copy(fd, dest, [max_bytes])
+                _copy(fd, dest, [max_bytes], owner)
                 (dest / "timestamp.txt").write_text(parts[2])
             except (Refused, OSError, RecursionError) as exc:
                 shutil.rmtree(dest, ignore_errors=True)
@@ -163,16 +163,18 @@ def _user_name(uid: int) -> str:
         return f"uid {uid}"
 
 
-def _copy(src_fd: int, dest: Path, left: list[int]) -> None:
+def _copy(src_fd: int, dest: Path, left: list[int], owner: int | None) -> None:
     """Copy the folder open as ``src_fd`` into ``dest``: folders and regular files only, each opened relative
-    to its folder without following a link, so nothing the learner changes meanwhile leads outside it."""
+    to its folder without following a link, so nothing the learner changes meanwhile leads outside it.  A
+    file that is not ``owner``'s (when known) is refused too, and where no owner is known, a file with a
+    second name (a hard link): either may be someone else's work."""
     for entry in os.scandir(src_fd):
         st = os.stat(entry.name, dir_fd=src_fd, follow_symlinks=False)
         if stat.S_ISDIR(st.st_mode):
             fd = os.open(entry.name, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW, dir_fd=src_fd)
             try:
                 (dest / entry.name).mkdir(mode=0o700)
-                _copy(fd, dest / entry.name, left)
+                _copy(fd, dest / entry.name, left, owner)
             finally:
                 os.close(fd)
         elif stat.S_ISREG(st.st_mode):
@@ -181,8 +183,13 @@ def _copy(src_fd: int, dest: Path, left: list[int]) -> None:
             except OSError as exc:
                 raise Refused(f"holds {entry.name!r}, which could not be opened as a file") from exc
             try:
-                if not stat.S_ISREG(os.fstat(fd).st_mode):
+                got = os.fstat(fd)
+                if not stat.S_ISREG(got.st_mode):
                     raise Refused(f"holds {entry.name!r}, which is no regular file")
+                if owner is not None and got.st_uid != owner:
+                    raise Refused(f"holds {entry.name!r}, which is {_user_name(got.st_uid)}'s")
+                if owner is None and got.st_nlink != 1:  # another name of a file elsewhere: whose, unknown
+                    raise Refused(f"holds {entry.name!r}, a file with another name too (a hard link)")
                 with open(dest / entry.name, "wb") as out, os.fdopen(os.dup(fd), "rb") as data:
                     while chunk := data.read(1 << 20):
                         left[0] -= len(chunk)

@@ -62,9 +62,18 @@ class Hub:
         learners: the accounts allowed in.
         domains: the ROS domains to give out.
         extra_env: more of the hub's environment (``RTT_HUB_SPAWNER``, ``RTT_HUB_PYTHON``, ...).
+        jupyterhub: the hub's program, if not this environment's (another JupyterHub version).
     """
 
-    def __init__(self, state: Path, learners, domains, extra_env: dict | None = None, timeout: float = 60.0):
+    def __init__(
+        self,
+        state: Path,
+        learners,
+        domains,
+        extra_env: dict | None = None,
+        timeout: float = 60.0,
+        jupyterhub: str | None = None,
+    ):
         self.port = free_port_block()
         self.learners = list(learners)
         self.cgroups_left: list[str] = []  # learners' cgroups the hub's own stop did not remove (close)
@@ -83,7 +92,11 @@ class Hub:
         Path(state).mkdir(parents=True, exist_ok=True)
         self._log = open(self.log_path, "w")  # noqa: SIM115 - closed in close()
         self.proc = subprocess.Popen(
-            [str(Path(sys.executable).with_name("jupyterhub")), "-f", str(ROOT / "course" / "jupyterhub_config.py")],
+            [
+                jupyterhub or str(Path(sys.executable).with_name("jupyterhub")),
+                "-f",
+                str(ROOT / "course" / "jupyterhub_config.py"),
+            ],
             cwd=state,
             env=env,
             stdout=self._log,

@@ -151,6 +151,14 @@ print(json.dumps({{"domain": os.environ.get("ROS_DOMAIN_ID"), "rtf": summary["re
 """
 
 
+# A demo joystick started from the learner's kernel, left running while the test watches the views.
+JOY_IN_THE_BACKGROUND = """
+import subprocess
+subprocess.Popen(["rtt-joy", "--demo", "--duration", "20"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+print("driving")
+"""
+
+
 @contextlib.contextmanager
 def hub_on_containers(tmp_path: Path, learners: list[str]):
     """``make hub-containers``'s script on a free port, a network of this test's own and a state folder of its
@@ -209,7 +217,7 @@ def test_a_class_on_containers(tmp_path):
     from playwright.sync_api import sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
-    from tests.lab_browser import step2_notebook
+    from tests.lab_browser import changed, moving, step2_notebook, wait_for
 
     names = ["learner-a", "learner-b"]
     with hub_on_containers(tmp_path, names) as hub:
@@ -272,8 +280,20 @@ def test_a_class_on_containers(tmp_path):
         with sync_playwright() as pw:
             browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
             try:
+                pages = {}
                 for name in names:
-                    require_live_view_draws(open_live_notebook(browser, hub.url, name), name)
+                    pages[name] = open_live_notebook(browser, hub.url, name)
+                    require_live_view_draws(pages[name], name)
+                stats = json.loads(podman("stats", "--no-stream", "--format", "json").stdout or "[]")
+                for s in stats:  # the same work as make test-hub's figure for a learner's server (book/course.md)
+                    if s.get("name", "").startswith("jupyter-learner"):
+                        print(f"{s['name']}, Step 2 and its live view running: memory {s.get('mem_usage', '?')}")
+                # A's demo joystick, in A's container: A's view shows A's tank driving; B's tank stands still.
+                assert a.run(JOY_IN_THE_BACKGROUND).strip() == "driving"
+                moved = wait_for(pages["learner-a"], lambda: moving(pages["learner-a"]), "A's view moving", 30)
+                still = changed(pages["learner-b"])
+                print(f"pixels changed in 1 s: A's view {moved}, B's view {still}")
+                assert still < 200, still
             finally:
                 browser.close()
         log = hub.log.read_text()

@@ -16,7 +16,7 @@ import re
 import pytest
 from exercise_rules import HIDDEN_MISTAKES, HIDDEN_MODULES, RULES, VISIBLE_ONLY
 
-from conftest import ROOT
+from conftest import ROOT, hear_the_checks
 
 MODULES = {
     "01": "tank_controller",
@@ -177,6 +177,31 @@ MISTAKES = [
         "        if joint.limited and not low <= q <= high:\n            continue\n",
         "        if joint.limited:\n            q = min(max(q, joint.lower), joint.upper)\n",
         "(huge)",
+    ),
+    (  # within the tolerance, the limit applied in place of the value sent
+        "3.2",
+        "        if joint.limited and not low <= q <= high:\n            continue\n",
+        "        if joint.limited and not low <= q <= high:\n            continue\n"
+        "        if joint.limited:\n            q = min(max(q, joint.lower), joint.upper)\n",
+        "(past the limit a little)",
+    ),
+    (  # another model's message counted as refused, and applied all the same
+        "3.1",
+        '            self.rejected["wrong_model"] += 1\n            return None\n',
+        '            self.rejected["wrong_model"] += 1\n            self.apply(msg)\n            return None\n',
+        "(one of the tank's joints and one unknown)",
+    ),
+    (  # the base's fields dropped from summary()
+        "1.2",
+        '        return {**super().summary(), "shots": shots}\n',
+        '        return {"shots": shots}\n',
+        "summary() after one Joy",
+    ),
+    (  # the sticks stored twice per Joy
+        "1.2",
+        "        super().on_joy(msg)  # store the sticks, as before\n",
+        "        super().on_joy(msg)  # store the sticks, as before\n        super().on_joy(msg)\n",
+        "on_joy(a Joy with the left stick up)",
     ),
     # the outside read's nine, each a plausible mistake the checks let pass before
     (
@@ -500,7 +525,14 @@ MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize("number,right,wrong,caught_by", MISTAKES, ids=[f"{m[0]}-{k}" for k, m in enumerate(MISTAKES)])
+def mistake_id(mistake: tuple) -> str:
+    """A wrong answer's test id, from what it changes (not its place in the table, so a new row renames none)."""
+    import hashlib
+
+    return f"{mistake[0]}-{hashlib.sha256(repr(mistake[1:3]).encode()).hexdigest()[:8]}"
+
+
+@pytest.mark.parametrize("number,right,wrong,caught_by", MISTAKES, ids=[mistake_id(m) for m in MISTAKES])
 def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wrong, caught_by):
     ex = exercise(number)
     assert right in ex["solution"], f"the solution of {number} no longer has {right!r}: update this test"
@@ -528,6 +560,12 @@ def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wro
         ("8.2", "return 15.0, 70", "return 15.0", "camera_settings()"),
         ("8.2", "return 15.0, 70", "return 15.0, 70.5", "camera_settings()"),
         ("8.2", "return 15.0, 70", "return {'rate': 15.0, 'jpeg_quality': 70}", "camera_settings()"),
+        (
+            "3.2",
+            "    return applied\n",
+            "    return list(applied.items())\n",
+            "my_match(tank joints, ['TURRET_Y', 'TURRET_P'], [0.3, 0.2]) (in order)",
+        ),
     ],
 )
 def test_a_wrongly_shaped_answer_is_told_so_not_judged_on_a_value(ros, snapshot, number, right, wrong, function):
@@ -588,6 +626,46 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
     assert result.passed, str(result)
 
 
+@pytest.mark.parametrize(
+    "added",
+    [
+        "    def configure(self, config):\n        super().configure(config)\n\n",
+        "    def summary(self):\n        super().summary()\n\n",
+    ],
+    ids=["configure", "summary"],
+)
+def test_a_3_1_answer_that_forgets_a_return_is_told_what_it_gave_not_a_crash(ros, snapshot, added):
+    """An override of the lifecycle or the summary without its ``return``: the line says what came back."""
+    ex = exercise("3.1")
+    anchor = "    def update_joint_state(self, msg):\n"
+    assert anchor in ex["solution"], "the worked solution of 3.1 changed: update this test"
+    result = grade(ex, ex["stub"], ex["solution"].replace(anchor, added + anchor))
+    assert not result.passed and " raised " not in result.message, str(result)
+    assert str(result) == snapshot
+
+
+def test_what_both_threads_read_that_is_no_state_passes_the_lock_check(ros):
+    """Exercise 1.2's lock check watches state, not the class: a property that takes the lock, a method, or the
+    object's own dunder attributes, read by both threads outside the lock, are not a count left unlocked."""
+    ex = exercise("1.2")
+    both = "        if self.count < 0 or not self.label() or self.__class__ is None:\n            raise ValueError\n"
+    answer = (
+        ex["solution"]
+        .replace(LOCKED_COUNT, LOCKED_COUNT + both)
+        .replace(
+            LOCKED_SUMMARY,
+            "    @property\n    def count(self) -> int:\n        with self._lock:\n            return self.shots\n\n"
+            "    def label(self) -> str:\n        return 'shots'\n\n"
+            "    def summary(self) -> dict:\n"
+            + both
+            + "        return {**super().summary(), self.label(): self.count}\n",
+        )
+    )
+    assert answer.count("self.__class__") == 2, answer
+    result = grade(ex, ex["stub"], answer)
+    assert result.passed, str(result)
+
+
 def test_a_count_changed_in_place_outside_the_lock_fails_the_lock_check(ros):
     """No attribute is assigned when a container is changed in place: the reads of it are watched too."""
     ex = exercise("1.2")
@@ -635,20 +713,6 @@ def test_a_failed_line_names_its_subject_once_and_wraps_for_nbgrader():
     assert " ".join(line.strip() for line in lines) == str(result)
 
 
-HEARD: list = []  # what the grading kernel's seal would hear of the checks (an audit hook: one per process)
-
-
-def hear_the_checks() -> list:
-    """HEARD, emptied: from now on it gets each (event, args) of the checks' audit events for the seal."""
-    import sys
-
-    if not getattr(sys, "_rtt_test_hears_checks", False):
-        sys.addaudithook(lambda event, args: HEARD.append((event, args)) if event.startswith("rtt.") else None)
-        sys._rtt_test_hears_checks = True
-    HEARD.clear()
-    return HEARD
-
-
 def test_require_tells_the_seal_each_verdict_and_wraps_without_breaking_a_word(snapshot):
     """``require()`` says each verdict to the seal (the ``rtt.verdict`` audit event, passed or not) before it
     raises; its lines are indented after the first, and a word longer than a line (a path) stays whole."""
@@ -672,40 +736,6 @@ def test_require_tells_the_seal_each_verdict_and_wraps_without_breaking_a_word(s
     assert path in lines[1:] or f"  {path}" in lines, lines  # on a line of its own, whole
     assert all(line.startswith("  ") for line in lines[1:]), lines
     assert str(raised.value) == snapshot
-
-
-def test_a_value_of_a_class_that_compares_as_it_likes_is_refused_and_told_to_the_seal():
-    """same_numbers and same_value refuse a value whose class is not exactly a number type or the expected one,
-    and tell the seal (``rtt.suspect``) when that class is an answer's own with a comparison of its own."""
-    import numpy as np
-
-    from tutorial.exercises.grader import same_numbers, same_value
-
-    class AlwaysEqual:
-        def __eq__(self, other):
-            return True
-
-    class MyFloat(float):
-        pass
-
-    class AClassWhoseNameIsLongerThanFortyCharactersByFar(int):
-        pass
-
-    heard = hear_the_checks()
-    assert not same_numbers(AlwaysEqual(), 1.0) and not same_value(AlwaysEqual(), "a")
-    assert not same_numbers(MyFloat(1.0), 1.0) and not same_value(MyFloat(2.0), 2)
-    assert not same_value(AClassWhoseNameIsLongerThanFortyCharactersByFar(3), 3)
-    assert not same_numbers("1.0", 1.0) and not same_value("1", 1) and not same_numbers(None, 1.0)  # builtins: untold
-    assert not same_value(np.str_("a"), "a")  # NumPy's own: not told
-    assert same_numbers(np.float32(1.0), 1.0) and same_value(np.int64(2), 2) and same_value(True, True)
-    own = "a class of its own that compares as it likes"
-    assert [h for h in heard if h[0] == "rtt.suspect"] == [
-        ("rtt.suspect", (f"a AlwaysEqual, {own}",)),
-        ("rtt.suspect", (f"a AlwaysEqual, {own}",)),
-        ("rtt.suspect", (f"a MyFloat, {own}",)),
-        ("rtt.suspect", (f"a MyFloat, {own}",)),
-        ("rtt.suspect", (f"a AClassWhoseNameIsLongerThanFortyCharacte, {own}",)),
-    ], heard
 
 
 # ---- hidden cases (grader.hidden_random): drawn while grading, by the statement's rules ----
@@ -781,6 +811,7 @@ FIRST_HIDDEN_MISTAKES = [m for m in {m[0]: m for m in reversed(HIDDEN_MISTAKES)}
 @pytest.mark.parametrize(
     "number, right, wrong, caught_by",
     [m if m in FIRST_HIDDEN_MISTAKES else pytest.param(*m, marks=pytest.mark.more) for m in HIDDEN_MISTAKES],
+    ids=[mistake_id(m) for m in HIDDEN_MISTAKES],
 )
 def test_a_mistake_only_the_hidden_cases_catch_fails_on_its_case(
     ros, grading_seed, snapshot, number, right, wrong, caught_by
@@ -873,10 +904,130 @@ def test_the_hidden_stamps_of_5_2_are_never_negative_and_exactly_a_second_back_o
     assert boundaries > 200, boundaries  # the exact second is drawn in the random runs too
 
 
+@pytest.mark.parametrize("number", EXERCISES)
+def test_each_check_draws_its_hidden_cases_from_its_own_exercises_seed(ros, monkeypatch, number):
+    """A check asks for the random source of its own exercise, once: another's would repeat that one's draws."""
+    import importlib
+
+    ex = exercise(number)
+    asked: list = []
+    checks = importlib.import_module(f"tutorial.exercises.{ex['checks']}")
+    monkeypatch.setattr(checks, "hidden_random", asked.append)  # None: the visible cases alone
+    grade(ex, ex["stub"])
+    assert asked == [number]
+
+
+@pytest.mark.more  # the seed make test keeps is the worked solution's hidden-cases test's
+def test_the_worked_solution_of_3_1_passes_the_hidden_cases_of_many_seeds(ros, monkeypatch):
+    """Among them runs with no message refused: a count of 0 refusals is no ``wrong_model`` entry at all."""
+    import random
+
+    from tutorial.exercises import step3_viewer
+
+    ex = exercise("3.1")
+    for seed in range(4):
+        monkeypatch.setattr(step3_viewer, "hidden_random", lambda exercise, seed=seed: random.Random(f"{seed}"))
+        result = grade(ex, ex["stub"], ex["solution"])
+        assert result.passed and "8 hidden ones" in result.message, str(result)
+
+
+def test_the_hidden_cases_of_1_1_follow_the_statements_rules():
+    """Each hidden case of 1.1 expects what the statement's rules give for its axes (a missing or non-finite D-pad
+    axis counts as 0; the sticks never count), and together they draw every D-pad direction, every stick across
+    its range, NaN and both infinities on either D-pad axis, and Joys of every length too short for it."""
+    import math
+    import random
+    from collections import Counter
+
+    from tutorial.exercises.step1_tank_controller import _random_dpad
+    from tutorial.interfaces import joy
+
+    def rule(axes) -> tuple[float, float]:  # the statement's rule, written again here
+        dh, dv = (axes[i] if len(axes) > i and math.isfinite(axes[i]) else 0.0 for i in (joy.DPAD_H, joy.DPAD_V))
+        return dv - 0.5 * dh, dv + 0.5 * dh
+
+    rng = random.Random("the rules of 1.1")
+    labels, directions, bad, short = Counter(), Counter(), Counter(), Counter()
+    sticks: list[float] = []
+    for _ in range(4000):
+        label, axes, expected = _random_dpad(rng)
+        assert expected == rule(axes), (label, axes, expected)
+        labels[label] += 1
+        if len(axes) <= joy.DPAD_H:
+            short[len(axes)] += 1
+            continue
+        sticks += [a for i, a in enumerate(axes) if i not in (joy.DPAD_H, joy.DPAD_V)]
+        for i in (joy.DPAD_H, joy.DPAD_V):
+            if math.isfinite(axes[i]):
+                directions[(i, axes[i])] += 1
+            else:
+                bad[(i, repr(axes[i]))] += 1
+    assert set(directions) == {(i, d) for i in (joy.DPAD_H, joy.DPAD_V) for d in (-1.0, 0.0, 1.0)}, directions
+    assert set(bad) == {(i, b) for i in (joy.DPAD_H, joy.DPAD_V) for b in ("nan", "inf", "-inf")}, bad
+    assert sorted(short) == list(range(joy.DPAD_H + 1)), short
+    assert -1.0 <= min(sticks) < -0.99 and 0.99 < max(sticks) <= 1.0, (min(sticks), max(sticks))  # all of -1 to 1
+    share = {k: n / 4000 for k, n in labels.items()}
+    assert 0.23 < share["a D-pad axis NaN or infinite, the other pressed"] < 0.27, share
+    assert 0.13 < share["a Joy too short for the D-pad's axes"] < 0.17, share  # a fifth of the other three quarters
+
+
+def test_the_hidden_sequences_of_1_2_follow_the_statements_rules():
+    """Each hidden sequence of 1.2 is 3 to 39 Joys, each A, B, both, released, A alone in a short Joy, or no
+    buttons; together they draw every length and every kind, A and released about twice as often as the rest."""
+    import random
+    from collections import Counter
+
+    from tutorial.exercises.step1_tank_controller import _random_presses
+
+    rng = random.Random("the rules of 1.2")
+    lengths, kinds = Counter(), Counter()
+    for _ in range(2000):
+        presses = _random_presses(rng)
+        lengths[len(presses)] += 1
+        kinds.update(tuple(p) for p in presses)
+    assert sorted(lengths) == list(range(3, 40)), lengths
+    a, b, none = (1, 0, 0, 0, 0, 0, 0, 0), (0, 1, 0, 0, 0, 0, 0, 0), (0,) * 8
+    assert set(kinds) == {a, b, none, (1,), (), (1, 1, 0, 0, 0, 0, 0, 0)}, kinds
+    share = {k: n / sum(kinds.values()) for k, n in kinds.items()}
+    assert all(0.23 < share[k] < 0.27 for k in (a, none)) and all(
+        0.11 < share[k] < 0.14 for k in kinds if k not in (a, none)
+    )
+
+
+def test_the_hidden_runs_of_3_1_follow_the_statements_rules():
+    """Each hidden run of 3.1 is 1 to 4 messages, each of 0 to 3 distinct names all from one pool (the tank's,
+    the crane's, or the tank's with an unknown one), as many positions as names, in -0.1 to 0.7 or NaN."""
+    import math
+    import random
+    from collections import Counter
+
+    from tutorial.exercises.step3_viewer import _random_run
+
+    rng = random.Random("the rules of 3.1")
+    pools = ({"TURRET_Y", "TURRET_P"}, {"SLEW", "LUFF", "TROLLEY"}, {"TURRET_P", "GUN"})
+    lengths, sizes, names_seen, nans = Counter(), Counter(), Counter(), 0
+    finite: list[float] = []
+    for _ in range(2000):
+        run = _random_run(rng)
+        lengths[len(run)] += 1
+        for names, positions in run:
+            assert len(set(names)) == len(names) == len(positions) and any(set(names) <= p for p in pools), names
+            sizes[len(names)] += 1
+            names_seen.update(names)
+            nans += sum(math.isnan(q) for q in positions)
+            finite += [q for q in positions if not math.isnan(q)]
+    assert sorted(lengths) == [1, 2, 3, 4] and sorted(sizes) == [0, 1, 2, 3], (lengths, sizes)
+    assert 0.22 < sizes[0] / sum(sizes.values()) < 0.28, sizes  # 0 to 3 names drawn: none in a quarter of them
+    assert -0.1 <= min(finite) < -0.09 and 0.69 < max(finite) <= 0.7, (min(finite), max(finite))
+    assert set(names_seen) == set().union(*pools), names_seen
+    assert 0.4 < nans / sum(names_seen.values()) < 0.6  # about half of the positions NaN
+
+
 def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
     """Every hidden message of 3.2 is one the statement's rules describe, and together they try each rule: known,
     unknown and repeated names; a value in range, within the tolerance past the upper limit, past it below the
-    lower one (0.01 m for a slide, 0.05 rad for a hinge; an unlimited joint: within 10), non-finite or huge;
+    lower one (0.01 m for a slide, 0.05 rad for a hinge; an unlimited joint: all of -10 to 10), NaN, either
+    infinity or huge;
     every length up to five; sometimes a position short, sometimes a name."""
     import math
     import random
@@ -886,7 +1037,8 @@ def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
 
     rng = random.Random("the rules of 3.2")
     bodies = (_tank().joint_infos, _crane().joint_infos)
-    lengths, bands, foreign, short = Counter(), Counter(), Counter(), Counter()
+    lengths, bands, foreign, short, specials = Counter(), Counter(), Counter(), Counter(), Counter()
+    unlimited: list[float] = []  # the values drawn in range for an unlimited joint
     past = {"upper": [], "lower": []}  # how far past a limit, in tolerances
     own = repeated = picks = 0
     for _ in range(3000):
@@ -909,8 +1061,10 @@ def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
             low, high = (j.lower, j.upper) if j.limited else (-10.0, 10.0)
             if not math.isfinite(q) or q == 1e300:
                 band = "not finite, or huge"
+                specials[repr(q)] += 1
             elif low <= q <= high:
                 band = "in range"
+                unlimited += [] if j.limited else [q]
             elif high < q <= high + 0.9 * tol:
                 band = "within the tolerance past the upper limit"
                 past["upper"].append((q - high) / tol)
@@ -921,6 +1075,8 @@ def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
                 raise AssertionError(f"{q} for {name} ({j.kind}, {low}..{high}) follows no rule")
             bands[(j.kind, j.limited, band)] += 1
     assert sorted(lengths) == [0, 1, 2, 3, 4, 5], lengths
+    assert set(specials) == {"nan", "inf", "-inf", "1e+300"}, specials  # each kind of value no joint can take
+    assert min(unlimited) < -9 and max(unlimited) > 9, (min(unlimited), max(unlimited))  # all of -10 to 10
     # each band is drawn across its whole width: up to 0.9 tolerances past the upper limit, 1.1 to 3 below
     assert min(past["upper"]) < 0.05 and max(past["upper"]) > 0.85, past["upper"]
     assert min(past["lower"]) < 1.15 and max(past["lower"]) > 2.9, past["lower"]

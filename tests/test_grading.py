@@ -313,16 +313,22 @@ def test_a_submission_handed_in_under_another_learners_name_is_refused(tmp_path)
         "nobody+hello+2026-11-26 11:00:00.000000 UTC+def": 0,  # root's, under nobody's name, newer
         f"learner-x+hello+{STAMP}+ghi": me.pw_uid,  # no account of that name
         f"daemon+hello+{STAMP}+jkl": me.pw_uid,  # a system account's name: no learner, so not checked
+        f"nobody+hello+{STAMP}+mno": me.pw_uid,  # their folder, with root's file in it (a hard link, say)
     }
     for name, uid in handed.items():
         (inbound / name).mkdir()
         (inbound / name / "hello.ipynb").write_text(name)
         os.chown(inbound / name, uid, uid)
+        os.chown(inbound / name / "hello.ipynb", uid, uid)
+    os.chown(inbound / f"nobody+hello+{STAMP}+mno" / "hello.ipynb", 0, 0)
     root, refused, unchecked = grade.stage_submissions(course)
     forged = "nobody+hello+2026-11-26 11:00:00.000000 UTC+def"
-    assert refused == [f"{forged}: handed in by root, not nobody"], refused
+    assert refused == [
+        f"nobody+hello+{STAMP}+mno: holds 'hello.ipynb', which is root's",
+        f"{forged}: handed in by root, not nobody",
+    ], refused
     assert unchecked == ["daemon", "learner-x"]
-    assert staged_names(root) == sorted(set(handed) - {forged})
+    assert staged_names(root) == sorted(set(handed) - {forged, f"nobody+hello+{STAMP}+mno"})
     staged = root / "ros-tank-tutorial" / "inbound" / f"nobody+hello+{STAMP}+abc"
     assert (staged / "hello.ipynb").read_text() == f"nobody+hello+{STAMP}+abc" and staged.stat().st_uid == 0
     assert root.stat().st_mode & 0o077 == 0  # out of the learners' reach
@@ -331,7 +337,7 @@ def test_a_submission_handed_in_under_another_learners_name_is_refused(tmp_path)
 
 def test_a_submission_holding_a_link_a_special_file_or_an_unreadable_time_is_refused(tmp_path):
     """Grading copies a submission without following any link: one that holds a link (to another learner's
-    work, the teacher's solutions) or a special file is refused whole, as is one whose time nbgrader cannot
+    work, the teacher's solutions), a hard link or a special file is refused whole, as is one whose time nbgrader cannot
     read (which would stop the collection of the whole class)."""
     exchange, course = exchange_and_course(tmp_path)
     inbound = exchange / "inbound"
@@ -347,6 +353,8 @@ def test_a_submission_holding_a_link_a_special_file_or_an_unreadable_time_is_ref
     (inbound / f"learner-c+hello+{STAMP}+c" / "hello.ipynb").symlink_to(secret / "hello.ipynb")  # a link in it
     (inbound / f"learner-d+hello+{STAMP}+d").mkdir()
     os.mkfifo(inbound / f"learner-d+hello+{STAMP}+d" / "hello.ipynb")  # a pipe: reading it would never end
+    (inbound / f"learner-i+hello+{STAMP}+i").mkdir()
+    os.link(secret / "hello.ipynb", inbound / f"learner-i+hello+{STAMP}+i" / "hello.ipynb")  # a second name
     (inbound / "learner-e+hello+yesterday+e").mkdir()
     (inbound / "learner-f").mkdir()
     (inbound / f"learner-g+hello+{STAMP}+x+y").mkdir()  # nbgrader would read its time as "x": collect would stop
@@ -372,6 +380,7 @@ def test_a_submission_holding_a_link_a_special_file_or_an_unreadable_time_is_ref
         "learner-f: not a submission's name",
         f"learner-g+hello+{STAMP}+x+y: not a submission's name",
         f"learner-h+hello+{STAMP}+h: could not be copied (OSError)",
+        f"learner-i+hello+{STAMP}+i: holds 'hello.ipynb', a file with another name too (a hard link)",
     ], refused
     assert list((root / "ros-tank-tutorial" / "inbound").glob("learner-h*")) == []  # no part of it left
 

@@ -205,6 +205,8 @@ def both_submit_under_their_own_names(hub: Hub, learners: list[Learner]) -> None
     import nbformat
 
     course = hub_state(hub) / "exchange" / "ros-tank-tutorial"
+    made = course.lstat()  # by the hub before any learner could (a learner's would stop grading)
+    assert (made.st_uid, made.st_mode & 0o7777) == (os.geteuid(), 0o755)
     (course / "outbound" / "hello").mkdir(parents=True)
     (course / "inbound").mkdir(mode=0o733)  # as nbgrader's release makes it: learners write, only the teacher lists
     (course / "inbound").chmod(0o733)  # past the umask
@@ -290,6 +292,59 @@ def test_a_learner_the_book_cannot_hold_is_told_why_and_no_one_else_is_disturbed
     (tmp_path / "bad.json").write_text("[1, 2]")
     with pytest.raises(DomainError, match="not a book of ROS domains"):
         DomainBook(tmp_path / "bad.json").domain_for("ada")
+
+
+@pytest.mark.slow
+@pytest.mark.cross_process
+@pytest.mark.skipif(not os.environ.get("RTT_TEST_JUPYTERHUB"), reason="RTT_TEST_JUPYTERHUB names no other JupyterHub")
+def test_a_hub_of_the_charts_jupyterhub_version_serves_this_learners_server(tmp_path):
+    """Zero to JupyterHub's chart runs its own JupyterHub (5.5 for chart 4.x); the image's learner server is the
+    lock's: a learner logs in through that hub, runs code, and their live view draws in a browser (the OAuth
+    that JupyterHub warns a version mismatch may break).  RTT_TEST_JUPYTERHUB: that hub's ``jupyterhub``
+    (book/course.md says how to install it: the tests fetch nothing)."""
+    import subprocess
+
+    from playwright.sync_api import sync_playwright
+
+    from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
+    from tests.lab_browser import step2_notebook
+
+    other = os.environ["RTT_TEST_JUPYTERHUB"]
+    version = subprocess.run([other, "--version"], capture_output=True, text=True, check=True).stdout.strip()
+    hub = Hub(tmp_path / "hub", ["learner-a"], DOMAINS[:1], jupyterhub=other)
+    try:
+        a = Learner(hub, "learner-a")
+        assert a.log_in().status_code == 302, hub.log()[-2000:]
+        a.start_server()
+        ours = a.run("import jupyterhub\nprint(jupyterhub.__version__)").strip()
+        print(f"hub {version}, learner's server {ours}")
+        assert version.split(".")[0] != ours.split(".")[0], "not another major version: nothing tested"
+        step2_notebook(tmp_path / "live.ipynb")
+        content = json.loads((tmp_path / "live.ipynb").read_text())
+        r = a.api("PUT", "api/contents/live.ipynb", json={"type": "notebook", "format": "json", "content": content})
+        assert r.status_code in (200, 201), r.text[:500]
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+            try:
+                require_live_view_draws(open_live_notebook(browser, hub.url, "learner-a"), "learner-a")
+            finally:
+                browser.close()
+    finally:
+        hub.close()
+
+
+@pytest.mark.slow  # make test-hub: make test keeps the hub's one real case, which checks the folder the hub made
+@pytest.mark.cross_process
+@pytest.mark.skipif(os.geteuid() != 0, reason="a folder of another user's needs root")
+def test_a_hub_whose_course_folder_in_the_exchange_a_learner_made_first_does_not_start(tmp_path):
+    """A learner who made the course's folder in the exchange before the hub did would own it, and grading
+    would refuse the whole course (course/submissions.py): the hub makes it first, or says what to do."""
+    taken = tmp_path / "exchange" / "ros-tank-tutorial"
+    taken.mkdir(parents=True)
+    os.chown(taken, 4242, 4242)  # a learner's uid
+    with pytest.raises(RuntimeError, match=r"ros-tank-tutorial is not the hub's \(a link, or someone") as refused:
+        Hub(tmp_path, ["learner-a"], DOMAINS, timeout=30).close()  # (closed, should it start: the test fails)
+    assert "Move it away" in str(refused.value)  # without it, the hub makes its own (both_submit_under_...)
 
 
 @pytest.mark.unit
@@ -541,6 +596,14 @@ def cpu_used(learner: str) -> int:
     return int(Path(f"/sys/fs/cgroup/cpuacct/rtt-learner-{learner}/cpuacct.usage").read_text())
 
 
+def memory_used(learner: str) -> int:
+    """Bytes of memory the learner's server and all it started use, as ``podman stats`` counts a container's:
+    their memory cgroup's usage less its inactive file cache (course/limits.py)."""
+    cgroup = Path(f"/sys/fs/cgroup/memory/rtt-learner-{learner}")
+    stat = dict(line.split() for line in (cgroup / "memory.stat").read_text().splitlines())
+    return int((cgroup / "memory.usage_in_bytes").read_text()) - int(stat["total_inactive_file"])
+
+
 # Learner C's misbehaviours, one at a time, each stopping itself where the issue says.
 BUSY = """
 import subprocess, sys
@@ -690,6 +753,8 @@ def test_a_learner_who_left_is_culled_and_finds_their_work_again(tmp_path):
             try:
                 page = open_live_notebook(browser, hub.url, "learner-c")
                 require_live_view_draws(page, "learner-c")
+                # the same work as a learner's container's figure in make test-containers (book/course.md)
+                print(f"C's server, Step 2 and its live view running: memory {memory_used('learner-c') / 1e6:.0f} MB")
                 refused_page_says_why(browser, hub.url, "learner-d")
                 page.context.close()  # C leaves: the simulation and its view run on in C's kernel
             finally:

@@ -246,7 +246,7 @@ def _suspect(got) -> None:
 def show(value) -> str:
     """A short, stable text for a value in a message (floats rounded to 4 decimals)."""
     if isinstance(value, float):
-        return repr(round(value, 4)) if math.isfinite(value) else repr(value)
+        return repr(round(float(value), 4))  # a NumPy float as a float; NaN and the infinities round to themselves
     if isinstance(value, (list, tuple)):
         inner = ", ".join(show(v) for v in value)
         return f"[{inner}]" if isinstance(value, list) else f"({inner}{',' if len(value) == 1 else ''})"

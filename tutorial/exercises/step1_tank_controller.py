@@ -87,25 +87,31 @@ def check_dpad_steering(func) -> Result:
 
     def case(label, axes, expected, hint, hidden=False):
         call = label if hidden else f"dpad_track_velocities({show(axes)}) ({label})"
-        return Case(call, lambda: expect_numbers(call, func(list(axes)), expected, hint=hint), hint, hidden)
+        return Case(call, lambda: expect_numbers(call, func(list(axes)), expected), hint, hidden)  # the case's hint
 
     cases = [case(*row) for row in table]
     rng = hidden_random("1.1")  # while grading: this learner's own cases, drawn by the same rules
     for _ in range(24 if rng else 0):
-        axes = [rng.uniform(-1.0, 1.0) for _ in range(joy.NUM_AXES)]  # every stick moved
-        dh, dv = rng.choice((-1.0, 0.0, 1.0)), rng.choice((-1.0, 0.0, 1.0))
-        axes[joy.DPAD_H], axes[joy.DPAD_V] = dh, dv
-        label, expected = "a D-pad direction (or none) with the sticks moved", _dpad(dh, dv)
-        if rng.random() < 0.25:  # a non-finite D-pad axis counts as 0
-            bad = rng.choice((joy.DPAD_H, joy.DPAD_V))
-            axes[bad] = rng.choice((math.nan, math.inf, -math.inf))
-            label = "a D-pad axis NaN or infinite, the other pressed"
-            expected = _dpad(0.0 if bad == joy.DPAD_H else dh, 0.0 if bad == joy.DPAD_V else dv)
-        elif rng.random() < 0.2:  # a message too short for the D-pad's axes
-            axes = axes[: rng.randrange(0, joy.DPAD_H + 1)]
-            label, expected = "a Joy too short for the D-pad's axes", (0.0, 0.0)
+        label, axes, expected = _random_dpad(rng)
         cases.append(case(label, axes, expected, "follow each rule of the statement, for every input.", True))
     return grade("Exercise 1.1, steer with the D-pad", cases)
+
+
+def _random_dpad(rng) -> tuple[str, list[float], tuple[float, float]]:
+    """A hidden case of 1.1, (what it tests, axes, expected (left, right) in m/s): every stick moved; a D-pad
+    direction or none; in a quarter of them one D-pad axis NaN or infinite, or else in a fifth of the rest
+    a Joy too short for the D-pad's axes."""
+    axes = [rng.uniform(-1.0, 1.0) for _ in range(joy.NUM_AXES)]
+    dh, dv = rng.choice((-1.0, 0.0, 1.0)), rng.choice((-1.0, 0.0, 1.0))
+    axes[joy.DPAD_H], axes[joy.DPAD_V] = dh, dv
+    if rng.random() < 0.25:  # a non-finite D-pad axis counts as 0
+        bad = rng.choice((joy.DPAD_H, joy.DPAD_V))
+        axes[bad] = rng.choice((math.nan, math.inf, -math.inf))
+        expected = _dpad(0.0 if bad == joy.DPAD_H else dh, 0.0 if bad == joy.DPAD_V else dv)
+        return "a D-pad axis NaN or infinite, the other pressed", axes, expected
+    if rng.random() < 0.2:  # a message too short for the D-pad's axes
+        return "a Joy too short for the D-pad's axes", axes[: rng.randrange(0, joy.DPAD_H + 1)], (0.0, 0.0)
+    return "a D-pad direction (or none) with the sticks moved", axes, _dpad(dh, dv)
 
 
 def _dpad(dh: float, dv: float) -> tuple[float, float]:
@@ -169,24 +175,32 @@ def check_shot_counter(cls) -> Result:
                 controller.on_joy(_joy(buttons))
             shots = controller.summary().get("shots")
             if not same_value(shots, expected):
-                raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.", hint)
+                # no hint of its own: the grader gives the case's (grader._failed)
+                raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.")
 
         return Case(call, run, hint, hidden)
 
+    stick = [0.0, 1.0] + [0.0] * (joy.NUM_AXES - 2)
+
     def still_drives():
         controller = cls()
-        stick = [0.0, 1.0] + [0.0] * (joy.NUM_AXES - 2)
         controller.on_joy(_joy(A, stick))
         count_, axes, _ = controller.take_input()
-        if not (
-            same_numbers(axes, stick)
-            and same_value(count_, 1)
-            and same_value(controller.summary().get("joy_received"), 1)
-        ):
+        if not (same_numbers(axes, stick) and same_value(count_, 1)):
             raise CaseFailed(
-                f"after on_joy(axes={show(stick)}), take_input() gave ({count_}, {show(list(axes))}, ...) "
-                f"and summary() {controller.summary()}: the sticks are no longer stored.",
-                "call super().on_joy(msg) first, so the controller still drives.",
+                f"after one on_joy(axes={show(stick)}), take_input() gave ({count_!r}, {show(list(axes))}, ...), "
+                f"expected (1, {show(stick)}, ...): the sticks are not stored once.",
+                "call super().on_joy(msg) once, first, so the controller still drives.",
+            )
+
+    def still_summarises():
+        controller = cls()
+        controller.on_joy(_joy(A))
+        got = controller.summary()
+        if not (type(got) is dict and same_value(got.get("joy_received"), 1)):
+            raise CaseFailed(
+                f"after one on_joy(), summary() gave {got!r}: RttTankController's own fields are gone.",
+                "start from super().summary(): return {**super().summary(), 'shots': shots}.",
             )
 
     def under_the_lock():
@@ -198,7 +212,6 @@ def check_shot_counter(cls) -> Result:
         for phase, run in (("on_joy", lambda: [controller.on_joy(_joy(b)) for b in (A, NONE, A)]), ("summary", None)):
             object.__setattr__(controller, "_phase", phase)
             (run or controller.summary)()
-        object.__setattr__(controller, "_phase", None)
         seen = [row for row in controller.__dict__["_watch"] if row[2] not in own]
         # what both threads touch: read by summary() (the main thread), read or written by on_joy (the spin thread)
         shared = {n for p, w, n, _ in seen if p == "summary" and w == "read"} & {
@@ -216,14 +229,25 @@ def check_shot_counter(cls) -> Result:
     cases = [count(*row) for row in sequences]
     rng = hidden_random("1.2")  # while grading: this learner's own sequences, counted by the statement's rule
     for _ in range(12 if rng else 0):
-        presses = [rng.choice((A, A, B, NONE, NONE, A[:1], [], [1, 1] + NONE[2:])) for _ in range(rng.randrange(3, 40))]
+        presses = _random_presses(rng)
         label = "a long random sequence of A, B, both, released and short Joys"
         cases.append(
             count(label, presses, _shots(presses), "a press is each change of A from released to pressed.", True)
         )
     cases.append(Case(f"{cls.__name__}: on_joy(a Joy with the left stick up)", still_drives))
+    cases.append(Case(f"{cls.__name__}: summary() after one Joy", still_summarises))
     cases.append(Case(f"{cls.__name__}: what on_joy() remembers, under self._lock", under_the_lock))
     return grade("Exercise 1.2, count the shots", cases)
+
+
+SHORT = [1]  # a Joy with button A alone: pressed
+BOTH = [1, 1] + NONE[2:]  # A and B pressed together
+JOYS = (A, A, B, NONE, NONE, SHORT, [], BOTH)  # what a hidden sequence is drawn from: A and none twice as often
+
+
+def _random_presses(rng) -> list[list[int]]:
+    """A hidden sequence of 1.2: 3 to 39 Joys of :data:`JOYS` (A, B, both, released, short and empty ones)."""
+    return [rng.choice(JOYS) for _ in range(rng.randrange(3, 40))]
 
 
 def _shots(presses) -> int:
@@ -273,7 +297,7 @@ def _watched(cls):
 
     def note(obj, what: str, name: str) -> None:
         d = object.__getattribute__(obj, "__dict__")
-        if d.get("_phase") is None or name.startswith("__") or name in ("_phase", "_watch", "_lock"):
+        if d.get("_phase") is None or name.startswith("__"):  # the check's own _phase and _watch: never through here
             return
         if hasattr(type(getattr(type(obj), name, None)), "__get__"):
             return  # a method or a property: what it touches is noted when it runs
