@@ -745,14 +745,14 @@ def test_require_tells_the_seal_each_verdict_and_wraps_without_breaking_a_word(s
 # their cases, the mistakes only the hidden cases catch) are in tests/exercise_rules.py.
 
 
-def hidden_cases_on(monkeypatch, *modules: str) -> None:
-    """The hidden cases of the checks in ``modules`` on, as the grading kernel's seal gives them (seeded)."""
+def hidden_cases_on(monkeypatch, *modules: str, seed: str = "test") -> None:
+    """The hidden cases of the checks in ``modules`` on, as the grading kernel's seal gives them (from ``seed``)."""
     import importlib
     import random
 
     for module in modules:
         checks = importlib.import_module(f"tutorial.exercises.{module}")
-        monkeypatch.setattr(checks, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
+        monkeypatch.setattr(checks, "hidden_random", lambda exercise: random.Random(f"{seed}/{exercise}"))
 
 
 @pytest.fixture
@@ -920,13 +920,9 @@ def test_each_check_draws_its_hidden_cases_from_its_own_exercises_seed(ros, monk
 @pytest.mark.more  # the seed make test keeps is the worked solution's hidden-cases test's
 def test_the_worked_solution_of_3_1_passes_the_hidden_cases_of_many_seeds(ros, monkeypatch):
     """Among them runs with no message refused: a count of 0 refusals is no ``wrong_model`` entry at all."""
-    import random
-
-    from tutorial.exercises import step3_viewer
-
     ex = exercise("3.1")
     for seed in range(4):
-        monkeypatch.setattr(step3_viewer, "hidden_random", lambda exercise, seed=seed: random.Random(f"{seed}"))
+        hidden_cases_on(monkeypatch, "step3_viewer", seed=str(seed))
         result = grade(ex, ex["stub"], ex["solution"])
         assert result.passed and "8 hidden ones" in result.message, str(result)
 
