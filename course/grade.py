@@ -32,6 +32,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import os
+import queue
 import re
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -155,16 +156,25 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
         who = learners(course, assignment)
         calls, checks = test_calls(course, assignment) if boxes else ([], [])  # the seal's, for every learner
 
-        def worker(k: int, who=who, assignment=assignment, calls=calls, checks=checks) -> None:
-            """Learners k, k + jobs, ... one after another, in domain ids[k]: never two kernels in one domain.
+        todo: queue.SimpleQueue = queue.SimpleQueue()  # the learners left: each worker takes the next when free
+        for learner in who:
+            todo.put(learner)
 
-            A submission nbgrader cannot grade (its kernel died, say) is named, and the others are graded.
+        def worker(k: int, todo=todo, assignment=assignment, calls=calls, checks=checks) -> None:
+            """The next learner of ``todo``, until none is left, in domain ids[k]: never two kernels in one domain.
+
+            A submission nbgrader cannot grade (its kernel died, say) is named, and the others are graded.  A
+            submission that runs to its timeout holds up this worker alone: the other takes the next ones.
             """
             env = dict(
                 os.environ, ROS_DOMAIN_ID=str(ids[k]), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RTT_TEST_MODE="1"
             )
             job = boxes.users[k] if boxes else None
-            for learner in who[k::jobs]:
+            while True:
+                try:
+                    learner = todo.get_nowait()
+                except queue.Empty:
+                    return
                 log, died = "", False
                 if job:
                     job.test_calls, job.checks = calls, checks

@@ -45,6 +45,7 @@ def test_viewer_page_draws_the_tank_and_follows_the_turret(procs, node, tmp_path
     assert np.count_nonzero(np.abs(after - broken).max(axis=2) > 0.1) < 50
 
 
+@pytest.mark.more  # make test: the viewer's meshcat page in Chromium (test_viewer_page_draws_the_tank_...)
 def test_simulation_page_shows_the_tank_driving(procs, tmp_path):
     joy = procs(module_command("tutorial.tools.rtt_joy", "--demo"))
     sim = procs(module_command("tutorial.tools.rtt_run", "project/step1.yaml", "--json", "--duration", "30"))

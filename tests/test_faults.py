@@ -415,6 +415,7 @@ def run_bag(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
     return subprocess.run(module_command(RTT_BAG, *args), capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
+@pytest.mark.more  # make test: the recorder stopped by a full disk, its file still read (below)
 def test_recorder_killed_loses_less_than_a_second_and_its_file_is_read_played_and_recovered(nodes, tmp_path):
     """SIGKILL ``rtt-bag record`` 10 s into a Step 2 run: ``info`` reports at least 9 s of messages, the
     newest less than 1 s before the kill; ``play`` plays them; ``recover`` writes a file both stock readers

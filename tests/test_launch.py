@@ -138,6 +138,7 @@ def test_a_node_hung_in_its_clean_up_says_where_before_it_is_killed(tmp_path, mo
     assert list(tmp_path.glob("core*")) == []
 
 
+@pytest.mark.more  # make test: a recording of a running step, test_bag_replay and test_tf_recording
 def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
     """``--record FILE.mcap`` adds ``rtt-bag record`` (node ``rtt_bag``); the launch's stop closes the file whole.
 

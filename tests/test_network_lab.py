@@ -11,11 +11,11 @@ nothing else.  The hosts are the network tier's (tests/netns.py):
   sockets are the robot host's own).
 
 A notebook starts Step 2 with its live view (``BackgroundApp(...).show()``),
-run with Run All, then keeps the kernel busy for 12 s: the view draws its
+run with Run All, then keeps the kernel busy for 20 s: the view draws its
 first picture within 2 s of its output appearing and moves while the
 joystick drives, while the cell runs; a page reload in that cell has the
-scene back (once the cell ends: JupyterLab restores widgets through the
-kernel's main shell).  Then, with the kernel idle: the view moves, and a
+scene back within 2 s of the view's output, and the view moving, before
+the cell ends.  Then, with the kernel idle: the view moves, and a
 trivial cell answers while the view is live.  The same without the busy
 cell, with the browser on the robot host, the kernel's own, and an idle
 page reload that has the scene back within 5 s, is a ``more`` case.
@@ -43,7 +43,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # The busy cell of the Run All notebook (a scripted drive or a wait_until, as a learner's): long enough that the
 # view is measured and the page reloaded while it runs (the browser checks that it still ran).
-BUSY_S = 12
+BUSY_S = 20
 
 
 def browse(host, url: str, address: str, busy_s: float = 0) -> dict:
@@ -94,10 +94,12 @@ def test_a_live_view_draws_through_jupyters_port_alone_while_run_all_keeps_the_k
     assert got["first_picture_s"] < 2, f"the view's first picture came {got['first_picture_s']} s after its output"
     assert got["moved_busy"] > 200, f"the view did not move while a cell ran: {got}"
     assert got["fps_busy"] >= 20, f"the view drew {got['fps_busy']} frames/s while a cell ran"
-    # A reload while a cell runs: JupyterLab restores the page's widgets through the kernel's main shell
-    # (comm_info_request), which answers once the cell ends.  Its time is printed, not held to 2 s (the
-    # README, "While a cell runs"); the scene must come back, and the view move, once the cell has ended.
-    assert got["reload_busy_s"] < BUSY_S + 10, f"no scene after a reload in the busy cell: {got}"
+    # A reload while the cell runs: the page asks the kernel for its widgets, and the views' subshell answers
+    # (tutorial/view/widget/widget.py, _ViewSubshell._restore_there): the scene is back within 2 s of the
+    # view's output, and the view moves, before the cell ends.  From the reload itself, JupyterLab's own
+    # loading comes first: printed (reload_busy_s), not held to a figure.
+    assert got["scene_after_view_busy_s"] < 2, f"the scene came late after a reload in the busy cell: {got}"
+    assert got["moved_after_busy"] > 200 and got["reload_busy_before_end"], f"a reload waited for the cell: {got}"
 
 
 @pytest.mark.more

@@ -174,6 +174,7 @@ def test_a_second_node_with_the_same_name_is_warned_about(procs):
         assert "2 nodes are named /rtt" in json.loads(first)["message"], p.out
 
 
+@pytest.mark.more  # make test: two learners' distinct names, no warning (test_hub), and the same name's warning
 def test_distinct_names_give_no_warning(procs):
     a = viewer(procs, "project/step3.yaml", "rtt_a", "--duration", "5")
     b = viewer(procs, "project/step3.yaml", "rtt_b", "--duration", "5")

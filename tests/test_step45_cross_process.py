@@ -179,6 +179,7 @@ def arrow_pixels(image):
     return int(red.sum()), int(blue.sum())
 
 
+@pytest.mark.more  # make test: a recording's arrows appear and hide in Chromium, test_imu
 def test_the_viewers_page_draws_the_arrows_and_hides_them(procs, node, tmp_path):
     from sensor_msgs.msg import Imu
 

@@ -70,19 +70,90 @@ def hello_while_the_cell_sleeps(kc, code: str) -> dict:
     return got
 
 
-def test_a_view_gets_its_scene_while_a_cell_runs_and_thread_output_stays_the_cells(tmp_path):
+@pytest.fixture(scope="module")
+def kernel(tmp_path_factory):
+    """A real ipykernel and its client (kc), for this module's tests in their order."""
     from jupyter_client.manager import start_new_kernel
 
-    km, kc = start_new_kernel(kernel_name="python3", cwd=str(tmp_path))
+    km, kc = start_new_kernel(kernel_name="python3", cwd=str(tmp_path_factory.mktemp("kernel")))
     try:
-        for which, code in (("the cell that makes the view", FIRST), ("a later cell", LATER)):
-            got = hello_while_the_cell_sleeps(kc, code)
-            assert got["cell_done_at"] is not None and got["asked"] is not None, f"{which}: it did not run: {got}"
-            assert got["scene_at"] is not None, f"{which}: no scene came for the view's hello"
-            assert got["scene_at"] < got["cell_done_at"], f"{which}: the scene waited for the cell to end"
-            late = got["scene_at"] - got["asked"]
-            assert late < 2.0, f"{which}: the scene came {late:.2f} s after the hello"
-            assert got["thread_output_parent"] == got["cell"], f"{which}: its thread's output went to the view's hello"
+        yield kc
     finally:
         kc.stop_channels()
         km.shutdown_kernel(now=True)
+
+
+def test_a_view_gets_its_scene_while_a_cell_runs_and_thread_output_stays_the_cells(kernel):
+    kc = kernel
+    for which, code in (("the cell that makes the view", FIRST), ("a later cell", LATER)):
+        got = hello_while_the_cell_sleeps(kc, code)
+        assert got["cell_done_at"] is not None and got["asked"] is not None, f"{which}: it did not run: {got}"
+        assert got["scene_at"] is not None, f"{which}: no scene came for the view's hello"
+        assert got["scene_at"] < got["cell_done_at"], f"{which}: the scene waited for the cell to end"
+        late = got["scene_at"] - got["asked"]
+        assert late < 2.0, f"{which}: the scene came {late:.2f} s after the hello"
+        assert got["thread_output_parent"] == got["cell"], f"{which}: its thread's output went to the view's hello"
+
+
+def test_a_page_reloaded_while_a_cell_runs_gets_the_kernels_info_and_its_widgets_at_once(kernel):
+    """What JupyterLab asks on a reload (kernel info, the control comm's states, the comms) is answered by the
+    views' subshell while a cell sleeps; a message signed with another key is not answered at all."""
+    from jupyter_client.session import Session
+
+    kc = kernel
+    model_id, comm_id = view_ids(kc)
+    cell = kc.execute("import time\ntime.sleep(4)")
+    sent = time.monotonic()
+    forged = Session(key=b"not the kernel's key", session=kc.session.session, username=kc.session.username)
+    asked = {
+        "forged": forged.send(kc.shell_channel.socket, "kernel_info_request")["header"]["msg_id"],
+        "kernel_info": kc.kernel_info(),
+        "comm_info": kc.comm_info(target_name="jupyter.widget"),
+    }
+    control = "control-" + str(sent)
+    kc.shell_channel.send(
+        kc.session.msg(
+            "comm_open",
+            {"comm_id": control, "target_name": "jupyter.widget.control", "data": {}},
+            metadata={"version": "1.0.0"},
+        )
+    )
+    kc.shell_channel.send(kc.session.msg("comm_msg", {"comm_id": control, "data": {"method": "request_states"}}))
+    came, states = {}, None
+    deadline = sent + 30
+    while time.monotonic() < deadline and (cell not in came or states is None):
+        try:
+            m = kc.get_shell_msg(timeout=0.05)
+            came[m["parent_header"]["msg_id"]] = (time.monotonic() - sent, m)
+        except queue.Empty:
+            pass
+        try:
+            m = kc.get_iopub_msg(timeout=0.05)
+        except queue.Empty:
+            continue
+        if m["msg_type"] == "comm_msg" and m["content"]["comm_id"] == control:
+            states = (time.monotonic() - sent, m["content"]["data"])
+    assert cell in came, f"the sleeping cell never ended: {came}"
+    ended = came[cell][0]
+    assert ended > 3.5, f"the cell ended after {ended:.2f} s: it did not sleep, nothing was measured"
+    for what in ("kernel_info", "comm_info"):
+        assert asked[what] in came, f"no {what}_reply"
+        at, reply = came[asked[what]]
+        assert at < 2.0 and at < ended, f"the {what}_reply came {at:.2f} s after the request (the cell: {ended:.2f} s)"
+    assert comm_id in came[asked["comm_info"]][1]["content"]["comms"], "the view's comm is not among the comms"
+    assert states is not None, "the control comm's request_states was never answered"
+    assert states[0] < 2.0, f"the widgets' states came {states[0]:.2f} s after the request (the cell: {ended:.2f} s)"
+    assert states[1]["method"] == "update_states" and model_id in states[1]["states"], states[1].keys()
+    assert asked["forged"] not in came, "a message signed with another key was answered"
+
+
+def view_ids(kc) -> tuple[str, str]:
+    """The view's widget model id and comm id, from the kernel (idle)."""
+    got = []
+    reply = kc.execute_interactive(
+        "print(view.model_id, view.comm.comm_id)", timeout=30, output_hook=lambda m: got.append(m)
+    )
+    assert reply["content"]["status"] == "ok", reply
+    text = "".join(m["content"].get("text", "") for m in got if m["msg_type"] == "stream")
+    model_id, comm_id = text.split()
+    return model_id, comm_id

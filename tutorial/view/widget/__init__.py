@@ -2,5 +2,6 @@
 
 ``widget``  :class:`MeshcatWidget` (an anywidget whose view is meshcat's own page) and its meshcat window
 ``flow``    :class:`FrameFlow`: coalescing, a window of frames in flight, the scene kept for views that open later
+``subshell`` :class:`ViewSubshell`: the kernel subshell that answers views, and reloaded pages, while a cell runs
 ``widget.js`` the browser's side
 """

@@ -31,7 +31,7 @@ animation frame of its own, and less on a slow machine or a slow link.
   newest), so a property set every frame does not grow the tree.
 
 Where the views have no kernel subshell of their own
-(``widget._ViewSubshell``: ipykernel before 7.4), the kernel reads no
+(``subshell.ViewSubshell``: ipykernel before 7.4), the kernel reads no
 message from the browser while it runs a cell: a view's ``drawn`` waits
 until the cell ends.  So while a cell runs there (:meth:`take`'s
 ``busy``), the flow sends without waiting for answers, at most

@@ -24,7 +24,7 @@ at most four frames in flight and the scene kept for a page that opens later are
 
 Threads: the visualizer (:meth:`visualizer`, :class:`WidgetWindow`) belongs to
 one thread, usually a run's owner thread; the browser's messages arrive on
-the views' kernel subshell (:class:`_ViewSubshell`), a thread of its own,
+the views' kernel subshell (:class:`ViewSubshell`), a thread of its own,
 or on the kernel's thread where there is none.  Both end in a send, under
 one lock (see ``MeshcatWidget._lock``).  The widget is shown, closed and displayed from
 the kernel's thread.
@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import contextvars
 import json
-import logging
 import threading
 import time
 from pathlib import Path
@@ -46,6 +45,7 @@ import traitlets
 from tutorial.view import meshcat_batch
 from tutorial.view.meshcat_page import PAGE_SCRIPT, viewer_script_gzip
 from tutorial.view.widget.flow import FrameFlow
+from tutorial.view.widget.subshell import ViewSubshell, current_kernel
 
 # What a view takes in one command (widget.js refuses more and says so): a mesh of a few hundred
 # thousand triangles fits; a frame's transforms are held to the limits of the server's set_transforms.
@@ -69,7 +69,7 @@ class _CellWatch:
     """Whether the kernel is running a cell now (IPython's ``pre_run_cell`` and ``post_run_cell``).
 
     While a cell runs, the kernel's main shell reads no message from the
-    browser.  Where the views have no subshell of their own (:class:`_ViewSubshell`),
+    browser.  Where the views have no subshell of their own (:class:`ViewSubshell`),
     no view can answer a frame then: :class:`FrameFlow` sends on a timer instead.
     Outside IPython (a script) no cell ever runs.
     """
@@ -99,7 +99,7 @@ class _CellWatch:
         shell.events.register("pre_run_cell", cls._begin)
         shell.events.register("post_run_cell", cls._end)
         cls._installed = True
-        kernel = _kernel()
+        kernel = current_kernel()
         parent = getattr(kernel, "get_parent", lambda: {})() or {}
         asked = (parent.get("header") or {}).get("msg_type")
         if threading.current_thread() is threading.main_thread() and asked == "execute_request":
@@ -108,7 +108,7 @@ class _CellWatch:
     @classmethod
     def _begin(cls, *_args) -> None:
         cls.busy = True
-        kernel = _kernel()
+        kernel = current_kernel()
         get_parent = getattr(kernel, "get_parent", None)  # ipykernel 6 on; before, no views' subshell either
         if get_parent is None or getattr(kernel, "shell", None) is None:
             return
@@ -143,7 +143,7 @@ class _CellWatch:
         scene) can still go to that message.  The message's own status
         messages keep their parent.
         """
-        kernel = _kernel()
+        kernel = current_kernel()
         if kernel is None or getattr(kernel, "shell", None) is None:
             return
         with cls._lock:
@@ -153,91 +153,6 @@ class _CellWatch:
 def cell_running() -> bool:
     """Whether the kernel is running a cell now (False outside IPython); any thread."""
     return _CellWatch.busy
-
-
-def _kernel():
-    """The ipykernel kernel of this process, or None (a script, another kernel)."""
-    try:
-        from ipykernel.kernelbase import Kernel
-    except ImportError:
-        return None
-    return Kernel.instance() if Kernel.initialized() else None
-
-
-class _ViewSubshell:
-    """One kernel subshell that hears every live view's messages, so a busy kernel still answers its views.
-
-    A view's messages to the kernel (its hello, ``drawn``, the viewer script
-    it asks for) are comm messages on the kernel's shell channel.  The main
-    shell reads them only between cells: with Run All, behind every cell
-    already sent.  ipykernel 7 runs *subshells* (Jupyter's kernel subshells,
-    JEP 91), each a thread with its own queue, and sends a comm's messages to
-    the subshell the comm names (``BaseComm._reply_subshell_for``).  Every
-    view's comm names this one subshell, created once per kernel: a view
-    draws its first picture, and keeps drawing at its own rate, while a cell
-    runs.
-
-    What it costs: each view message makes the kernel say "busy" then "idle"
-    on its own (Jupyter's kernel indicator may show idle while a cell
-    runs); and ipykernel makes each message it handles the parent of
-    output from threads, so the view's handler gives that back to the
-    running cell (:meth:`_CellWatch.give_output_back`: all but what a
-    thread prints while a view's message is being handled).
-
-    Where ipykernel has no subshells (before 7) or no comm routing (before
-    7.4), or outside a kernel, :meth:`id` is None and views wait for the
-    kernel to be idle, as before.  Any thread.
-    """
-
-    _id: str | None = None
-    _tried = False
-    _lock = threading.Lock()  # one subshell however many views are made, from whichever threads
-
-    @classmethod
-    def id(cls) -> str | None:
-        with cls._lock:
-            if not cls._tried:
-                cls._tried = True
-                cls._id = cls._create()
-            return cls._id
-
-    @staticmethod
-    def _create() -> str | None:
-        kernel = _kernel()
-        try:
-            from ipykernel.comm.comm import BaseComm
-        except ImportError:
-            return None
-        thread = getattr(kernel, "shell_channel_thread", None)
-        if not getattr(kernel, "_supports_kernel_subshells", False) or thread is None:
-            return None
-        if not hasattr(BaseComm, "_reply_subshell_for"):
-            return None
-        made: dict = {}
-        done = threading.Event()
-
-        def create() -> None:  # on the shell channel's thread, as ipykernel's own create_subshell_request
-            try:
-                made["id"] = thread.manager._create_subshell()
-            finally:
-                done.set()
-
-        thread.io_loop.add_callback(create)
-        if not done.wait(5.0) or "id" not in made:
-            logging.getLogger("rtt.views").warning(
-                "no kernel subshell for the live views: they draw only while no cell runs"
-            )
-            return None
-        return made["id"]
-
-    @classmethod
-    def route(cls, comm) -> bool:
-        """Send ``comm``'s messages from the browser to the views' subshell; whether it could."""
-        subshell = cls.id()
-        if subshell is None or comm is None or not hasattr(comm, "_reply_subshell_for"):
-            return False
-        comm._reply_subshell_for = lambda _data, _default: subshell
-        return True
 
 
 class MeshcatWidget(anywidget.AnyWidget):
@@ -274,7 +189,7 @@ class MeshcatWidget(anywidget.AnyWidget):
         self.last_heard = time.monotonic()  # when a page last said anything: a run unwatched pauses (runs.py)
         self.probe: list | None = None  # a benchmark's list: (frame number, monotonic ns when sent) of each frame
         self.on_msg(self._on_message)
-        self.off_main = _ViewSubshell.route(self.comm)  # the browser's messages come on the views' subshell
+        self.off_main = ViewSubshell.route(self.comm)  # the browser's messages come on the views' subshell
 
     def __repr__(self) -> str:  # the same text every run (a saved output's text/plain)
         return f"MeshcatWidget({self.label!r})"
