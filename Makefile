@@ -10,7 +10,7 @@
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does three; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
-#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 80 s),
+#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 2.5 min),
 #       make test-hub (the hub with learners as Unix users: slow), make test-robots (the UR5, SO-100 and Go2 in Chromium),
 #       make image (the learner image, podman), make hub-containers (the class on containers), make test-containers,
 #       make assignments (the class's nbgrader assignments from the notebooks, into course/),
@@ -111,7 +111,7 @@ mutate: $(VENV)/.installed
 
 # The cases make test leaves out to stay under 10 minutes, each of a kind make test keeps one real case of
 # (marked "more": two more faults, two more network set-ups, one more robot across processes, and the mistakes
-# only the exercises' hidden cases catch past the first of each exercise): about 80 s.
+# only the exercises' hidden cases catch past the first of each exercise): about 2.5 minutes.
 test-more: $(VENV)/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m more -q

@@ -13,7 +13,9 @@ is given, at the exchange's own paths (so the hub's ``nbgrader_config.py`` for l
 
 ``make grade`` stages those with the rest, refusing a submission whose name is not its folder's
 (``course/submissions.py``).  The hub's thread calls :func:`give_learner_their_exchange` (the pre-spawn hook).
-The folders are given to uid 1000 of this machine too, where that is an account: keep it no one's.
+The folders are given to this machine's uid for that learner's ``jovyan``: each container runs in a user
+namespace of its own (``course/jupyterhub_containers_config.py``), so no account of this machine, and no other
+learner, owns them.
 """
 
 from __future__ import annotations
@@ -27,8 +29,9 @@ ROOTS = "container-roots"  # each learner's exchange root, under which the folde
 JOVYAN = 1000  # the image's user (course/containers/Containerfile)
 
 
-def give_learner_their_exchange(spawner, exchange: Path, learner_config: Path) -> None:
-    """Add to ``spawner.volumes`` the exchange as ``spawner.user.name`` sees it, making their folder."""
+def give_learner_their_exchange(spawner, exchange: Path, learner_config: Path, owner: int = JOVYAN) -> None:
+    """Add to ``spawner.volumes`` the exchange as ``spawner.user.name`` sees it, making their folders, owned
+    by ``owner``: this machine's uid for the image's user in that learner's container (its user namespace)."""
     course = exchange / COURSE_ID
     name = spawner.user.name
     (course / "outbound").mkdir(mode=0o755, parents=True, exist_ok=True)
@@ -42,7 +45,7 @@ def give_learner_their_exchange(spawner, exchange: Path, learner_config: Path) -
     root = course / ROOTS / name
     for folder in (own, root):
         folder.mkdir(mode=0o700, exist_ok=True)
-        os.chown(folder, JOVYAN, JOVYAN)
+        os.chown(folder, owner, owner)
     spawner.volumes = {
         **spawner.volumes,
         str(learner_config / "nbgrader_config.py"): {"bind": "/etc/jupyter/nbgrader_config.py", "mode": "ro"},

@@ -11,6 +11,8 @@
 #   hub's API also listens on (RTT_HUB_CONTAINER_GATEWAY), for the servers to reach the hub;
 # - the learner's home is a named volume, rtt-home-<name>: the image's notebooks and project files the first
 #   time, the learner's own work after (a container is removed when its server stops; the volume stays);
+# - each container in a user namespace of its own (below): on this machine, a learner's files belong to a uid
+#   of that learner's alone;
 # - the limits are DockerSpawner's (mem_limit, cpu_limit, a pids limit), from the same figures as course/limits.py;
 # - no book of ROS domains: each container has a network namespace of its own, where discovery on localhost
 #   finds that learner's nodes only, so every learner uses the same domain (RTT_HUB_CONTAINER_DOMAIN, default 0).
@@ -29,7 +31,7 @@ GATEWAY = os.environ.get("RTT_HUB_CONTAINER_GATEWAY") or "127.0.0.1"  # never ""
 c.JupyterHub.hub_ip = GATEWAY  # the hub's API, for the learners' servers: on the containers' network only
 c.JupyterHub.hub_connect_ip = GATEWAY
 
-from container_exchange import give_learner_their_exchange  # noqa: E402 - course/ is on the path: the base's
+from container_exchange import JOVYAN, give_learner_their_exchange  # noqa: E402 - course/ is on the path: the base's
 from dockerspawner import DockerSpawner  # noqa: E402
 from idle_stops import remembering_last_use  # noqa: E402 - course/ is on the path: the base put it there
 from traitlets.config.loader import PyFileConfigLoader  # noqa: E402
@@ -40,7 +42,29 @@ c.DockerSpawner.network_name = os.environ.get("RTT_HUB_CONTAINER_NETWORK", "rtt-
 c.DockerSpawner.use_internal_ip = True  # the proxy reaches each container at its address on that network
 c.DockerSpawner.remove = True
 c.DockerSpawner.notebook_dir = "/home/jovyan"
-c.DockerSpawner.volumes = {"rtt-home-{username}": "/home/jovyan"}
+# U: podman gives the volume to the container's user as its namespace maps it (below), at every start
+c.DockerSpawner.volumes = {"rtt-home-{username}": {"bind": "/home/jovyan", "mode": "rw,U"}}
+# Each learner's container in a user namespace of its own: its uids 0 to 65535 are this machine's
+# USERNS_FIRST + 65536 x (the hub's id for the learner) on.  So the image's jovyan (uid 1000) is, on this
+# machine, a uid no account has and no other learner's container shares: what a learner's container writes
+# (their home volume, their folder of the exchange) is theirs alone, not uid 1000's.  Podman takes the
+# mapping through Docker's API as its --userns=auto:uidmapping=...; the default first uid, 2^24, is past
+# the ranges /etc/subuid usually hands out.
+USERNS_FIRST = int(os.environ.get("RTT_HUB_USERNS_FIRST", str(1 << 24)))
+USERNS_SIZE = 65536
+
+
+def learner_uid(spawner, uid: int = 0) -> int:
+    """This machine's uid for ``uid`` in ``spawner``'s learner's container."""
+    return USERNS_FIRST + USERNS_SIZE * spawner.user.id + uid
+
+
+def in_a_user_namespace_of_their_own(spawner) -> dict:
+    mapping = f"0:{learner_uid(spawner)}:{USERNS_SIZE}"
+    return {"host_config": {"UsernsMode": f"auto:uidmapping={mapping},gidmapping={mapping}"}}
+
+
+c.DockerSpawner.extra_create_kwargs = in_a_user_namespace_of_their_own
 c.DockerSpawner.extra_host_config = {"pids_limit": int(os.environ.get("RTT_HUB_PIDS_LIMIT", "500"))}
 c.Spawner.cmd = ["jupyterhub-singleuser"]  # the image's own environment, not this machine's
 c.Spawner.args = []
@@ -55,7 +79,7 @@ def prepare_learner(spawner):
     """No domain to give, no files to copy (the image and the volume hold them): the learner's exchange, and
     a learner the culler stopped is told, as on the base (course/idle_stops.py, whose IdleStops the base's
     post_stop_hook belongs to)."""
-    give_learner_their_exchange(spawner, EXCHANGE, LEARNER_CONFIG)
+    give_learner_their_exchange(spawner, EXCHANGE, LEARNER_CONFIG, owner=learner_uid(spawner, JOVYAN))
     c.Spawner.post_stop_hook.__self__.before_spawn(spawner)
 
 

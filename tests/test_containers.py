@@ -212,6 +212,31 @@ def hub_on_containers(tmp_path: Path, learners: list[str]):
         assert not [n for n in left if n.startswith("jupyter-learner")], f"the hub left containers: {left}"
 
 
+def home_volume_of(name: str) -> Path:
+    """Where this machine keeps the home volume of the running container of the hub's learner ``name``."""
+    for container in podman("ps", "--format", "{{.Names}}").stdout.split():
+        info = json.loads(podman("inspect", container).stdout)[0]
+        if f"JUPYTERHUB_USER={name}" in info["Config"]["Env"]:
+            return Path(next(m["Source"] for m in info["Mounts"] if m["Destination"] == "/home/jovyan"))
+    raise AssertionError(f"no running container of {name}")
+
+
+def learners_own_their_files(learners: list[Learner], course: Path) -> None:
+    """Each learner's container runs as jovyan (1000) inside, and as a uid of that learner's alone on this
+    machine (a user namespace each: course/jupyterhub_containers_config.py): their home volume's files and
+    their folder of the exchange are that uid's, not uid 1000's, and not the other learner's."""
+    owners = {}
+    for learner in learners:
+        assert learner.run("import os\nprint(os.getuid(), os.getgid())").strip() == "1000 1000"
+        home = home_volume_of(learner.name)
+        uids = {p.lstat().st_uid for p in [home, *home.rglob("*")]}
+        inbound = (course / "inbound-by-learner" / learner.name).lstat().st_uid
+        assert len(uids) == 1 and uids == {inbound}, (learner.name, uids, inbound)
+        owners[learner.name] = inbound
+    print(f"this machine's uids for the learners' jovyan: {owners}")
+    assert len(set(owners.values())) == len(learners) and all(uid >= 1 << 24 for uid in owners.values()), owners
+
+
 def test_a_class_on_containers(tmp_path):
     import nbformat
     from playwright.sync_api import sync_playwright
@@ -227,6 +252,7 @@ def test_a_class_on_containers(tmp_path):
             started = time.monotonic()
             learner.start_server(timeout=180)
             print(f"{learner.name}'s container answered through the hub in {time.monotonic() - started:.1f} s")
+        learners_own_their_files(learners, tmp_path / "hub" / "exchange" / "ros-tank-tutorial")
         # Both drive at once, in the same ROS domain, each in a container of their own: A's joystick drives
         # A's tank only.
         results, errors = {}, []
