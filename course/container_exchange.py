@@ -1,9 +1,10 @@
 """nbgrader's exchange for a class on containers: each learner's container hands in to a folder of its own.
 
-In containers every learner is the same user (``jovyan``, uid 1000), so the owner of a submission cannot say
-who handed it in, as it does for learners who are Unix users (``course/submissions.py``), and a
-shared ``inbound/`` would let one learner read, or replace, another's work.  Instead each learner's container
-is given, at the exchange's own paths (so the hub's ``nbgrader_config.py`` for learners serves here too):
+In containers every learner is the same user inside (``jovyan``, uid 1000), so a shared ``inbound/`` would let
+one learner read, or replace, another's work, and a submission's owner is a uid of no account here, not a name
+(``course/submissions.py`` reads a learner's name from their Unix user where learners are users).
+Instead each learner's container is given, at the exchange's own paths (so the hub's ``nbgrader_config.py``
+for learners serves here too):
 
 - ``outbound/`` (the released assignments) and ``feedback/``, read only;
 - as ``inbound/``, the host's ``inbound-by-learner/NAME/``, NAME being the hub's name for that learner, which

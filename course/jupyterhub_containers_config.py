@@ -21,7 +21,10 @@
 # Not stopped: a learner's container reaching a port another learner's container serves on that network (the
 # learners' Jupyter servers ask for the hub's login; anything else a learner starts there does not).
 
+import contextlib
+import grp
 import os
+import pwd
 from pathlib import Path
 
 c = get_config()  # noqa: F821 - JupyterHub provides it
@@ -50,13 +53,38 @@ c.DockerSpawner.volumes = {"rtt-home-{username}": {"bind": "/home/jovyan", "mode
 # (their home volume, their folder of the exchange) is theirs alone, not uid 1000's.  Podman takes the
 # mapping through Docker's API as its --userns=auto:uidmapping=...; the default first uid, 2^24, is past
 # the ranges /etc/subuid usually hands out.
+# Podman only: Docker refuses both this user namespace mode and the volume's U.  The hub's id for a learner is
+# a row of its database: a new database may give a learner another's range, which :U and the pre-spawn hook
+# give back to them (their files are theirs again; no other learner's volume or folder is ever mounted).
 USERNS_FIRST = int(os.environ.get("RTT_HUB_USERNS_FIRST", str(1 << 24)))
 USERNS_SIZE = 65536
+if USERNS_FIRST < 1 << 24:
+    raise SystemExit(f"RTT_HUB_USERNS_FIRST={USERNS_FIRST}: below 2^24, the learners' uids may be accounts'")
 
 
 def learner_uid(spawner, uid: int = 0) -> int:
-    """This machine's uid for ``uid`` in ``spawner``'s learner's container."""
-    return USERNS_FIRST + USERNS_SIZE * spawner.user.id + uid
+    """This machine's uid for ``uid`` in ``spawner``'s learner's container.
+
+    Raises:
+        RuntimeError: that learner's range is past the last uid, or an account, a group or a subordinate
+            range (/etc/subuid, /etc/subgid) of this machine has some of it: their files would not be theirs alone.
+    """
+    first = USERNS_FIRST + USERNS_SIZE * spawner.user.id
+    last = first + USERNS_SIZE - 1
+    if last >= (1 << 32) - 1:
+        raise RuntimeError(f"no uids left for {spawner.user.name} (the hub's learner {spawner.user.id})")
+    for listed in ("/etc/subuid", "/etc/subgid"):
+        for line in Path(listed).read_text().splitlines() if Path(listed).is_file() else ():
+            fields = line.split(":")
+            if len(fields) == 3 and fields[1].isdigit() and fields[2].isdigit():
+                start = int(fields[1])
+                if start <= last and first < start + int(fields[2]):
+                    raise RuntimeError(f"{listed} gives {fields[0]} uids of {spawner.user.name}'s range {first}-{last}")
+    for owner in (first, first + JOVYAN):  # the uids the learner's files have on this machine
+        for known in (pwd.getpwuid, grp.getgrgid):
+            with contextlib.suppress(KeyError):
+                raise RuntimeError(f"uid {owner}, of {spawner.user.name}'s container, is {known(owner)[0]!r} here")
+    return first + uid
 
 
 def in_a_user_namespace_of_their_own(spawner) -> dict:

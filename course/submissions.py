@@ -13,7 +13,7 @@ reads that copy:
   link or a special file is refused), no larger than nbgrader allows; its ``timestamp.txt`` the time in its name;
 - where learners are Unix users of this machine (the hub's ``users`` spawner), the submission's folder must be
   owned by the user of the name it bears;
-- in containers, where every learner is uid 1000, each learner hands in to a folder of their own that the hub
+- in containers, where every learner is ``jovyan`` inside, each learner hands in to a folder of their own that the hub
   named (``inbound-by-learner/NAME``, :mod:`container_exchange`): a submission in it must bear that name;
 - its name must read the same as nbgrader reads it, with a time nbgrader can read (one that is not would stop
   ``collect`` for the whole class); one that cannot be copied (too deep, changed while copied) is refused.

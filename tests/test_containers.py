@@ -229,9 +229,10 @@ def learners_own_their_files(learners: list[Learner], course: Path) -> None:
     for learner in learners:
         assert learner.run("import os\nprint(os.getuid(), os.getgid())").strip() == "1000 1000"
         home = home_volume_of(learner.name)
-        uids = {p.lstat().st_uid for p in [home, *home.rglob("*")]}
-        inbound = (course / "inbound-by-learner" / learner.name).lstat().st_uid
-        assert len(uids) == 1 and uids == {inbound}, (learner.name, uids, inbound)
+        owners_there = {(p.lstat().st_uid, p.lstat().st_gid) for p in [home, *home.rglob("*")]}
+        folder = (course / "inbound-by-learner" / learner.name).lstat()
+        inbound = folder.st_uid
+        assert owners_there == {(inbound, inbound)} == {(folder.st_uid, folder.st_gid)}, (learner.name, owners_there)
         owners[learner.name] = inbound
     print(f"this machine's uids for the learners' jovyan: {owners}")
     assert len(set(owners.values())) == len(learners) and all(uid >= 1 << 24 for uid in owners.values()), owners

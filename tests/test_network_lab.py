@@ -95,7 +95,7 @@ def test_a_live_view_draws_through_jupyters_port_alone_while_run_all_keeps_the_k
     assert got["moved_busy"] > 200, f"the view did not move while a cell ran: {got}"
     assert got["fps_busy"] >= 20, f"the view drew {got['fps_busy']} frames/s while a cell ran"
     # A reload while the cell runs: the page asks the kernel for its widgets, and the views' subshell answers
-    # (tutorial/view/widget/widget.py, _ViewSubshell._restore_there): the scene is back within 2 s of the
+    # (tutorial/view/widget/subshell.py, ViewSubshell._restore_there): the scene is back within 2 s of the
     # view's output, and the view moves, before the cell ends.  From the reload itself, JupyterLab's own
     # loading comes first: printed (reload_busy_s), not held to a figure.
     assert got["scene_after_view_busy_s"] < 2, f"the scene came late after a reload in the busy cell: {got}"

@@ -1,4 +1,4 @@
-"""A live view hears its page while a cell runs: the views' kernel subshell (tutorial/view/widget/widget.py).
+"""A live view hears its page while a cell runs: the views' kernel subshell (tutorial/view/widget/subshell.py).
 
 A real ipykernel, driven as a front end drives it (jupyter_client): a cell
 makes a view, a second cell sleeps, and while it sleeps the "page" (this
@@ -102,13 +102,17 @@ def test_a_page_reloaded_while_a_cell_runs_gets_the_kernels_info_and_its_widgets
 
     kc = kernel
     model_id, comm_id = view_ids(kc)
-    cell = kc.execute("import time\ntime.sleep(4)")
+    # the cell's thread prints after the questions are answered: its output must still be the cell's
+    cell = kc.execute(
+        "import threading, time\nthreading.Timer(2.5, lambda: print('late', flush=True)).start()\ntime.sleep(4)"
+    )
     sent = time.monotonic()
     forged = Session(key=b"not the kernel's key", session=kc.session.session, username=kc.session.username)
     asked = {
         "forged": forged.send(kc.shell_channel.socket, "kernel_info_request")["header"]["msg_id"],
         "kernel_info": kc.kernel_info(),
         "comm_info": kc.comm_info(target_name="jupyter.widget"),
+        "inspect": kc.inspect("time"),  # not a page's question: it waits for the cell
     }
     control = "control-" + str(sent)
     kc.shell_channel.send(
@@ -119,9 +123,9 @@ def test_a_page_reloaded_while_a_cell_runs_gets_the_kernels_info_and_its_widgets
         )
     )
     kc.shell_channel.send(kc.session.msg("comm_msg", {"comm_id": control, "data": {"method": "request_states"}}))
-    came, states = {}, None
+    came, states, late_parent = {}, None, None
     deadline = sent + 30
-    while time.monotonic() < deadline and (cell not in came or states is None):
+    while time.monotonic() < deadline and (cell not in came or states is None or asked["inspect"] not in came):
         try:
             m = kc.get_shell_msg(timeout=0.05)
             came[m["parent_header"]["msg_id"]] = (time.monotonic() - sent, m)
@@ -133,6 +137,8 @@ def test_a_page_reloaded_while_a_cell_runs_gets_the_kernels_info_and_its_widgets
             continue
         if m["msg_type"] == "comm_msg" and m["content"]["comm_id"] == control:
             states = (time.monotonic() - sent, m["content"]["data"])
+        elif m["msg_type"] == "stream" and "late" in m["content"]["text"]:
+            late_parent = m["parent_header"].get("msg_id")
     assert cell in came, f"the sleeping cell never ended: {came}"
     ended = came[cell][0]
     assert ended > 3.5, f"the cell ended after {ended:.2f} s: it did not sleep, nothing was measured"
@@ -145,15 +151,49 @@ def test_a_page_reloaded_while_a_cell_runs_gets_the_kernels_info_and_its_widgets
     assert states[0] < 2.0, f"the widgets' states came {states[0]:.2f} s after the request (the cell: {ended:.2f} s)"
     assert states[1]["method"] == "update_states" and model_id in states[1]["states"], states[1].keys()
     assert asked["forged"] not in came, "a message signed with another key was answered"
+    assert came[asked["inspect"]][0] >= ended, "an inspect request was answered while the cell ran: not the main shell"
+    assert late_parent == cell, f"the cell's thread's output went to {late_parent}, not the cell ({cell})"
 
 
 def view_ids(kc) -> tuple[str, str]:
-    """The view's widget model id and comm id, from the kernel (idle)."""
+    """The view's widget model id and comm id, from the kernel (idle), made if this kernel has none yet."""
     got = []
-    reply = kc.execute_interactive(
-        "print(view.model_id, view.comm.comm_id)", timeout=30, output_hook=lambda m: got.append(m)
+    code = (
+        "from tutorial.view.widget.widget import MeshcatWidget\n"
+        "if 'view' not in globals():\n    view = MeshcatWidget('subshell test')\n"
+        "print(view.model_id, view.comm.comm_id)"
     )
+    reply = kc.execute_interactive(code, timeout=30, output_hook=lambda m: got.append(m))
     assert reply["content"]["status"] == "ok", reply
     text = "".join(m["content"].get("text", "") for m in got if m["msg_type"] == "stream")
     model_id, comm_id = text.split()
     return model_id, comm_id
+
+
+def test_a_figure_drawn_while_the_view_hears_its_page_stays_the_cells(kernel):
+    """ipykernel's comms fire IPython's pre_execute and post_execute around each message; on the views' subshell
+    they must not: matplotlib's inline backend would show the running cell's figure there, half drawn, and close
+    it (the cell's next pyplot call then draws on a new, second figure)."""
+    kc = kernel
+    _, comm_id = view_ids(kc)
+    kc.execute_interactive("%matplotlib inline", timeout=30)
+    cell = kc.execute(
+        "import matplotlib.pyplot as plt, time\nplt.plot([0, 1])\nprint('drawing', flush=True)\ntime.sleep(2)\n"
+        "plt.title('drawn')\nplt.show()"  # one figure, finished after the view's message: shown once, whole
+    )
+    pictures, scene, done = [], False, False
+    for m in messages(kc, time.monotonic() + 30):
+        content = m["content"]
+        if m["msg_type"] == "stream" and "drawing" in content.get("text", ""):
+            data = {"method": "custom", "content": {"type": "hello", "id": "figure"}}
+            kc.shell_channel.send(kc.session.msg("comm_msg", {"comm_id": comm_id, "data": data}))
+        elif m["msg_type"] == "comm_msg" and content["data"].get("content", {}).get("type") == "scene":
+            scene = True
+        elif m["msg_type"] == "display_data" and "image/png" in content["data"]:
+            pictures.append(m["parent_header"].get("msg_id"))
+        elif m["msg_type"] == "status" and m["parent_header"].get("msg_id") == cell:
+            done = content["execution_state"] == "idle"
+            if done:
+                break
+    assert done and scene, f"the cell ended: {done}; the view answered its hello: {scene}"
+    assert pictures == [cell], f"the figure was shown under {pictures}, not once under the cell ({cell})"

@@ -13,8 +13,10 @@ to be idle, as before.
 
 from __future__ import annotations
 
+import inspect
 import logging
 import threading
+from collections.abc import Callable
 
 
 def current_kernel():
@@ -107,28 +109,43 @@ class ViewSubshell:
         """Send the messages with which a page restores its widgets to ``subshell`` too.  Shell channel's thread.
 
         A page (re)loaded while a cell runs first asks the kernel who it is
-        (``kernel_info_request``: JupyterLab waits 3 s for the answer), then
-        for its widgets: ipywidgets' widget manager (JupyterLab's, Notebook 7's) opens a
-        ``jupyter.widget.control`` comm and asks it for every widget's state,
-        or, if no answer comes within 4 s, asks for the kernel's comms
-        (``comm_info_request``) and then each widget's state.  A view's own
-        comm messages already come to this subshell; these would go to the
-        main shell, behind the running cell, and the page would show no view
-        until the cell ends.  The shell channel's thread takes every shell
-        message first (ipykernel's ``shell_channel_thread_main``, which picks
-        the subshell a message names): this step, before it, makes each of
-        these messages that names no subshell name the views' one, signed
-        anew with the kernel's own key.  Every other message passes unchanged.
+        (``kernel_info_request``: JupyterLab went on without the answer after
+        3 s, measured), then for its widgets: ipywidgets' widget manager
+        (JupyterLab's, Notebook 7's) opens a ``jupyter.widget.control`` comm
+        and asks it for every widget's state, or, if no answer comes within
+        4 s, asks for the kernel's comms (``comm_info_request``) and then each
+        widget's state.  A view's own comm messages already come to this
+        subshell; these would go to the main shell, behind the running cell,
+        and the page would show no view until the cell ends.  The shell
+        channel's thread takes every shell message first (ipykernel's
+        ``shell_channel_thread_main``, which picks the subshell a message
+        names): this step, before it, makes each of these messages that names
+        no subshell name the views' one, signed anew with the kernel's own
+        key.  Every other message passes unchanged, and so does one whose
+        signature is wrong (ipykernel refuses it).  Once handled, the running
+        cell gets its threads' output back (:attr:`after_handled`).
+
+        Raises:
+            RuntimeError: the shell channel is not as ipykernel 7.4 makes it.
         """
         import zmq
 
-        session, pick_subshell = kernel.session, kernel.shell_channel_thread_main
+        session, pick_subshell, stream = kernel.session, kernel.shell_channel_thread_main, kernel.shell_stream
+        if getattr(stream, "_recv_callback", None) != pick_subshell:
+            raise RuntimeError("the kernel's shell stream does not go to shell_channel_thread_main")
         controls: set = set()  # control comms opened, until their request; only this thread uses it
+        asked = (b'"kernel_info_request"', b'"comm_info_request"', b'"comm_open"')
+        failed: list = []  # said once
 
         def restoring(frames) -> bool:
+            # Most messages (a view's answers, cells) pass at once, on their header's bytes alone: reading them
+            # can only decide to leave a message as it came.  The others are read as ipykernel reads them.
+            header = frames[1].bytes
+            if not any(kind in header for kind in asked) and not (controls and b'"comm_msg"' in header):
+                return False
             peeked = session.deserialize(frames, content=False, copy=False)  # signature checked, not yet recorded
             kind = peeked["header"]["msg_type"]
-            if peeked["header"].get("subshell_id") or kind not in _RESTORING:
+            if peeked["header"].get("subshell_id") or kind not in _RESTORING or (kind == "comm_msg" and not controls):
                 return False
             if kind in ("kernel_info_request", "comm_info_request"):
                 return True
@@ -144,22 +161,53 @@ class ViewSubshell:
         async def on_shell_message(msg) -> None:
             try:
                 idents, frames = session.feed_identities(msg, copy=False)
-                if restoring(frames):  # (a message whose signature is wrong raised: it goes on as it came)
-                    whole = session.deserialize(frames, content=True, copy=False)
+                if restoring(frames):
+                    whole = session.deserialize(frames, content=True, copy=False)  # (records the signature)
                     whole["header"]["subshell_id"] = subshell
                     parts = session.serialize(whole, ident=idents) + list(whole.get("buffers", []))
                     msg = [zmq.Frame(part) for part in parts]  # as the stream gives them (copy=False)
             except Exception:  # noqa: BLE001 - passed on as it came: ipykernel's routing says what is wrong with it
-                pass
+                if not failed:
+                    failed.append(True)
+                    logging.getLogger("rtt.views").debug("a shell message kept its route", exc_info=True)
             await pick_subshell(msg)
 
-        kernel.shell_stream.on_recv(on_shell_message, copy=False)
+        # ipykernel makes the message it handles the parent of output from threads: after one of these, handled
+        # on the views' subshell while a cell may run, the cell gets its threads' output back.
+        for kind in _RESTORING:
+            kernel.shell_handlers[kind] = ViewSubshell._then_output_back(kernel.shell_handlers[kind])
+        stream.on_recv(on_shell_message, copy=False)
+
+    # What gives a running cell its threads' output back (tutorial/view/widget/widget.py sets it); any thread.
+    after_handled: Callable[[], None] = staticmethod(lambda: None)
+
+    @staticmethod
+    def _then_output_back(handler):
+        """``handler`` (a kernel's shell handler), then, off the kernel's main thread, :attr:`after_handled`."""
+
+        async def handled(*args, **kwargs):
+            try:
+                result = handler(*args, **kwargs)
+                if inspect.isawaitable(result):
+                    await result
+            finally:
+                if threading.current_thread() is not threading.main_thread():
+                    ViewSubshell.after_handled()
+
+        return handled
 
     @classmethod
     def route(cls, comm) -> bool:
-        """Send ``comm``'s messages from the browser to the views' subshell; whether it could."""
+        """Send ``comm``'s messages from the browser to the views' subshell; whether it could.
+
+        There, they call the comm's callback without IPython's ``pre_execute``
+        and ``post_execute`` events, which ipykernel's comms fire around each
+        message: those belong to the cell on the main shell (matplotlib's
+        inline backend shows and closes the running cell's figures on
+        ``post_execute``)."""
         subshell = cls.id()
         if subshell is None or comm is None or not hasattr(comm, "_reply_subshell_for"):
             return False
         comm._reply_subshell_for = lambda _data, _default: subshell
+        comm.handle_msg = lambda msg: comm._msg_callback and comm._msg_callback(msg)
         return True

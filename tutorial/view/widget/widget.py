@@ -150,6 +150,9 @@ class _CellWatch:
             cls._put_back(kernel)
 
 
+ViewSubshell.after_handled = _CellWatch.give_output_back  # after a reloaded page's questions, too
+
+
 def cell_running() -> bool:
     """Whether the kernel is running a cell now (False outside IPython); any thread."""
     return _CellWatch.busy
