@@ -15,8 +15,8 @@ What a learner does and sees, checked on the page itself:
   tank; turning the turret with the panel turns it in the viewer's view,
   another node's.  Kernel > Restart: the views say they are not live any
   more (a notice over their last frames, and the caption).
-* the notebooks of ``IN_MAKE_TEST`` (``test_run_all``): the setup check
-  and the two above; every notebook ``notebooks/[0-9][0-9]_*.ipynb`` with
+* the notebooks of ``IN_MAKE_TEST`` (``test_run_all``): the two above;
+  every notebook ``notebooks/[0-9][0-9]_*.ipynb`` with
   ``RTT_LAB_ALL=1`` (``make test-lab``).  Run All
   runs every cell once, in order, with no error output and no stderr
   output but the committed notebook's; every live view has its scene from
@@ -80,7 +80,7 @@ pytestmark = [
 ]
 
 ALL = os.environ.get("RTT_LAB_ALL") == "1"  # make test-lab: every notebook
-IN_MAKE_TEST = {"00_setup_check", "01_step1_tank_controller", "03_step3_viewer"}  # the first, and the interactive
+IN_MAKE_TEST = {"01_step1_tank_controller", "03_step3_viewer"}  # the interactive (00: nbval, and make test-lab)
 NOTEBOOKS = sorted(n for n in (ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb") if ALL or n.stem in IN_MAKE_TEST)
 # s, for the whole module: servers, browsers and its notebooks (all ten took 140 to over 175 s here)
 BUDGET = 300.0 if ALL else 150.0

@@ -34,6 +34,7 @@ def stop_when_stale(proc, stale_before: int, timeout=30):
     return proc.summary()
 
 
+@pytest.mark.more  # make test: a replayed drive's viewer ends on the recording's last state (test_bag_replay)
 def test_viewer_ends_on_the_simulations_final_state(procs):
     view = viewer(procs)
     joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "4"))

@@ -131,6 +131,7 @@ ARROWS = [
 ]
 
 
+@pytest.mark.more  # make test: the arrows and the rejections in-process (test_imu), the wall's shake across
 def test_the_arrows_follow_the_numbers_sent_and_bad_ones_are_counted(procs, node):
     from sensor_msgs.msg import Imu
 
