@@ -28,7 +28,7 @@ def current_kernel():
     return Kernel.instance() if Kernel.initialized() else None
 
 
-# What a page sends to restore its widgets (ViewSubshell._restore_there)
+# What a page sends to restore its widgets (ViewSubshell._restore_there); their handlers give output back
 _RESTORING = ("kernel_info_request", "comm_info_request", "comm_open", "comm_msg")
 
 
@@ -48,9 +48,9 @@ class ViewSubshell:
     What it costs: each view message makes the kernel say "busy" then "idle"
     on its own (Jupyter's kernel indicator may show idle while a cell
     runs); and ipykernel makes each message it handles the parent of
-    output from threads, so the view's handler gives that back to the
-    running cell (:meth:`_CellWatch.give_output_back`: all but what a
-    thread prints while a view's message is being handled).
+    output from threads, so each handler, on this subshell, gives that back
+    to the running cell afterwards (:attr:`after_handled`: all but what a
+    thread prints while the message is being handled).
 
     Where ipykernel has no subshells (before 7) or no comm routing (before
     7.4), or outside a kernel, :meth:`id` is None and views wait for the
@@ -87,6 +87,10 @@ class ViewSubshell:
         def create() -> None:  # on the shell channel's thread, as ipykernel's own create_subshell_request
             try:
                 made["id"] = thread.manager._create_subshell()
+                # ipykernel makes the message it handles the parent of output from threads: after one handled on
+                # the views' subshell (a view's, a reloaded page's) while a cell may run, the cell gets it back.
+                for kind in _RESTORING:
+                    kernel.shell_handlers[kind] = ViewSubshell._then_output_back(kernel.shell_handlers[kind])
                 try:
                     ViewSubshell._restore_there(kernel, made["id"])
                 except Exception:  # noqa: BLE001 - an ipykernel whose shell channel is made otherwise: said, not fatal
@@ -122,8 +126,7 @@ class ViewSubshell:
         names): this step, before it, makes each of these messages that names
         no subshell name the views' one, signed anew with the kernel's own
         key.  Every other message passes unchanged, and so does one whose
-        signature is wrong (ipykernel refuses it).  Once handled, the running
-        cell gets its threads' output back (:attr:`after_handled`).
+        signature is wrong (ipykernel refuses it).
 
         Raises:
             RuntimeError: the shell channel is not as ipykernel 7.4 makes it.
@@ -134,7 +137,7 @@ class ViewSubshell:
         if getattr(stream, "_recv_callback", None) != pick_subshell:
             raise RuntimeError("the kernel's shell stream does not go to shell_channel_thread_main")
         controls: set = set()  # control comms opened, until their request; only this thread uses it
-        asked = (b'"kernel_info_request"', b'"comm_info_request"', b'"comm_open"')
+        asked = tuple(f'"{kind}"'.encode() for kind in _RESTORING if kind != "comm_msg")  # comm_msg: controls
         failed: list = []  # said once
 
         def restoring(frames) -> bool:
@@ -172,10 +175,6 @@ class ViewSubshell:
                     logging.getLogger("rtt.views").debug("a shell message kept its route", exc_info=True)
             await pick_subshell(msg)
 
-        # ipykernel makes the message it handles the parent of output from threads: after one of these, handled
-        # on the views' subshell while a cell may run, the cell gets its threads' output back.
-        for kind in _RESTORING:
-            kernel.shell_handlers[kind] = ViewSubshell._then_output_back(kernel.shell_handlers[kind])
         stream.on_recv(on_shell_message, copy=False)
 
     # What gives a running cell its threads' output back (tutorial/view/widget/widget.py sets it); any thread.

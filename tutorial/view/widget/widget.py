@@ -150,7 +150,7 @@ class _CellWatch:
             cls._put_back(kernel)
 
 
-ViewSubshell.after_handled = _CellWatch.give_output_back  # after a reloaded page's questions, too
+ViewSubshell.after_handled = _CellWatch.give_output_back  # after each message the views' subshell handles
 
 
 def cell_running() -> bool:
@@ -228,13 +228,6 @@ class MeshcatWidget(anywidget.AnyWidget):
                 self.probe.append((n, time.monotonic_ns()))
 
     # ---- the views' subshell (else the kernel's thread): what the browser says ---------------------------
-    def _handle_msg(self, msg) -> None:
-        try:
-            super()._handle_msg(msg)
-        finally:
-            if self.off_main:  # handled while a cell may run: its threads' output stays the cell's
-                _CellWatch.give_output_back()
-
     def _on_message(self, _widget, content, buffers) -> None:
         self.last_heard = time.monotonic()
         kind = content.get("type") if isinstance(content, dict) else None
