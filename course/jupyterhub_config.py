@@ -23,6 +23,8 @@
 #                       and 215-232; tests pick their own)
 #   RTT_HUB_FRAME_RATE  the learners' live views' frames per second, at most (default 20: a server's CPU is
 #                       shared; a learner's own machine draws 60)
+#   RTT_HUB_REALTIME_SLICE_MS  how far ahead of real time a learner's simulation runs before it sleeps (default
+#                       10 ms; 0.2 as on a learner's own machine, where CPU is not shared)
 #   RTT_HUB_PER_LEARNER_NETWORK  "1" when the spawner gives each learner a network namespace (containers,
 #                       pods): domains may then repeat
 #   RTT_HUB_WORKED_SOLUTIONS  "shown" to keep the notebooks' folded worked solutions in the learners' copies (a
@@ -117,6 +119,10 @@ c.Spawner.environment = {
     # Live views draw at most this many frames a second (tutorial/app/frame_clock.py; 60 on a learner's own
     # machine): each frame costs the server, and the book's Benchmarks page says how many learners it holds.
     "RTT_FRAME_RATE": os.environ.get("RTT_HUB_FRAME_RATE", "20"),
+    # A simulation keeps real time in slices of 10 ms, not 0.2 ms (tutorial/core/simulator.py): each wake-up
+    # costs about 0.1 ms of CPU, so a learner's tank at 1 kHz costs 0.05 cores less.  The lessons' topics
+    # (50 Hz) and views (20 frames/s) are far slower than 10 ms; a 1 kHz publisher's messages come in tens.
+    "RTT_REALTIME_SLICE_MS": os.environ.get("RTT_HUB_REALTIME_SLICE_MS", "10"),
     # One thread each for NumPy's BLAS and OpenMP (not one per core of a large server): threads count
     # against a learner's processes (course/limits.py), and the lessons' arrays are small.
     "OPENBLAS_NUM_THREADS": "1",

@@ -61,17 +61,20 @@ def test_learners_targets_and_plot(tmp_path):
     from benchmarks.plots import plot_learners
     from benchmarks.targets import LEARNERS_TARGETS
 
-    def one(n, rtf, age_p99, mb):
+    def one(n, rtf, age_p99, mb, cores=0.19):
         return {
             "real_time_factor": [rtf] * n, "real_time_factor_min": rtf, "age_ms_p99_max": age_p99,
             "age_ms_pooled": {"p50": age_p99 / 3}, "memory_mb_per_learner_mean": mb, "cores_busy": 0.25 * n,
-            "cores_by_role": {"kernels": 0.16 * n, "learners' servers": 0.05 * n},
+            "cores_by_role": {"kernels": 0.14 * n, "learners' servers": 0.05 * n}, "cores_per_learner": cores,
         }  # fmt: skip
 
-    run = {"machine": {"cpus": 2}, "when": "now", "learners": {"1": one(1, 1.0, 0.8, 277), "8": one(8, 1.0, 1.5, 232)}}
-    rtf, age, memory = (t.row(run) for t in LEARNERS_TARGETS)
-    assert rtf["pass"] and age["pass"] and memory["pass"] and age["measured"] == "1.5 ms"
-    run["learners"]["8"] = one(8, 0.98, 1.7, 1100)  # behind real time, ages past 2 x 0.8 ms, over 1 GiB
+    run = {"machine": {"cpus": 2}, "when": "now", "learners": {"1": one(1, 1.0, 0.8, 277), "8": one(8, 1.0, 32.9, 232)},
+           "learners_before": {"1": one(1, 1.0, 0.9, 277, cores=0.49)}}  # fmt: skip
+    rtf, age, memory, cores = (t.row(run) for t in LEARNERS_TARGETS)
+    assert rtf["pass"] and age["pass"] and memory["pass"] and cores["pass"] and age["measured"] == "32.9 ms"
+    assert cores["measured"] == "0.190 cores" and "before 2026-11-27 0.490 cores" in cores["baseline"]
+    run["learners"]["8"] = one(8, 0.98, 33.1, 1100)  # behind real time, ages past 33 ms, over 1 GiB
+    run["learners"]["1"] = one(1, 1.0, 0.8, 277, cores=0.21)  # a learner costs over a fifth of a core
     assert not any(t.row(run)["pass"] for t in LEARNERS_TARGETS)
     assert [t.row({}) for t in LEARNERS_TARGETS if t.needs is None or {}.get(t.needs)] == []  # not run: left out
     path = plot_learners(run, tmp_path / "bench_learners.png")
@@ -95,7 +98,7 @@ def test_a_class_that_fails_keeps_the_smaller_classes_figures(monkeypatch, tmp_p
             "real_time_factor": [1.0] * n, "real_time_factor_min": 1.0, "age_ms_p99_max": 3.0 * n,
             "age_ms_pooled": {"p50": 1.0}, "memory_mb_per_learner_mean": 250.0, "cores_busy": 0.4 * n,
             "cores_by_role": {"kernels": 0.2 * n}, "learners_with_no_state_in_window": 0, "frames_per_s_min": 38.0,
-            "client_cores": 0.05,
+            "client_cores": 0.05, "cores_per_learner": 0.2,
         }  # fmt: skip
 
     monkeypatch.setattr(learners, "one_class", one_class)
@@ -105,8 +108,8 @@ def test_a_class_that_fails_keeps_the_smaller_classes_figures(monkeypatch, tmp_p
     assert out["8"] == {"learners": 8, "failed": "TimeoutError: a learner's cell did not finish"}
     assert "8 learners: the class failed (TimeoutError" in capsys.readouterr().out
     run = {"machine": {"cpus": 2}, "when": "now", "learners": out}
-    assert [t.row(run)["measured"] for t in LEARNERS_TARGETS] == ["n/a"] * 3
-    assert not any(t.row(run)["pass"] for t in LEARNERS_TARGETS)
+    assert [t.row(run)["measured"] for t in LEARNERS_TARGETS[:3]] == ["n/a"] * 3  # the class of 8's
+    assert not any(t.row(run)["pass"] for t in LEARNERS_TARGETS[:3])
     assert plot_learners(run, tmp_path / "bench_learners.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

@@ -108,6 +108,7 @@ def test_each_learners_robots_are_their_own(hub):
     assert env_a["RTT_ASSIGNED_ROS_DOMAIN_ID"] == env_a["ROS_DOMAIN_ID"]
     assert env_a["ROS_AUTOMATIC_DISCOVERY_RANGE"] == env_b["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
     assert env_a["RTT_FRAME_RATE"] == "20"  # a class's server: live views at 20 frames/s (the Benchmarks page)
+    assert env_a["RTT_REALTIME_SLICE_MS"] == "10"  # ... and its simulations wake up every 10 ms, not every step
     book = json.loads((hub_state(hub) / "ros_domains.json").read_text())
     assert book == {"learner-a": int(env_a["ROS_DOMAIN_ID"]), "learner-b": int(env_b["ROS_DOMAIN_ID"])}
     given = hub_state(hub) / "homes" / "learner-a" / "notebooks" / "01_step1_tank_controller.ipynb"

@@ -89,3 +89,55 @@ def test_a_paused_simulation_stops_when_asked():
     sim.pause()
     sim.request_stop()
     assert sim.join(10) and sim.error is None
+
+
+def test_the_realtime_slice_comes_from_the_environment_or_a_clear_error():
+    """A class's server sets RTT_REALTIME_SLICE_MS (course/jupyterhub_config.py); elsewhere a step at a time."""
+    import pytest
+
+    from tutorial.core.simulator import REALTIME_MIN_SLEEP, realtime_slice
+
+    assert realtime_slice(None) == realtime_slice(" ") == REALTIME_MIN_SLEEP == 0.0002
+    assert realtime_slice("10") == 0.010 and realtime_slice("0.2") == 0.0002 and realtime_slice("50") == 0.050
+    for bad in ("0", "0.1", "51", "-10", "nan", "inf", "ten"):
+        with pytest.raises(ValueError, match=r"RTT_REALTIME_SLICE_MS must be milliseconds from 0.2 to 50"):
+            realtime_slice(bad)
+
+
+class Clocked(SimpleController):
+    """Keeps each step's wall time (simulation thread)."""
+
+    def initialize(self, io):
+        import time
+
+        self.wall, self.clock = [], time.perf_counter
+        return True
+
+    def control(self):
+        self.wall.append(self.clock())
+        return True
+
+
+def _gaps_over_3_ms(slice_ms, monkeypatch) -> tuple[int, float]:
+    """A 0.6 s real-time run: the steps followed by a sleep over 3 ms, and the real-time factor."""
+    if slice_ms is None:
+        monkeypatch.delenv("RTT_REALTIME_SLICE_MS", raising=False)
+    else:
+        monkeypatch.setenv("RTT_REALTIME_SLICE_MS", slice_ms)
+    model = build_world([ModelEntry("Room", MODEL / "room.xml"), ModelEntry("Tank", MODEL / "tank.xml")])
+    clocked = Clocked()
+    sim = Simulator(model, mujoco.MjData(model), [Attachment("C", clocked, "Tank")], realtime_sync=True, duration=0.6)
+    sim.start()
+    assert sim.join(30) and sim.error is None
+    gaps = [b - a for a, b in zip(clocked.wall, clocked.wall[1:])]
+    return sum(g > 0.003 for g in gaps), sim.real_time_factor
+
+
+def test_a_class_server_s_simulation_keeps_real_time_in_slices(monkeypatch):
+    """With RTT_REALTIME_SLICE_MS=10 the thread runs ~10 steps, then sleeps ~10 ms: fewer wake-ups, same time."""
+    sliced, rtf = _gaps_over_3_ms("10", monkeypatch)
+    assert 0.97 <= rtf <= 1.01, rtf
+    assert 40 <= sliced <= 62, sliced  # about 60 sleeps of about 10 ms (a late one can take two slices)
+    stepwise, rtf = _gaps_over_3_ms(None, monkeypatch)
+    assert 0.97 <= rtf <= 1.01, rtf
+    assert stepwise <= 5, stepwise  # a sleep before nearly every step, each well under 3 ms

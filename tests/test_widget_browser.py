@@ -145,7 +145,7 @@ def test_scene_and_frames_draw_and_each_is_answered(view):
 def test_two_frames_drawn_together_are_answered_once_and_a_lone_frame_on_its_own(view):
     page, errors = view
     frame(page, [pack_batch([move(0.5)])])  # whatever was owed before is answered
-    page.wait_for_timeout(200)  # two animation frames at 60 Hz and more: no answer left owed
+    page.wait_for_timeout(300)  # six animation frames at 60 Hz (0.1 s) and more: no answer left owed
     before = page.evaluate("window.sent.length")
     page.evaluate(  # two frames in one task: drawn in the same animation frame
         "([a, b]) => { for (const m of [a, b]) window.deliver({type: 'frame'}, "
@@ -241,7 +241,7 @@ def test_cut_off_from_its_kernel_the_view_says_it_is_not_live_and_an_answer_take
     assert caption.inner_text().startswith("test view (live): running")
     before = page.evaluate("window.sent.length")
     page.evaluate("window.trigger('comm_live_update')")
-    # one ping for the cut-off (a frame's lone answer, two animation frames late, may be sent beside it)
+    # one ping for the cut-off (a frame's lone answer, six animation frames late, may be sent beside it)
     asked = page.evaluate(f"window.sent.slice({before}).map(m => m.type)")
     assert asked.count("ping") == 1 and set(asked) <= {"ping", "drawn"}, asked
     notice = page.locator(".rtt-not-live")

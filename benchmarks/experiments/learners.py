@@ -53,6 +53,10 @@ LEARNERS = (1, 2, 4, 8, 16)
 # ROS domains for the hub to give out: one upper block (215-232) and 101, clear of the 1-100 that test
 # sessions and the other benchmarks pick from.
 DOMAINS = (101, *range(215, 233))
+LONE_WAIT = 6  # animation frames a lone frame waits for its answer: widget.js's LONE_WAIT
+# The code path before 2026-11-27, kept for a same-run baseline (--before): a view answered a lone frame two
+# animation frames later, and a class's simulation slept before every step (the hub's RTT_HUB_REALTIME_SLICE_MS).
+BEFORE = {"lone_wait": 2, "hub_env": {"RTT_HUB_REALTIME_SLICE_MS": "0.2"}}
 
 # A learner's first cell: what notebook 03's set-up cell imports, and ROS 2 initialised.
 PREPARE = """\
@@ -121,12 +125,12 @@ class ViewClient:
 
     It acts as widget.js does without drawing: a view's ``hello`` on its
     comm's opening, then ``drawn`` for the frames as they arrive, two at a
-    time, a lone frame two 60 Hz frames later.  Frames are counted with their
+    time, a lone frame six 60 Hz frames later.  Frames are counted with their
     arrival times (monotonic ns).  One asyncio task.
     """
 
-    def __init__(self, url: str, token: str):
-        self.url, self.token = url, token
+    def __init__(self, url: str, token: str, lone_wait: int = LONE_WAIT):
+        self.url, self.token, self.lone_wait = url, token, lone_wait
         self.frames: list[tuple[int, int]] = []  # (arrival, ns; its buffers' bytes)
         self.scenes = 0
         self.views: list[str] = []
@@ -201,10 +205,10 @@ class ViewClient:
                     future.set_result(None)
 
     def _settle_later(self, comm: str) -> None:
-        """Answer a lone frame as widget.js does: two animation frames (60 Hz) later, unless a second came."""
+        """Answer a lone frame as widget.js does: six animation frames (60 Hz) later, unless a second came."""
 
         async def settle() -> None:
-            await asyncio.sleep(2 / 60)
+            await asyncio.sleep(self.lone_wait / 60)
             await self._settle(comm)
 
         task = asyncio.get_running_loop().create_task(settle())
@@ -252,6 +256,9 @@ ROLES = (
 )
 
 
+LEARNER_ROLES = ("kernels", "learners' servers", "joysticks")
+
+
 def _role(p: psutil.Process) -> str:
     line = " ".join(p.cmdline())
     for key, role in ROLES:
@@ -294,12 +301,19 @@ def _pss_mb(procs: list[psutil.Process]) -> float:
     return total / 2**20
 
 
-def one_class(n: int, seconds: float, warmup: float, directory: Path, frame_rate: float | None = None) -> dict:
-    """N learners at once: each one's figures, and the machine's (``frame_rate``: the hub's, else its default)."""
+def one_class(
+    n: int, seconds: float, warmup: float, directory: Path, frame_rate: float | None = None, before: bool = False
+) -> dict:
+    """N learners at once: each one's figures, and the machine's (``frame_rate``: the hub's, else its default).
+
+    ``before``: the code path of before 2026-11-27 (:data:`BEFORE`), where it can still be chosen.
+    """
     from tests.hub import Hub, Learner
 
     names = [f"learner{i + 1:02d}" for i in range(n)]
     env = {} if frame_rate is None else {"RTT_HUB_FRAME_RATE": str(frame_rate)}
+    if before:
+        env.update(BEFORE["hub_env"])
     hub = Hub(directory / "hub", names, DOMAINS[:n], extra_env=env, timeout=120)
     try:
         learners = [Learner(hub, name) for name in names]
@@ -315,7 +329,8 @@ def one_class(n: int, seconds: float, warmup: float, directory: Path, frame_rate
             r = learner.api("POST", "api/kernels", json={"name": "python3"})
             r.raise_for_status()
             learner.kernel_id = r.json()["id"]
-        return asyncio.run(_measure(hub, learners, seconds, warmup, directory))
+        lone_wait = BEFORE["lone_wait"] if before else LONE_WAIT
+        return asyncio.run(_measure(hub, learners, seconds, warmup, directory, lone_wait))
     except BaseException:
         print(f"the hub's log, its end:\n{hub.log()[-3000:]}", file=sys.stderr)
         raise
@@ -323,12 +338,12 @@ def one_class(n: int, seconds: float, warmup: float, directory: Path, frame_rate
         hub.close()
 
 
-async def _measure(hub, learners, seconds: float, warmup: float, directory: Path) -> dict:
+async def _measure(hub, learners, seconds: float, warmup: float, directory: Path, lone_wait: int) -> dict:
     n = len(learners)
     clients = []
     for learner in learners:
         url = f"ws://127.0.0.1:{hub.port}/user/{learner.name}/api/kernels/{learner.kernel_id}/channels"
-        client = ViewClient(url, learner.token)
+        client = ViewClient(url, learner.token, lone_wait)
         await client.connect()
         clients.append(client)
     probes = [directory / f"{learner.name}.json" for learner in learners]
@@ -396,6 +411,9 @@ async def _measure(hub, learners, seconds: float, warmup: float, directory: Path
         "cores_busy": round(busy / (t1 - t0), 2),
         "client_cores": round(own / (t1 - t0), 2),
         "cores_by_role": roles,
+        # what a learner costs the server: their kernel, their Jupyter server and their joystick (the hub, its
+        # proxy and the stand-in browsers are the class's, or not the server's)
+        "cores_per_learner": round(sum(roles.get(k, 0.0) for k in LEARNER_ROLES) / n, 3),
         "summary_real_time_factor": [f["real_time_factor"] for f in finished],
         "errors": [f["error"] for f in finished if f["error"]],
     }
@@ -437,7 +455,9 @@ def _in_window(p: dict, window: tuple[int, int]) -> dict:
     }
 
 
-def learners_per_server(counts, seconds: float, warmup: float, frame_rate: float | None = None) -> dict:
+def learners_per_server(
+    counts, seconds: float, warmup: float, frame_rate: float | None = None, before: bool = False
+) -> dict:
     """The class sizes in turn; each one's figures.
 
     A class that fails (the machine too loaded for a learner's cell to
@@ -449,7 +469,7 @@ def learners_per_server(counts, seconds: float, warmup: float, frame_rate: float
     for n in counts:
         try:
             with tempfile.TemporaryDirectory() as d:
-                out[str(n)] = one_class(n, seconds, warmup, Path(d), frame_rate)
+                out[str(n)] = one_class(n, seconds, warmup, Path(d), frame_rate, before)
         except Exception as error:  # noqa: BLE001 - kept as this size's result, with what went wrong
             out[str(n)] = {"learners": n, "failed": f"{type(error).__name__}: {error}"[:500]}
             print(f"{n:3d} learners: the class failed ({out[str(n)]['failed']}); no larger class tried", flush=True)
@@ -464,8 +484,9 @@ def learners_per_server(counts, seconds: float, warmup: float, frame_rate: float
                 else f"{r['learners_with_no_state_in_window']} learner(s) shown no state in the window, "
             )
             + f"frames/s min {r['frames_per_s_min']:.1f}, "
-            f"{r['memory_mb_per_learner_mean']:.0f} MB/learner, {r['cores_busy']:.2f} cores busy "
-            f"(client {r['client_cores']:.2f})",
+            f"{r['memory_mb_per_learner_mean']:.0f} MB/learner, {r['cores_per_learner']:.3f} cores/learner, "
+            f"{r['cores_busy']:.2f} cores busy (client {r['client_cores']:.2f})"
+            + (" [code path before]" if before else ""),
             flush=True,
         )
     return out
@@ -478,6 +499,7 @@ def main(argv=None) -> int:
     p.add_argument("--warmup", type=float, default=3.0)
     p.add_argument("--frame-rate", type=float, default=None, help="the live views' frames/s (default: the hub's)")
     p.add_argument("--output", default=None, help="a folder: learners.json and its plot, bench_learners.png")
+    p.add_argument("--before", action="store_true", help="also one learner on the code path before 2026-11-27")
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))  # the hub gives each learner theirs
@@ -492,6 +514,8 @@ def main(argv=None) -> int:
         "frame_rate": args.frame_rate,
         "learners": learners_per_server(args.learners, args.seconds, args.warmup, args.frame_rate),
     }
+    if args.before:
+        r["learners_before"] = learners_per_server([1], args.seconds, args.warmup, args.frame_rate, before=True)
     if args.output:
         out = Path(args.output)
         out.mkdir(parents=True, exist_ok=True)

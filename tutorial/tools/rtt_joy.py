@@ -22,6 +22,7 @@ from tutorial.interfaces import joy
 from tutorial.joystick.publisher import JoyPublisher
 from tutorial.ros import env as ros_env
 from tutorial.ros import program as ros_program
+from tutorial.ros.spin import SpinThread
 
 NODE_NAME = "rtt_joy"
 
@@ -82,20 +83,21 @@ def main(argv: list[str] | None = None) -> int:
     ros_env.use_localhost_by_default()
     with contextlib.ExitStack() as stack:
         source, what = choose_source(args, stack)
-        # Ctrl-C and SIGTERM end the loop below: raised as KeyboardInterrupt inside spin_once, they
-        # could leave one of rclpy's tasks half made, whose clean-up then printed a traceback.
+        # Ctrl-C and SIGTERM end the loop below through a flag: raised as KeyboardInterrupt inside rclpy,
+        # they could leave one of its tasks half made, whose clean-up then printed a traceback.
         stop = ros_program.StopRequest().install()
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
         node = rclpy.create_node(NODE_NAME)
         pub = JoyPublisher(node, source, rate=args.rate, autorepeat=args.autorepeat, duration=args.duration)
         print(f"[{node.get_fully_qualified_name()}] publishing {joy.TOPIC} from {what}", flush=True)
+        spin = SpinThread(node).start()  # the node's own services answer there; the ticks run here
         try:
-            while rclpy.ok() and not pub.done and not stop.requested:
-                rclpy.spin_once(node, timeout_sec=0.1)
+            pub.run(lambda: stop.requested or not rclpy.ok())
         except ExternalShutdownException:
             pass
         finally:
             ros_program.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
+            spin.stop()
             node.destroy_node()
             rclpy.try_shutdown()
         print(f"[{NODE_NAME}] published {pub.published} messages", flush=True)
