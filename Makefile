@@ -111,7 +111,7 @@ mutate: $(VENV)/.installed
 
 # The cases make test leaves out to stay under 10 minutes, each of a kind make test keeps one real case of
 # (marked "more": two more faults, two more network set-ups, one more robot across processes, and the mistakes
-# only the exercises' hidden cases catch past the first of each exercise): about 2.5 minutes.
+# only the exercises' hidden cases catch past the first of each exercise, and more): about 3.5 minutes.
 test-more: $(VENV)/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m more -q

@@ -1,8 +1,11 @@
 """Step 1 across real processes: rtt-joy --demo drives rtt-run project/step1.yaml over /joy."""
 
+import pytest
+
 from conftest import module_command
 
 
+@pytest.mark.more  # make test: each hub learner's demo joystick drives their own tank across processes (test_hub)
 def test_demo_joy_drives_the_simulated_tank(procs):
     joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "15"))
     joy.wait_for_line(lambda line: "publishing /joy" in line, timeout=30)

@@ -123,6 +123,7 @@ HOSTILE = [
 ]
 
 
+@pytest.mark.more  # make test: the same rejections counted in-process (test_fuzz_messages, test_joint_matching)
 def test_hostile_publisher_is_counted_exactly(procs, node):
     from sensor_msgs.msg import JointState
 
