@@ -340,8 +340,9 @@ LEARNERS_TARGETS = (
         AT_MOST,
         read("learners", "1", "cores_per_learner"),
         "{:.3f} cores",
-        baseline=read("learners_before", "1", "cores_per_learner"),
-        baseline_fmt="the code path before 2026-11-27 {:.3f} cores",
+        # for reference only (held against the limit): a before-run that failed reads n/a, never a crash
+        baseline=lambda r: ((r.get("learners_before") or {}).get("1") or {}).get("cores_per_learner"),
+        baseline_fmt="before the slice and lone-wait cuts {:.3f} cores",
         needs="learners",
     ),
 )

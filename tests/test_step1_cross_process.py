@@ -5,7 +5,7 @@ import pytest
 from conftest import module_command
 
 
-@pytest.mark.more  # make test: each hub learner's demo joystick drives their own tank across processes (test_hub)
+@pytest.mark.more  # make test: a hub learner's demo joystick drives their Step 2 tank across processes (test_hub)
 def test_demo_joy_drives_the_simulated_tank(procs):
     joy = procs(module_command("tutorial.tools.rtt_joy", "--demo", "--duration", "15"))
     joy.wait_for_line(lambda line: "publishing /joy" in line, timeout=30)

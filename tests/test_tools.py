@@ -60,7 +60,8 @@ def test_a_bad_ros_argument_is_one_line_and_status_2(prog, ros_args):
     assert line.startswith(f"{prog}: bad ROS arguments after --ros-args: Failed to parse ROS arguments: "), line
 
 
-@pytest.mark.more  # make test: the plot in-process (above), and notebook 03's graph of its running nodes (nbval)
+@pytest.mark.more  # make test: the plot in-process (above), notebook 02's live plot and 03's graph (nbval); the
+# programs' own command lines (--json, --output, --wait) only here
 def test_plot_and_graph_of_a_running_step2(procs, tmp_path):
     png = tmp_path / "plot.png"
     graph_png = tmp_path / "graph.png"

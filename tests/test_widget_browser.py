@@ -235,6 +235,51 @@ def test_a_scene_for_another_view_is_ignored(view):
     assert page.evaluate("window.el.rttView")["scenes"] == before["scenes"]
 
 
+def test_at_20_frames_a_second_two_frames_are_answered_once_and_a_lone_one_after_a_tenth_of_a_second(view):
+    """A class's 20 frames/s: the second frame comes 50 ms after the first, before the lone wait (0.1 s) ends."""
+    page, errors = view
+    frame(page, [pack_batch([move(0.5)])])  # whatever was owed before is answered
+    page.wait_for_timeout(300)  # a lone answer, were one owed, would have gone by now
+    before, errors_before = page.evaluate("window.sent.length"), len(errors)
+    times = page.evaluate(  # two frames 50 ms apart; then a lone one, timed from its delivery to its answer
+        """async ([a, b]) => {
+          const put = (m) => window.deliver({type: 'frame'},
+            [new DataView(Uint8Array.from(atob(m), (c) => c.charCodeAt(0)).buffer)]);
+          const drawn = () => window.sent.filter((m) => m.type === 'drawn').length;
+          const answered = (n) => new Promise((done) => {
+            const look = () => (drawn() >= n ? done() : setTimeout(look, 2));
+            look();
+          });
+          const start = drawn();
+          put(a);
+          await new Promise((done) => setTimeout(done, 50));
+          put(b);
+          await answered(start + 1);
+          await new Promise((done) => setTimeout(done, 300));
+          const t0 = performance.now();
+          put(a);
+          await answered(start + 2);
+          return {pair_answers: drawn() - start - 1, lone_ms: performance.now() - t0};
+        }""",
+        b64([pack_batch([move(1.0)]), pack_batch([move(1.5)])]),
+    )
+    answers = [m for m in page.evaluate("window.sent")[before:] if m["type"] == "drawn"]
+    assert answers == [{"type": "drawn", "frames": 2}, {"type": "drawn", "frames": 1}], answers
+    assert 100 <= times["lone_ms"] <= 1000, times  # drawn in the next animation frame, answered 0.1 s after that
+    assert errors[errors_before:] == []
+
+
+def test_the_benchmarks_stand_in_browser_waits_as_long_as_the_view():
+    """benchmarks/experiments/learners.py answers lone frames as widget.js does: the same wait, kept in step."""
+    import re
+
+    from benchmarks.experiments.learners import LONE_WAIT_MS
+    from tutorial.view.widget.widget import MeshcatWidget
+
+    found = re.search(r"const LONE_WAIT_MS = (\d+);", MeshcatWidget._esm)
+    assert found and int(found.group(1)) == LONE_WAIT_MS == 100
+
+
 def test_cut_off_from_its_kernel_the_view_says_it_is_not_live_and_an_answer_takes_that_back(view):
     page, _ = view
     caption = page.locator(".rtt-caption")

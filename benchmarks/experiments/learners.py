@@ -53,10 +53,10 @@ LEARNERS = (1, 2, 4, 8, 16)
 # ROS domains for the hub to give out: one upper block (215-232) and 101, clear of the 1-100 that test
 # sessions and the other benchmarks pick from.
 DOMAINS = (101, *range(215, 233))
-LONE_WAIT = 6  # animation frames a lone frame waits for its answer: widget.js's LONE_WAIT
+LONE_WAIT_MS = 100  # how long a lone frame waits for its answer: widget.js's LONE_WAIT_MS
 # The code path before 2026-11-27, kept for a same-run baseline (--before): a view answered a lone frame two
 # animation frames later, and a class's simulation slept before every step (the hub's RTT_HUB_REALTIME_SLICE_MS).
-BEFORE = {"lone_wait": 2, "hub_env": {"RTT_HUB_REALTIME_SLICE_MS": "0.2"}}
+BEFORE = {"lone_wait_ms": 2000 / 60, "hub_env": {"RTT_HUB_REALTIME_SLICE_MS": "0.2"}}
 
 # A learner's first cell: what notebook 03's set-up cell imports, and ROS 2 initialised.
 PREPARE = """\
@@ -125,12 +125,12 @@ class ViewClient:
 
     It acts as widget.js does without drawing: a view's ``hello`` on its
     comm's opening, then ``drawn`` for the frames as they arrive, two at a
-    time, a lone frame six 60 Hz frames later.  Frames are counted with their
+    time, a lone frame 0.1 s later.  Frames are counted with their
     arrival times (monotonic ns).  One asyncio task.
     """
 
-    def __init__(self, url: str, token: str, lone_wait: int = LONE_WAIT):
-        self.url, self.token, self.lone_wait = url, token, lone_wait
+    def __init__(self, url: str, token: str, lone_wait_ms: float = LONE_WAIT_MS):
+        self.url, self.token, self.lone_wait_ms = url, token, lone_wait_ms
         self.frames: list[tuple[int, int]] = []  # (arrival, ns; its buffers' bytes)
         self.scenes = 0
         self.views: list[str] = []
@@ -205,10 +205,10 @@ class ViewClient:
                     future.set_result(None)
 
     def _settle_later(self, comm: str) -> None:
-        """Answer a lone frame as widget.js does: six animation frames (60 Hz) later, unless a second came."""
+        """Answer a lone frame as widget.js does: 0.1 s later, unless a second came."""
 
         async def settle() -> None:
-            await asyncio.sleep(self.lone_wait / 60)
+            await asyncio.sleep(self.lone_wait_ms / 1000)
             await self._settle(comm)
 
         task = asyncio.get_running_loop().create_task(settle())
@@ -227,7 +227,7 @@ class ViewClient:
 
     async def close(self) -> None:
         for task in list(self._settling):
-            task.cancel()  # answers still due two frames later: the page is closing
+            task.cancel()  # lone frames' answers still due: the page is closing
         if self._ws is not None:
             await self._ws.close()
             self._reader.cancel()
@@ -329,8 +329,8 @@ def one_class(
             r = learner.api("POST", "api/kernels", json={"name": "python3"})
             r.raise_for_status()
             learner.kernel_id = r.json()["id"]
-        lone_wait = BEFORE["lone_wait"] if before else LONE_WAIT
-        return asyncio.run(_measure(hub, learners, seconds, warmup, directory, lone_wait))
+        lone_wait_ms = BEFORE["lone_wait_ms"] if before else LONE_WAIT_MS
+        return asyncio.run(_measure(hub, learners, seconds, warmup, directory, lone_wait_ms))
     except BaseException:
         print(f"the hub's log, its end:\n{hub.log()[-3000:]}", file=sys.stderr)
         raise
@@ -338,12 +338,12 @@ def one_class(
         hub.close()
 
 
-async def _measure(hub, learners, seconds: float, warmup: float, directory: Path, lone_wait: int) -> dict:
+async def _measure(hub, learners, seconds: float, warmup: float, directory: Path, lone_wait_ms: float) -> dict:
     n = len(learners)
     clients = []
     for learner in learners:
         url = f"ws://127.0.0.1:{hub.port}/user/{learner.name}/api/kernels/{learner.kernel_id}/channels"
-        client = ViewClient(url, learner.token, lone_wait)
+        client = ViewClient(url, learner.token, lone_wait_ms)
         await client.connect()
         clients.append(client)
     probes = [directory / f"{learner.name}.json" for learner in learners]

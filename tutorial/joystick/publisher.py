@@ -28,9 +28,9 @@ class JoyPublisher:
 
     It reads the source on a plain loop, not an rclpy timer: an executor's
     ``spin_once`` builds its wait set again at every tick, and at 60 Hz that
-    cost ``rtt-joy --demo`` 0.067 cores against 0.029 for the loop, with a
-    spin thread beside it for the node's services (``benchmarks/RESULTS.md``,
-    *A class on one server*).
+    cost ``rtt-joy --demo`` 0.067 cores; the loop, with an idle spin thread
+    beside it for the node's services, 0.031 to 0.032
+    (``benchmarks/RESULTS.md``, *What a learner costs a class's server*).
     """
 
     def __init__(self, node, source, rate=60.0, autorepeat=20.0, duration=None):
@@ -52,13 +52,16 @@ class JoyPublisher:
     def run(self, stop_requested) -> None:
         """Read and publish every ``1/rate`` s until the source ends, the duration is up or ``stop_requested()``.
 
-        A tick that comes late is not made up: the next one is due a period after it.
+        Ticks that come late are not made up: after a stall the next tick is at once, and the ones after it
+        a period apart.  ``stop_requested`` is asked at least every 0.1 s, whatever the rate.
         """
         due = time.monotonic()
         while not self.done and not stop_requested():
-            self.tick()
-            due = max(due + self.period, time.monotonic())
-            time.sleep(max(0.0, due - time.monotonic()))
+            now = time.monotonic()
+            if now >= due:
+                self.tick()
+                due = max(due + self.period, now)
+            time.sleep(min(0.1, max(0.0, due - time.monotonic())))
 
     def tick(self) -> None:
         """Read the source once; publish on a change, or when the autorepeat is due (:meth:`run`'s thread)."""

@@ -2,7 +2,7 @@
 
 Every source has ``read(now) -> (axes, buttons)`` in the convention of
 :mod:`tutorial.interfaces.joy` (8 axes, stick up/left = +1; 8 buttons), or None when
-the user asked to quit.  Only the thread running the joy node calls ``read``.
+the user asked to quit.  One thread calls ``read``: the one running ``JoyPublisher.run`` (``rtt-joy``'s main thread).
 """
 
 from __future__ import annotations

@@ -90,16 +90,19 @@ def main(argv: list[str] | None = None) -> int:
         node = rclpy.create_node(NODE_NAME)
         pub = JoyPublisher(node, source, rate=args.rate, autorepeat=args.autorepeat, duration=args.duration)
         print(f"[{node.get_fully_qualified_name()}] publishing {joy.TOPIC} from {what}", flush=True)
-        spin = SpinThread(node).start()  # the node's own services answer there; the ticks run here
+        spin = None
         try:
-            pub.run(lambda: stop.requested or not rclpy.ok())
+            spin = SpinThread(node).start()  # the node's own services answer there; the ticks run here
+            pub.run(lambda: stop.requested or not rclpy.ok() or spin.error is not None)
         except ExternalShutdownException:
             pass
         finally:
             ros_program.ignore_stop_signals()  # a second Ctrl-C must not break the clean-up
-            spin.stop()
-            node.destroy_node()
+            if spin is None or spin.stop():  # a spin thread still running must keep its node
+                node.destroy_node()
             rclpy.try_shutdown()
+        if spin is not None and spin.error is not None:
+            print(f"[{NODE_NAME}] spinning ended: {spin.error!r}", file=sys.stderr, flush=True)
         print(f"[{NODE_NAME}] published {pub.published} messages", flush=True)
     return 0
 

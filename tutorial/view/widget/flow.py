@@ -13,9 +13,9 @@ animation frame of its own, and less on a slow machine or a slow link.
   away, and what goes out is always the newest state, never a queue of
   old ones.
 - **it sends only what the browser can draw.**  A view answers the frames
-  it has drawn with ``drawn`` (two at a time, or a lone one six animation
-  frames, 0.1 s, later: each message to the kernel costs it a busy and an
-  idle status on its connection).  The flow keeps at most :data:`WINDOW` frames
+  it has drawn with ``drawn`` (two at a time, or a lone one 0.1 s later:
+  each message to the kernel costs it a busy and an idle status on its
+  connection).  The flow keeps at most :data:`WINDOW` frames
   in flight: two drawn and not answered yet, and two more on their way, so
   that neither the answer's trip back to the kernel cuts the frame rate nor
   a state waits here for it (with room for one on its way, not two, one

@@ -5,7 +5,7 @@
 // lighter drawing without a GPU).  The kernel sends meshcat's own commands, packed with msgpack, as the
 // buffers of one widget message a frame.  The view answers the frames it has drawn with "drawn" (how
 // many), which is what lets the kernel send the next: a slow browser gets fewer frames, never a queue.
-// It answers two frames at a time, or a lone frame six animation frames (0.1 s) after it was drawn: the
+// It answers two frames at a time, or a lone frame 0.1 s after it was drawn (LONE_WAIT_MS): the
 // kernel publishes a busy and an idle status for every message it is sent, so an answer per frame would
 // double the traffic on the kernel's connection and slow the frames themselves (the Benchmarks page, "Live
 // views in the notebook").  At a class server's 20 frames/s the next frame comes first, so a view answers
@@ -19,7 +19,7 @@ const PAGE_SCRIPT = __PAGE_SCRIPT__;
 const LIMITS = __LIMITS__;
 const KNOWN = ["set_transform", "set_transforms", "set_object", "set_property", "delete", "set_animation"];
 const SCRIPT_KEY = "__rttMeshcatViewerScript";
-const LONE_WAIT = 6;  // animation frames a lone drawn frame waits for a second one before it is answered
+const LONE_WAIT_MS = 100;  // how long a lone drawn frame waits for a second one before it is answered, ms
 
 // meshcat's viewer script as a blob: URL, asked of the kernel once per browser page and shared by every view.
 function viewerScript(model) {
@@ -202,7 +202,7 @@ function render({ model, el }) {
   // A benchmark's probe (benchmarks/experiments/widget.py sets window.rttProbe to an array): for each
   // frame, [its number, when it arrived, when it was drawn], on this page's clock, ms.
   const now = () => performance.timeOrigin + performance.now();
-  let owed = 0;  // frames drawn and not answered yet: at most one, for at most LONE_WAIT animation frames
+  let owed = 0;  // frames drawn and not answered yet: at most one, for about LONE_WAIT_MS
   const settle = () => {
     try {
       if (!gone && owed > 0) model.send({ type: "drawn", frames: owed });
@@ -222,9 +222,11 @@ function render({ model, el }) {
       owed += 1;
       if (owed >= 2) {
         settle();
-      } else {  // a lone frame: answered with the next one, or LONE_WAIT animation frames from now
-        const wait = (n) => view.requestAnimationFrame(n > 1 ? () => wait(n - 1) : settle);
-        wait(LONE_WAIT);
+      } else {  // a lone frame: answered with the next one, or LONE_WAIT_MS from now (in an animation frame,
+        // so a hidden tab answers nothing, whatever its display's refresh rate)
+        const drawnAt = performance.now();
+        const wait = () => (performance.now() - drawnAt >= LONE_WAIT_MS ? settle() : view.requestAnimationFrame(wait));
+        view.requestAnimationFrame(wait);
       }
     });
   };
