@@ -29,8 +29,8 @@ class JoyPublisher:
     It reads the source on a plain loop, not an rclpy timer: an executor's
     ``spin_once`` builds its wait set again at every tick, and at 60 Hz that
     cost ``rtt-joy --demo`` 0.067 cores; the loop, with an idle spin thread
-    beside it for the node's services, 0.031 to 0.032
-    (``benchmarks/RESULTS.md``, *What a learner costs a class's server*).
+    beside it for the node's services, 0.031 to 0.034 (``benchmarks/RESULTS.md``,
+    *What a learner costs a class's server*).
     """
 
     def __init__(self, node, source, rate=60.0, autorepeat=20.0, duration=None):
