@@ -54,8 +54,9 @@ LEARNERS = (1, 2, 4, 8, 16)
 # sessions and the other benchmarks pick from.
 DOMAINS = (101, *range(215, 233))
 LONE_WAIT_MS = 100  # how long a lone frame waits for its answer: widget.js's LONE_WAIT_MS
-# The code path before 2026-11-27, kept for a same-run baseline (--before): a view answered a lone frame two
-# animation frames later, and a class's simulation slept before every step (the hub's RTT_HUB_REALTIME_SLICE_MS).
+# The code path before the slice and lone-wait cuts of 2026-11-27, kept for a same-run baseline (--before;
+# rtt-joy's own cut is not undone): a view answered a lone frame two animation frames later, and a class's
+# simulation slept before every step (the hub's RTT_HUB_REALTIME_SLICE_MS).
 BEFORE = {"lone_wait_ms": 2000 / 60, "hub_env": {"RTT_HUB_REALTIME_SLICE_MS": "0.2"}}
 
 # A learner's first cell: what notebook 03's set-up cell imports, and ROS 2 initialised.
@@ -306,7 +307,7 @@ def one_class(
 ) -> dict:
     """N learners at once: each one's figures, and the machine's (``frame_rate``: the hub's, else its default).
 
-    ``before``: the code path of before 2026-11-27 (:data:`BEFORE`), where it can still be chosen.
+    ``before``: the code path before the slice and lone-wait cuts (:data:`BEFORE`).
     """
     from tests.hub import Hub, Learner
 
@@ -486,7 +487,7 @@ def learners_per_server(
             + f"frames/s min {r['frames_per_s_min']:.1f}, "
             f"{r['memory_mb_per_learner_mean']:.0f} MB/learner, {r['cores_per_learner']:.3f} cores/learner, "
             f"{r['cores_busy']:.2f} cores busy (client {r['client_cores']:.2f})"
-            + (" [code path before]" if before else ""),
+            + (" [before the slice and lone-wait cuts]" if before else ""),
             flush=True,
         )
     return out
@@ -499,7 +500,9 @@ def main(argv=None) -> int:
     p.add_argument("--warmup", type=float, default=3.0)
     p.add_argument("--frame-rate", type=float, default=None, help="the live views' frames/s (default: the hub's)")
     p.add_argument("--output", default=None, help="a folder: learners.json and its plot, bench_learners.png")
-    p.add_argument("--before", action="store_true", help="also one learner on the code path before 2026-11-27")
+    p.add_argument(
+        "--before", action="store_true", help="also one learner before the slice and lone-wait cuts (BEFORE)"
+    )
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))  # the hub gives each learner theirs
