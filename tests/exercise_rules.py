@@ -257,6 +257,20 @@ HIDDEN_MISTAKES_02 = [
     ),
     # old: passed (the visible rates are whole numbers)
     ("2.2", 'self.rate = config.parameters["rate"]', 'self.rate = int(config.parameters["rate"])', "fractional"),
+    # found by make mutate: the position rounded for tidy printing, 0.1 mm off at most (the visible cases allow 5)
+    (
+        "2.2",
+        "p.x, p.y, p.z = float(x), float(y), float(z)",
+        "p.x, p.y, p.z = (round(float(v), 4) for v in (x, y, z))",
+        "the root's position, frame world",
+    ),
+    # found by make mutate: the quaternion rounded the same way, still of unit length within 2e-4
+    (
+        "2.2",
+        "o.x, o.y, o.z, o.w = float(qx), float(qy), float(qz), float(w)",
+        "o.x, o.y, o.z, o.w = (round(float(v), 4) for v in (qx, qy, qz, w))",
+        "the root's orientation, tilted",
+    ),
 ]
 
 # ---- notebooks 04 and 05 ----
@@ -353,12 +367,14 @@ RULES_04_05 = {
     },
     "4.2": {
         "parameters threshold (default 20) and holdoff (default 0.5)": [
+            "PARAMETERS",
             "with default parameters",
             "with threshold=10.0, the wall",
         ],
         "a report when the mean's hypot(x, y) is above threshold": [
             "with threshold=10.0, the wall",
             "the hit: a slower rate, another threshold",
+            "a period whose y part decides",
         ],
         "exactly at threshold is not above it": ["a period exactly at threshold is not above it"],
         "after a report, nothing more for holdoff s of simulated time": [
@@ -446,6 +462,28 @@ HIDDEN_MISTAKES_04_05 = [
         "        self.recent = (getattr(self, 'recent', []) + [math.hypot(a[0], a[1])])[-steps:]\n"
         "        self.peak = max(self.recent)\n",
         "every period, at a rate of",
+    ),
+    # found by make mutate: the period's length worked out, 1 / rate s, which a rate of 0 (every step) divides by
+    (
+        "4.1",
+        "        self.peak = 0.0  # m/s^2, the largest horizontal reading of this period so far\n",
+        "        self.peak = 0.0  # m/s^2, the largest horizontal reading of this period so far\n"
+        "        self.period = 1.0 / self.rate  # s: the steps the peak covers\n",
+        "at a rate of zero",
+    ),
+    # found by make mutate: the horizontal acceleration taken as x alone (passed the old check)
+    (
+        "4.2",
+        "if math.hypot(a.x, a.y) > self.threshold",
+        "if abs(a.x) > self.threshold",
+        "a period whose y part decides",
+    ),
+    # found by make mutate: the larger of the two parts (passed the old check)
+    (
+        "4.2",
+        "if math.hypot(a.x, a.y) > self.threshold",
+        "if max(abs(a.x), abs(a.y)) > self.threshold",
+        "a period whose y part decides",
     ),
     # the time counted in Imu messages, at 20 Hz (passed the old check)
     (

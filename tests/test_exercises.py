@@ -525,6 +525,85 @@ MISTAKES = [
 ]
 
 
+# More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
+# them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
+MUTANT_MISTAKES = [
+    # the statement's default rate not kept: the drive, with no rate parameter, publishes at 20 Hz
+    ("2.2", '"rate": (float, 10.0,', '"rate": (float, 20.0,', "10 Hz from t = 0"),
+    # the topic not named after the body
+    ("2.2", 'f"/{config.body_name}/pose"', '"/pose"', "10 Hz from t = 0"),
+    # y and z swapped: off by the root's height, a few cm, less than a tank's length
+    ("2.2", "p.x, p.y, p.z = float(x), float(y), float(z)", "p.x, p.y, p.z = float(x), float(z), float(y)", "position"),
+    # the peak's topic not named after the body
+    ("4.1", 'f"/{config.body_name}/peak_acceleration"', '"/peak_acceleration"', "rate=20.0"),
+    # no peak published at rest: fewer peaks than Imu messages
+    (
+        "4.1",
+        "        self.peak_publisher.publish(Float64(data=self.peak))\n",
+        "        if self.peak > 0.01:  # nothing to report at rest\n"
+        "            self.peak_publisher.publish(Float64(data=self.peak))\n",
+        "rate=20.0",
+    ),
+    # the Imu message no longer published
+    ("4.1", "        super().publish()\n        self.peak_publisher", "        self.peak_publisher", "rate=20.0"),
+    # the collision's topic not named after the body
+    ("4.2", 'f"/{config.body_name}/collision"', '"/collision"', "with default parameters"),
+    # the report in the world frame, not the IMU's
+    (
+        "4.2",
+        "            report = Vector3Stamped(header=self.msg.header)\n",
+        "            report = Vector3Stamped()\n            report.header.stamp = self.msg.header.stamp\n"
+        '            report.header.frame_id = "world"\n',
+        "with default parameters",
+    ),
+    # the vertical part kept in the vector
+    (
+        "4.2",
+        "            report.vector.x, report.vector.y = a.x, a.y\n",
+        "            report.vector.x, report.vector.y, report.vector.z = a.x, a.y, a.z\n",
+        "with default parameters",
+    ),
+    # the vector rounded to 0.01 m/s^2 ("plenty for a collision"): not the mean the Imu message carries
+    (
+        "4.2",
+        "            report.vector.x, report.vector.y = a.x, a.y\n",
+        "            report.vector.x, report.vector.y = round(a.x, 2), round(a.y, 2)\n",
+        "with default parameters",
+    ),
+    # the Imu message no longer published: nothing to report on
+    ("4.2", "        super().publish()\n        a, now", "        a, now", "with default parameters"),
+    # a default holdoff of 1 s, not the statement's 0.5 s: the check's default run reports alike
+    ("4.2", '"holdoff": (float, 0.5,', '"holdoff": (float, 1.0,', "PARAMETERS"),
+    # the peak of the last 50 steps: a period at 20 Hz, not at the rate given
+    (
+        "4.1",
+        "        self.peak = max(self.peak, math.hypot(a[0], a[1]))\n",
+        "        self.recent = (getattr(self, 'recent', []) + [math.hypot(a[0], a[1])])[-50:]  # a period's steps\n"
+        "        self.peak = max(self.recent)\n",
+        "rate=10.0",
+    ),
+    # the pose without its header: geometry_msgs/Pose
+    (
+        "2.2",
+        ('            PoseStamped, f"/{config.body_name}/pose"', "            self.publisher.publish(msg)\n"),
+        (
+            "            __import__('geometry_msgs.msg').msg.Pose, f\"/{config.body_name}/pose\"",
+            "            self.publisher.publish(msg.pose)\n",
+        ),
+        "10 Hz from t = 0",
+    ),
+]
+
+
+def put_in(solution: str, right, wrong) -> str:
+    """``solution`` with each text of ``right`` (a str, or a tuple of them) replaced by its ``wrong`` one."""
+    rights, wrongs = (right, wrong) if isinstance(right, tuple) else ((right,), (wrong,))
+    for r, w in zip(rights, wrongs, strict=True):
+        assert r in solution, f"the solution no longer has {r!r}: update this test"
+        solution = solution.replace(r, w)
+    return solution
+
+
 def mistake_id(mistake: tuple) -> str:
     """A wrong answer's test id, from what it changes (not its place in the table, so a new row renames none)."""
     import hashlib
@@ -532,11 +611,14 @@ def mistake_id(mistake: tuple) -> str:
     return f"{mistake[0]}-{hashlib.sha256(repr(mistake[1:3]).encode()).hexdigest()[:8]}"
 
 
-@pytest.mark.parametrize("number,right,wrong,caught_by", MISTAKES, ids=[mistake_id(m) for m in MISTAKES])
+@pytest.mark.parametrize(
+    "number,right,wrong,caught_by",
+    [*MISTAKES, *(pytest.param(*m, marks=pytest.mark.more) for m in MUTANT_MISTAKES)],
+    ids=[mistake_id(m) for m in MISTAKES + MUTANT_MISTAKES],
+)
 def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wrong, caught_by):
     ex = exercise(number)
-    assert right in ex["solution"], f"the solution of {number} no longer has {right!r}: update this test"
-    result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
+    result = grade(ex, ex["stub"], put_in(ex["solution"], right, wrong))
     assert not result.passed, f"the check of {number} passed a wrong answer ({wrong!r})"
     assert caught_by in result.case, (caught_by, str(result))
     assert result.case in result.message, str(result)  # the failing input is in the line
@@ -624,6 +706,47 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
     assert right in ex["solution"], "the worked solution of 1.2 changed: update this test"
     result = grade(ex, ex["stub"], ex["solution"].replace(right, other))
     assert result.passed, str(result)
+
+
+@pytest.mark.parametrize(
+    "number,right,other",
+    [
+        (  # a second publisher, of another topic, besides the exercise's
+            "2.2",
+            "        return True\n\n    def unconfigure",
+            '        self.debug = config.node.create_publisher(PoseStamped, "/debug/pose", 1)\n'
+            "        return True\n\n    def unconfigure",
+        ),
+    ],
+    ids=["2.2-another-publisher"],
+)
+def test_a_right_answer_written_otherwise_passes(ros, number, right, other):
+    """What a statement leaves free is left free by its check (found by make mutate: a mutant failed it)."""
+    ex = exercise(number)
+    result = grade(ex, ex["stub"], put_in(ex["solution"], right, other))
+    assert result.passed, str(result)
+
+
+@pytest.mark.more
+def test_2_2_a_check_whose_own_drive_does_not_turn_the_tank_says_so(ros, monkeypatch):
+    """The check's own runs are checked after the learner's cases pass: a broken check raises, told as such."""
+    from tutorial.exercises import step2_joint_state_publisher as step2
+
+    monkeypatch.setattr(step2, "TURN_SCRIPT", ((0.2, (0.0, 0.0, 0.0, 0.0)),))  # sticks still: no turn
+    ex = exercise("2.2")
+    with pytest.raises(RuntimeError, match=r"the check's own drive did not turn the tank \(0\.0\d\d rad\)"):
+        grade(ex, ex["stub"], ex["solution"])
+
+
+@pytest.mark.more
+def test_2_2_a_check_whose_own_tumble_does_not_tilt_the_tank_says_so(ros, grading_seed, monkeypatch):
+    from tutorial.exercises import step2_joint_state_publisher as step2
+
+    still = {"quat": [1.0, 0.0, 0.0, 0.0], "spin": [0.0, 0.0, 0.0], "place": [0.0, 0.0, 1.0], "drift": [0.0] * 3}
+    monkeypatch.setattr(step2, "_tumble", lambda rng: still)  # upright in the air (the tracks' drive tilts it a little)
+    ex = exercise("2.2")
+    with pytest.raises(RuntimeError, match=r"the check's own run did not tilt the tank \(0\.0\d\d\)"):
+        grade(ex, ex["stub"], ex["solution"])
 
 
 @pytest.mark.parametrize(

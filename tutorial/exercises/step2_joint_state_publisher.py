@@ -117,18 +117,28 @@ def _turret_script(rng):
     return ((0.1, (0.0, 0.0, 0.0, 0.0)), (0.9, sticks()), (1.0, sticks()))
 
 
-def _tumbling(rng):
-    """A controller that turns gravity off and puts the tank in the air at t = 0, turned at random and tumbling.
+def _tumble(rng) -> dict:
+    """A hidden run's start in the air: ``{"quat", "spin", "place", "drift"}``, drawn from ``rng``.
 
-    It spins at least 1 rad/s about both of its horizontal axes, so its pose tilts far from upright.
+    ``quat``: w x y z, a unit quaternion, every orientation equally likely; ``spin``: rad/s about x, y, z,
+    at least 1 and at most 2 about both horizontal axes (either way), so the pose tilts far from upright;
+    ``place``: m, a tank's length above the floor; ``drift``: m/s, slow.
     """
-    from tutorial.core.controller import SimpleController
-
     quat = [rng.gauss(0.0, 1.0) for _ in range(4)]
     quat = [v / math.sqrt(sum(q * q for q in quat)) for v in quat]
-    spin = [rng.choice((-1.0, 1.0)) * rng.uniform(1.0, 2.0) for _ in range(2)] + [rng.uniform(-2.0, 2.0)]  # rad/s
-    place = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 1.0]  # m: a tank's length above the floor, at least
-    drift = [rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.05, 0.05)]  # m/s
+    return {
+        "quat": quat,
+        "spin": [rng.choice((-1.0, 1.0)) * rng.uniform(1.0, 2.0) for _ in range(2)] + [rng.uniform(-2.0, 2.0)],
+        "place": [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), 1.0],
+        "drift": [rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.2), rng.uniform(-0.05, 0.05)],
+    }
+
+
+def _tumbling(rng):
+    """A controller that turns gravity off and puts the tank in the air at t = 0 (:func:`_tumble`'s start)."""
+    from tutorial.core.controller import SimpleController
+
+    start = _tumble(rng)
 
     class Tumble(SimpleController):
         def initialize(self, io):
@@ -136,8 +146,8 @@ def _tumbling(rng):
             model.opt.gravity[:] = 0.0
             joint = model.body_jntadr[io.body.root_id]  # the root's free joint
             q, v = model.jnt_qposadr[joint], model.jnt_dofadr[joint]
-            io.data.qpos[q : q + 7] = place + quat  # position, then the quaternion w x y z
-            io.data.qvel[v : v + 6] = drift + spin
+            io.data.qpos[q : q + 7] = start["place"] + start["quat"]  # position, then the quaternion w x y z
+            io.data.qvel[v : v + 6] = start["drift"] + start["spin"]
             io.body.notify_kinematic_state_change()
             return True
 
@@ -156,6 +166,48 @@ def _errors_logged(name: str):
         yield records
     finally:
         logger.removeHandler(handler)
+
+
+# The rates of 2.1's hidden runs, Hz: each period a whole number of the tank's 1 ms steps.
+HIDDEN_CHOICE_RATES = (12.5, 20.0, 25.0, 40.0, 100.0, 200.0)
+# Kinds of joint name the tank lacks, each with how to draw one (from the random source given).
+LACKING = {
+    "a joint of the tank in the wrong case": lambda rng: rng.choice((str.lower, str.capitalize))(rng.choice(TANK)),
+    "a part of a joint's name": lambda rng: rng.choice(("TURRET", "TURRET_", "URRET_P", "RRET_Y", "_P")),
+    "another robot's joint": lambda rng: rng.choice(("GUN", "SLEW", "LUFF", "TROLLEY", "WHEEL_L")),
+}
+
+
+def _spaced(rng, names) -> str:
+    """``names`` joined by commas, each with 0 to 2 spaces drawn on either side."""
+    return ",".join(" " * rng.randrange(3) + name + " " * rng.randrange(3) for name in names)
+
+
+def _hidden_choices(rng) -> list:
+    """Four hidden runs of 2.1: ``(joints parameter, the names expected, rate in Hz, ScriptedJoy script)``.
+
+    Each chooses 0 to 2 of the tank's joints in a random order (none: every joint is expected), spaced at
+    random, at a rate of :data:`HIDDEN_CHOICE_RATES`, with the turret moving (:func:`_turret_script`).
+    """
+    runs = []
+    for _ in range(4):
+        chosen = rng.sample(TANK, rng.randrange(3))
+        runs.append((_spaced(rng, chosen), chosen or TANK, rng.choice(HIDDEN_CHOICE_RATES), _turret_script(rng)))
+    return runs
+
+
+def _hidden_lacking(rng) -> list:
+    """One hidden refusal of 2.1 per kind of :data:`LACKING`: ``(kind, joints parameter)``.
+
+    The parameter names 1 or 2 of the tank's joints and one name it lacks, put before a known name (not only
+    the last name is checked), spaced at random.
+    """
+    cases = []
+    for kind, draw in LACKING.items():
+        known = rng.sample(TANK, rng.randrange(1, 3))
+        known.insert(rng.randrange(len(known)), draw(rng))
+        cases.append((kind, _spaced(rng, known)))
+    return cases
 
 
 def check_selected_joints(cls) -> Result:
@@ -256,32 +308,19 @@ def check_selected_joints(cls) -> Result:
         return Case(call, run, hint, hidden=label is not None)
 
     def hidden_cases(rng):
-        """The statement's rules on this learner's draws: a choice of the tank's joints (none: every joint), in a
-        random order, spaced at random, at a random rate, the turret moving; and names the tank lacks."""
-
-        def spaced(names):
-            return ",".join(" " * rng.randrange(3) + name + " " * rng.randrange(3) for name in names)
-
-        for _ in range(4):
-            chosen = rng.sample(TANK, rng.randrange(3))
-            label = "the tank's joints chosen at random (or none), in a random order and spacing, at a random rate"
+        """The statement's rules on this learner's draws (:func:`_hidden_choices`, :func:`_hidden_lacking`)."""
+        label = "the tank's joints chosen at random (or none), in a random order and spacing, at a random rate"
+        for joints, expected, rate, script in _hidden_choices(rng):
             yield selects(
-                spaced(chosen),
-                chosen or TANK,
-                rng.choice((12.5, 20.0, 25.0, 40.0, 100.0, 200.0)),
+                joints,
+                expected,
+                rate,
                 "those joints only, in that order, each with its own position, velocity and effort, at the rate.",
-                _turret_script(rng),
+                script,
                 label + ", the turret moving",
             )
-        lacks = {  # kinds of name the tank lacks, and one of each drawn
-            "a joint of the tank in the wrong case": lambda: rng.choice((str.lower, str.capitalize))(rng.choice(TANK)),
-            "a part of a joint's name": lambda: rng.choice(("TURRET", "TURRET_", "URRET_P", "RRET_Y", "_P")),
-            "another robot's joint": lambda: rng.choice(("GUN", "SLEW", "LUFF", "TROLLEY", "WHEEL_L")),
-        }
-        for kind, draw in lacks.items():
-            known = rng.sample(TANK, rng.randrange(1, 3))
-            known.insert(rng.randrange(len(known)), draw())  # before a known name: not only the last is checked
-            yield refuses(spaced(known), f"a name the tank lacks ({kind}): configure logs an error, returns False")
+        for kind, joints in _hidden_lacking(rng):
+            yield refuses(joints, f"a name the tank lacks ({kind}): configure logs an error, returns False")
 
     rng = hidden_random("2.1")  # while grading: this learner's own choices, rates, drives and wrong names
     return grade(
@@ -301,6 +340,11 @@ def check_selected_joints(cls) -> Result:
             *(hidden_cases(rng) if rng else ()),
         ],
     )
+
+
+# The rates of 2.2's hidden runs, Hz, by kind: a whole and a fractional number of hertz, each period a whole
+# number of the tank's 1 ms steps (so each stamp is a step's exact time).
+HIDDEN_POSE_RATES = {"whole": (4.0, 8.0, 20.0, 40.0, 50.0, 100.0, 250.0), "fractional": (2.5, 12.5, 62.5)}
 
 
 def check_pose_publisher(cls) -> Result:
@@ -329,11 +373,14 @@ def check_pose_publisher(cls) -> Result:
             if len(pubs) != 1:
                 topics = [p.topic for p in node.published()]
                 raise CaseFailed(
-                    f"{call} published on {topics}, expected one publisher of /Tank/pose.",
+                    f"published on {topics}, expected one publisher of /Tank/pose.",
                     'name the topic after the body: f"/{config.body_name}/pose".',
                 )
             if pubs[0].msg_type is not PoseStamped:
-                raise CaseFailed(f"{call} publishes {pubs[0].msg_type.__name__}, expected geometry_msgs/PoseStamped.")
+                raise CaseFailed(
+                    f"publishes {pubs[0].msg_type.__name__}, expected geometry_msgs/PoseStamped.",
+                    "publish a PoseStamped: the pose with its header (the stamp and the frame).",
+                )
             messages = pubs[0].messages()
             runs[kind] = (messages[: round(rate * duration)], messages, probe, pubs[0])
         return runs[kind]
@@ -366,7 +413,8 @@ def check_pose_publisher(cls) -> Result:
                 raise CaseFailed(
                     f"{who}: pose {k} is stamped {t:.4f} s, expected {k / rate:.4f} s.",
                     f"stamp with simulation time (io.data.time), the first at t = 0, every {1 / rate:g} s: "
-                    "read config.parameters['rate'].",
+                    "read config.parameters['rate']"
+                    + (" (10 Hz when none is given: the default in PARAMETERS)." if kind == "drive" else "."),
                 )
 
     def split(kind: str, who: str):  # a ROS time: whole seconds in sec, nanosec below one second
@@ -418,14 +466,10 @@ def check_pose_publisher(cls) -> Result:
         if kind not in runs:  # the learner's cases of this kind did not run it
             return
         quats = [state[2] for state in runs[kind][2].controller.states.values()]
-        if kind == "turn":
-            turned = max(abs(2 * math.atan2(float(q[3]), float(q[0]))) for q in quats)
-            if not turned > 0.3:
-                raise RuntimeError(f"the check's own drive did not turn the tank ({turned:.3f} rad)")
-        if plans[kind][3] is not None:
-            tilted = max(math.hypot(float(q[1]), float(q[2])) for q in quats)
-            if not tilted > 0.3:
-                raise RuntimeError(f"the check's own run did not tilt the tank ({tilted:.3f})")
+        if kind == "turn" and not _turned(quats) > 0.3:
+            raise RuntimeError(f"the check's own drive did not turn the tank ({_turned(quats):.3f} rad)")
+        if plans[kind][3] is not None and not _tilted(quats) > 0.3:
+            raise RuntimeError(f"the check's own run did not tilt the tank ({_tilted(quats):.3f})")
 
     def hidden_cases(rng):
         """The statement's rules on this learner's draws: the tank tilted and tumbling in the air, at a rate of a
@@ -454,7 +498,7 @@ def check_pose_publisher(cls) -> Result:
                 "z), whatever the tilt: not a yaw alone.",
             ),
         )
-        for kind, rates in (("whole", (4.0, 8.0, 20.0, 40.0, 50.0, 100.0, 250.0)), ("fractional", (2.5, 12.5, 62.5))):
+        for kind, rates in HIDDEN_POSE_RATES.items():
             plans[kind] = (rng.choice(rates), None, HIDDEN_DURATION, _tumbling(rng))
             who = f"the tank tilted and tumbling in the air, at a rate of its own, a {kind} number of hertz"
             for what, test, hint in rules:
@@ -483,9 +527,21 @@ def check_pose_publisher(cls) -> Result:
     return grade("Exercise 2.2, publish the pose", cases(rng))
 
 
-def _same_rotation(a, b, tol: float = 1e-2) -> bool:
-    """Two unit quaternions (x, y, z, w) give the same rotation (q and -q do)."""
-    if not all(math.isfinite(v) for v in a):
-        return False
+def _turned(quats) -> float:
+    """The largest turn (rad) about z of quaternions ``quats`` (w x y z) that turn about z alone: 2 atan2(z, w)."""
+    return max(abs(2 * math.atan2(float(q[3]), float(q[0]))) for q in quats)
+
+
+def _tilted(quats) -> float:
+    """The largest ``hypot(x, y)`` of quaternions ``quats`` (w x y z): 0 upright, sin(a / 2) tilted by ``a``."""
+    return max(math.hypot(float(q[1]), float(q[2])) for q in quats)
+
+
+def _same_rotation(a, b, tol: float) -> bool:
+    """Two quaternions (x, y, z, w) give the same rotation (q and -q do), ``a`` of unit length (within 1e-3).
+
+    ``b`` is a unit quaternion; ``1 - |a . b|`` at most ``tol`` passes.  A NaN or an infinity in ``a`` never
+    passes: every comparison with a NaN is false, and an infinity makes the dot product infinite or NaN.
+    """
     dot = abs(sum(x * y for x, y in zip(a, b)))
     return abs(1.0 - dot) <= tol and abs(sum(x * x for x in a) - 1.0) <= 1e-3

@@ -197,6 +197,12 @@ def _half_step(rng, low: int, high: int) -> float:
     return (rng.randrange(low, high) + 0.5) / 1000
 
 
+def _hidden_peak_rates(rng) -> tuple[float, float]:
+    """The rates (Hz) of 4.1's hidden runs: one from 6 to 20, one from 20 to 45, drawn as floats, so their periods
+    are no whole number of the 1 ms steps."""
+    return rng.uniform(6, 20), rng.uniform(20, 45)
+
+
 def check_peak_publisher(cls) -> Result:
     """Check a ``RttImuStatePublisher`` subclass publishing each period's peak horizontal acceleration.
 
@@ -213,7 +219,7 @@ def check_peak_publisher(cls) -> Result:
 
     def run(rate: float):
         if rate not in runs:
-            call = f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s"
+            call = "it"  # each case names the controller, its rate and the drive
             node, probe = _drive("PeakImuPublisher", cls, {"rate": rate})
             imu = _imu_messages(node, call)
             peaks = _one_publisher(
@@ -267,9 +273,15 @@ def check_peak_publisher(cls) -> Result:
         hidden = [
             *(
                 compare("every period, at a rate of no whole number of steps", rate, lambda t: True, periods, True)
-                for rate in (rng.uniform(6, 20), rng.uniform(20, 45))
+                for rate in _hidden_peak_rates(rng)
             ),
-            compare("every period, at a rate of zero: each step is a period", 0.0, lambda t: True, periods, True),
+            compare(
+                "every period, at a rate of zero: each step is a period",
+                0.0,
+                lambda t: True,
+                "a rate of zero publishes at every step, each step a period of its own: divide by no rate.",
+                True,
+            ),
             Case(
                 "each peak published right after its Imu message",
                 right_after,
@@ -319,8 +331,12 @@ def _destroyed(publisher, call: str, name: str) -> None:
 
 
 def _num(value) -> str:
-    """A number for a message: 6 significant digits (a peak at rest is a few 1e-4 m/s^2)."""
-    return f"{value:.6g}" if isinstance(value, float) else repr(value)
+    """A number for a message: 6 significant digits (a peak at rest is a few 1e-4 m/s^2).
+
+    Every value given is a float: a ``std_msgs/Float64``'s ``data`` (rclpy refuses any other type) or one
+    the check computed.
+    """
+    return f"{value:.6g}"
 
 
 def _same(got, expected: float) -> bool:
@@ -362,8 +378,10 @@ def check_collision_reporter(cls) -> Result:
     default 20) and no collision was reported in the ``holdoff`` s (default
     0.5) of simulated time before; the stamp and frame are the Imu
     message's, the vector its acceleration's horizontal part ``(x, y, 0)``.
-    Hidden cases: other rates, thresholds and holdoffs; a period exactly at
-    threshold (not above it); each report published right after its Imu
+    The defaults are read from the class's ``PARAMETERS``.  Hidden cases:
+    other rates, thresholds and holdoffs; a period exactly at threshold (not
+    above it); a period whose y part decides (``hypot(x, y)``, not ``x``
+    alone nor the larger part); each report published right after its Imu
     message; the publisher's QoS ``imu_qos()``.
     """
     from geometry_msgs.msg import Vector3Stamped
@@ -398,6 +416,21 @@ def check_collision_reporter(cls) -> Result:
         _, _, imu, _ = outcome({}, cls.__name__)
         outcome({"threshold": _exact_threshold(imu), "holdoff": holdoff}, cls.__name__)
 
+    def y_decides(holdoff: float):
+        """Threshold: between a period's larger part and its hypot(x, y) (:func:`_y_threshold`); holdoff: tiny."""
+        _, _, imu, _ = outcome({}, cls.__name__)
+        outcome({"threshold": _y_threshold(imu), "holdoff": holdoff}, cls.__name__)
+
+    def defaults():
+        declared = getattr(cls, "PARAMETERS", {})
+        got = {name: declared.get(name, (None, None))[1] for name in ("threshold", "holdoff")}
+        if got != {"threshold": 20.0, "holdoff": 0.5}:
+            raise CaseFailed(
+                f"its defaults are {got}, expected threshold 20.0 and holdoff 0.5.",
+                'declare them: PARAMETERS = {**RttImuStatePublisher.PARAMETERS, "threshold": (float, 20.0, ...), '
+                '"holdoff": (float, 0.5, ...)}.',
+            )
+
     def right_after(parameters: dict):
         node, _, _, reported = outcome(parameters, cls.__name__)
         if _follows(node, "/Tank/collision") != reported:
@@ -406,11 +439,7 @@ def check_collision_reporter(cls) -> Result:
     hidden = []
     rng = hidden_random("4.2")  # while grading: this learner's own parameters, judged by the same rule
     if rng:
-        # a faster rate with a holdoff of many periods, then a slower one: time, not a count of messages.
-        # From 9.5 to 15 Hz the hit's period is above 13 m/s^2 (below 9.5 Hz it may be diluted to 12).
-        low = {"rate": rng.uniform(30, 50), "threshold": rng.uniform(2.5, 5), "holdoff": _half_step(rng, 150, 400)}
-        hit = {"rate": rng.uniform(9.5, 15), "threshold": rng.uniform(5, 10), "holdoff": _half_step(rng, 20, 600)}
-        tiny = _half_step(rng, 2, 45)  # a holdoff shorter than the default period: each period above is reported
+        low, hit, tiny = _hidden_collision_parameters(rng)
         hidden = [
             reports(low, "driving hard: a faster rate, a low threshold, a longer holdoff"),
             reports(hit, "the hit: a slower rate, another threshold and holdoff"),
@@ -418,6 +447,12 @@ def check_collision_reporter(cls) -> Result:
                 "a period exactly at threshold is not above it",
                 lambda: exactly_at_threshold(tiny),
                 "above threshold means hypot(x, y) > threshold: a period exactly at it is no collision.",
+                True,
+            ),
+            Case(
+                "a period whose y part decides: hypot(x, y), not x alone nor the larger part",
+                lambda: y_decides(tiny),
+                "the horizontal acceleration is math.hypot(a.x, a.y): both parts count.",
                 True,
             ),
             Case(
@@ -436,6 +471,7 @@ def check_collision_reporter(cls) -> Result:
     return grade(
         "Exercise 4.2, report collisions",
         [
+            Case(f"{cls.__name__}.PARAMETERS", defaults),
             reports({}),
             reports({"threshold": 10.0}),
             reports({"threshold": 10.0, "holdoff": 0.1}),
@@ -451,6 +487,20 @@ def check_collision_reporter(cls) -> Result:
             *hidden,
         ],
     )
+
+
+def _hidden_collision_parameters(rng) -> tuple[dict, dict, float]:
+    """4.2's hidden parameters: ``(driving hard, the hit, a tiny holdoff in s)``.
+
+    Driving hard: a faster rate (30 to 50 Hz), a low threshold (2.5 to 5 m/s^2) and a holdoff of many periods
+    (150.5 to 399.5 ms): time, not a count of messages.  The hit: a slower rate (9.5 to 15 Hz, where the hit's
+    period is above 13 m/s^2; below 9.5 Hz it may be diluted to 12), a threshold of 5 to 10 m/s^2 and a holdoff
+    of 20.5 to 599.5 ms.  The tiny holdoff (2.5 to 44.5 ms) is shorter than the default period (50 ms): each
+    period above is reported.  Every holdoff is a whole number of ms and a half (:func:`_half_step`).
+    """
+    low = {"rate": rng.uniform(30, 50), "threshold": rng.uniform(2.5, 5), "holdoff": _half_step(rng, 150, 400)}
+    hit = {"rate": rng.uniform(9.5, 15), "threshold": rng.uniform(5, 10), "holdoff": _half_step(rng, 20, 600)}
+    return low, hit, _half_step(rng, 2, 45)
 
 
 def _compare_reports(call: str, parameters: dict, imu, got) -> list[int]:
@@ -499,6 +549,17 @@ def _compare_reports(call: str, parameters: dict, imu, got) -> list[int]:
                 "the vector is the mean acceleration's horizontal part: (x, y, 0).",
             )
     return reported
+
+
+def _y_threshold(imu) -> float:
+    """A threshold that a mean's y part decides: halfway between ``max(|x|, |y|)`` and ``hypot(x, y)`` of the Imu
+    message whose hypot is the most above its larger part (at least 5 % above: no float rounding decides)."""
+    means = [(m.linear_acceleration.x, m.linear_acceleration.y) for m in imu]
+    x, y = max(means, key=lambda v: _horizontal(v) / max(abs(v[0]), abs(v[1]), 1e-300))
+    larger = max(abs(x), abs(y))
+    if not _horizontal((x, y)) >= 1.05 * larger > 0.0:
+        raise CaseFailed("the Imu messages have no mean whose y part decides whether it is above a threshold.")
+    return (larger + _horizontal((x, y))) / 2
 
 
 def _exact_threshold(imu) -> float:

@@ -1,0 +1,256 @@
+"""The parts of the checks of notebooks 02 and 04 that whole answers do not pin down: no simulation, no ROS.
+
+The exercises' tests (tests/test_exercises.py) run each check on worked
+solutions and on wrong answers.  These hold each part to its own rule at
+its edges: a hint to the mistake it names (an empty period, the step
+before a period, the step after it), the numbers a message shows, and the
+hidden runs' draws to what the statement promises (found by make mutate:
+a mutant of each survived the whole answers).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from types import SimpleNamespace
+
+import pytest
+
+from tutorial.exercises import step2_joint_state_publisher as step2
+from tutorial.exercises import step4_imu_publisher as step4
+
+# One reading per step (x, y, z in m/s^2).  Steps 2 to 4 are the checked period; each other step is made
+# larger, or smaller, than the period's own so that each mistake's window gives a value of its own.
+READINGS = [
+    (9.0, 0.0, 0.0),  # 0: before the period, the largest horizontal reading up to the period's end
+    (0.0, 7.0, 0.0),  # 1: the step just before the period
+    (1.0, 1.0, 0.0),  # 2: the period's first
+    (2.0, 0.0, 5.0),  # 3: the period's largest with z in the norm (5.39), not horizontally (2)
+    (0.0, 3.0, 0.0),  # 4: the period's last, its horizontal peak (3)
+    (60.0, 0.0, 0.0),  # 5: after the period
+]
+FIRST, LAST = 2, 4
+
+
+def hint(got: float, mean: float = 0.123, readings=READINGS, first: int = FIRST, last: int = LAST) -> str:
+    return step4._diagnose(got, mean, readings, first, last)
+
+
+def test_4_1_the_right_peak_gets_no_hint():
+    assert hint(3.0) == ""
+
+
+def test_4_1_the_periods_mean_is_named_as_the_mean():
+    assert "the period's mean" in hint(0.123)
+
+
+def test_4_1_a_norm_with_z_is_named_only_over_the_periods_own_steps():
+    assert "x and y only" in hint(math.sqrt(2.0**2 + 5.0**2))
+    # the steps before the period (9, 7) and after it (60) are no such mistake
+    assert hint(60.0) == ""
+    for before in (9.0, 7.0):
+        assert "x and y only" not in hint(before)
+
+
+def test_4_1_a_peak_never_started_over_is_named_only_after_the_first_period():
+    assert "start over" in hint(9.0)  # the largest since step 0
+    assert "start over" not in hint(9.0, first=0)  # the first period starts at step 0: nothing to start over
+
+
+def test_4_1_a_peak_one_step_early_is_named_for_the_step_before_the_period_only():
+    early = "belongs to the period it ends"
+    assert early in hint(7.0)  # steps 1 to 3: the step before, not the last
+    # the period's own last step is larger than the early window's (steps 1 and 2): its peak is still named
+    assert early in hint(2.5, readings=[(0.0, 0.0, 0.0), (0.0, 2.5, 0.0), (1.0, 1.0, 0.0), (0.0, 3.0, 0.0)], last=3)
+    # the first period: its early window is its own steps but the last (0 and 1 of 0 to 2)
+    assert early in hint(5.0, readings=[(0.0, 5.0, 0.0), (1.0, 1.0, 0.0), (0.0, 9.0, 0.0)], first=0, last=2)
+    # the second period (steps 1 to 2): its early window starts at step 0
+    assert early in hint(8.0, readings=[(0.0, 8.0, 0.0), (1.0, 1.0, 0.0), (0.0, 9.0, 0.0)], first=1, last=2)
+
+
+def test_4_1_an_empty_early_window_reads_as_a_peak_of_zero():
+    # rate 0: each step is its own period; the first (step 0 alone) has no step before it.  A peak of 0
+    # there is one published before its step's reading was added: the early mistake.
+    one = [(0.0, 1.0, 2.0)]
+    assert "belongs to the period it ends" in hint(0.0, mean=5.0, readings=one, first=0, last=0)
+    assert hint(0.5, mean=5.0, readings=one, first=0, last=0) == ""
+
+
+def test_4_1_numbers_in_a_message_have_six_significant_digits():
+    assert step4._num(0.000123456789) == "0.000123457"
+    assert step4._num(20.0) == "20"
+
+
+@pytest.mark.parametrize("got", [math.nan, math.inf, 3])
+def test_4_1_a_peak_that_is_no_finite_float_is_never_the_right_one(got):
+    assert not step4._same(got, 3.0)
+
+
+def test_2_2_a_hidden_tumble_starts_in_the_air_turned_any_way_and_spinning_about_both_horizontal_axes():
+    starts = [step2._tumble(random.Random(seed)) for seed in range(400)]
+    for s in starts:
+        assert math.isclose(sum(q * q for q in s["quat"]), 1.0)
+        assert all(1.0 <= abs(w) <= 2.0 for w in s["spin"][:2]) and abs(s["spin"][2]) <= 2.0
+        assert s["place"][2] == 1.0 and all(abs(p) <= 1.0 for p in s["place"][:2])
+        assert all(abs(d) <= limit for d, limit in zip(s["drift"], (0.2, 0.2, 0.05)))
+    # every orientation equally likely: each component's mean near 0 (a biased draw puts one near 0.5)
+    for k in range(4):
+        assert abs(sum(s["quat"][k] for s in starts) / len(starts)) < 0.1
+    # both ways and spread over their ranges
+    for key, k in [*(("spin", k) for k in range(3)), ("place", 0), ("place", 1), *(("drift", k) for k in range(3))]:
+        values = [s[key][k] for s in starts]
+        assert min(values) < 0 < max(values), (key, k)
+    for k in range(2):
+        magnitudes = [abs(s["spin"][k]) for s in starts]
+        assert min(magnitudes) < 1.2 and max(magnitudes) > 1.8
+
+
+def test_2_1_the_hidden_choices_follow_the_statement():
+    draws = [step2._hidden_choices(random.Random(seed)) for seed in range(300)]
+    assert all(len(runs) == 4 for runs in draws)
+    runs = [run for runs in draws for run in runs]
+    sizes, orders, spaces, rates = set(), set(), set(), set()
+    for joints, expected, rate, script in runs:
+        names = joints.split(",") if joints else []
+        chosen = [n.strip() for n in names]
+        assert len(set(chosen)) == len(chosen) <= 2 and set(chosen) <= set(step2.TANK)
+        assert expected == (chosen or step2.TANK)
+        sizes.add(len(chosen))
+        orders.add(tuple(chosen))
+        spaces |= {len(n) - len(n.lstrip(" ")) for n in names} | {len(n) - len(n.rstrip(" ")) for n in names}
+        rates.add(rate)
+        assert [t for t, _ in script] == [0.1, 0.9, 1.0] and script[0][1] == (0.0, 0.0, 0.0, 0.0)
+        for _, sticks in script[1:]:
+            assert sticks[0] == 0.0 and abs(sticks[1]) <= 0.5
+            assert all(0.3 <= abs(v) <= 0.8 for v in sticks[2:])
+    assert sizes == {0, 1, 2} and {("TURRET_P", "TURRET_Y"), ("TURRET_Y", "TURRET_P")} <= orders
+    assert spaces == {0, 1, 2} and rates == set(step2.HIDDEN_CHOICE_RATES)
+    sticks = [s for _, _, _, script in runs for _, s in script[1:]]
+    for k in (1, 2, 3):  # forward, turn, tilt: either way, over their whole ranges
+        values = [s[k] for s in sticks]
+        assert min(values) < 0 < max(values)
+        assert max(abs(v) for v in values) > (0.45 if k == 1 else 0.75)
+    assert min(abs(s[k]) for s in sticks for k in (2, 3)) < 0.35
+
+
+def test_2_1_the_hidden_names_the_tank_lacks_follow_the_statement():
+    kinds = list(step2.LACKING)
+    seen = {kind: set() for kind in kinds}
+    positions, counts = set(), set()
+    for seed in range(300):
+        cases = step2._hidden_lacking(random.Random(seed))
+        assert [kind for kind, _ in cases] == kinds
+        for kind, joints in cases:
+            names = [n.strip() for n in joints.split(",")]
+            lacking = [k for k, n in enumerate(names) if n not in step2.TANK]
+            assert len(lacking) == 1 and lacking[0] < len(names) - 1  # one, never the last
+            known = [n for n in names if n in step2.TANK]
+            assert len(set(known)) == len(known) in (1, 2)
+            positions.add(lacking[0])
+            counts.add(len(known))
+            seen[kind].add(names[lacking[0]])
+    assert positions == {0, 1} and counts == {1, 2}
+    wrong_case = seen["a joint of the tank in the wrong case"]
+    assert {n.upper() for n in wrong_case} == set(step2.TANK) and not wrong_case & set(step2.TANK)
+    assert {"turret_y", "Turret_p"} <= wrong_case
+    assert seen["a part of a joint's name"] == {"TURRET", "TURRET_", "URRET_P", "RRET_Y", "_P"}
+    assert seen["another robot's joint"] == {"GUN", "SLEW", "LUFF", "TROLLEY", "WHEEL_L"}
+
+
+def test_2_x_every_hidden_rate_has_a_period_of_whole_steps():
+    for rate in (*step2.HIDDEN_CHOICE_RATES, *(r for rates in step2.HIDDEN_POSE_RATES.values() for r in rates)):
+        assert math.isclose(1000.0 / rate, round(1000.0 / rate)), rate
+    assert all(r == int(r) for r in step2.HIDDEN_POSE_RATES["whole"])
+    assert all(r != int(r) for r in step2.HIDDEN_POSE_RATES["fractional"])
+
+
+def test_4_1_the_hidden_rates_follow_the_statement():
+    rates = [step4._hidden_peak_rates(random.Random(seed)) for seed in range(300)]
+    for k, (low, high) in enumerate(((6, 20), (20, 45))):
+        drawn = [r[k] for r in rates]
+        assert all(low <= r <= high for r in drawn)
+        assert min(drawn) < low + 1 and max(drawn) > high - 1
+        assert not any(math.isclose(1000 / r, round(1000 / r)) for r in drawn)  # no whole number of steps
+
+
+def _ms(seconds: float) -> float:
+    return round(seconds * 1000, 6)
+
+
+def test_4_2_the_hidden_parameters_follow_the_statement():
+    draws = [step4._hidden_collision_parameters(random.Random(seed)) for seed in range(400)]
+    ranges = {  # (key, its range), per drawn set; holdoffs in ms
+        0: {"rate": (30, 50), "threshold": (2.5, 5), "holdoff": (150.5, 399.5)},
+        1: {"rate": (9.5, 15), "threshold": (5, 10), "holdoff": (20.5, 599.5)},
+    }
+    for k, limits in ranges.items():
+        for key, (low, high) in limits.items():
+            drawn = [d[k][key] * (1000 if key == "holdoff" else 1) for d in draws]
+            assert all(low <= v <= high for v in drawn), (k, key)
+            spread = (high - low) / 10
+            assert min(drawn) < low + spread and max(drawn) > high - spread, (k, key)
+    tiny = [_ms(d[2]) for d in draws]
+    assert min(tiny) == 2.5 and max(tiny) == 44.5
+    for holdoff in tiny + [_ms(d[k]["holdoff"]) for d in draws for k in (0, 1)]:
+        assert holdoff % 1 == 0.5  # a whole number of ms and a half: never a whole number of steps
+    assert all(set(d[k]) == {"rate", "threshold", "holdoff"} for d in draws for k in (0, 1))
+
+
+def test_2_2_the_same_rotation_is_q_or_minus_q_of_unit_length_up_to_the_tolerance():
+    q = (0.0, 0.6, 0.0, 0.8)
+    assert step2._same_rotation(q, q, 1e-9) and step2._same_rotation(tuple(-v for v in q), q, 1e-9)
+    # 1 - |a . b| exactly at the tolerance passes; a hair beyond it does not
+    half_turn = (0.0, 0.0, math.sqrt(0.75), 0.5)  # |a . b| = 0.5 exactly
+    assert step2._same_rotation((0.0, 0.0, 0.0, 1.0), half_turn, 0.5)
+    assert not step2._same_rotation((0.0, 0.0, 0.0, 1.0), half_turn, 0.4999)
+    # a quaternion scaled off unit length fails however close its direction: within 1e-3 of 1 in squared norm
+    assert step2._same_rotation((0.0, 0.0, 0.0, math.sqrt(1.0009765625)), (0.0, 0.0, 0.0, 1.0), 1e-2)
+    assert not step2._same_rotation((0.0, 0.0, 0.0, math.sqrt(1.00146484375)), (0.0, 0.0, 0.0, 1.0), 1e-2)
+    assert not step2._same_rotation((0.0, 0.0, 0.0, 0.5), (0.0, 0.0, 0.0, 1.0), 1.0)
+    for bad in (math.nan, math.inf, -math.inf):
+        assert not step2._same_rotation((bad, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0, 1.0), 1.0)
+        assert not step2._same_rotation((bad, 0.0, 0.0, 1.0), (0.6, 0.0, 0.0, 0.8), 1.0)
+
+
+def test_2_2_the_checks_own_runs_are_measured_by_their_turn_and_their_tilt():
+    def about(axis, angle):  # w x y z
+        return (math.cos(angle / 2), *(math.sin(angle / 2) * a for a in axis))
+
+    assert math.isclose(step2._turned([about((0, 0, 1), 0.1), about((0, 0, 1), -0.25)]), 0.25)
+    assert step2._turned([about((1, 0, 0), 1.0)]) == 0.0  # a roll is no turn
+    assert math.isclose(step2._tilted([about((1, 0, 0), 0.2), about((0, 1, 0), -1.0)]), math.sin(0.5))
+    assert math.isclose(step2._tilted([about((0.6, 0.8, 0), 1.0)]), math.sin(0.5))
+    assert step2._tilted([about((0, 0, 1), 2.0)]) == 0.0  # a turn is no tilt
+
+
+def _imu(*means):
+    return [SimpleNamespace(linear_acceleration=SimpleNamespace(x=x, y=y)) for x, y in means]
+
+
+def test_4_2_the_exact_threshold_is_the_largest_mean_below_the_top_that_every_way_computes_alike():
+    from tutorial.exercises.grader import CaseFailed
+
+    # horizontal means 5.001, 4.0 and 4.243 (3, 3: every way gives 4.242640687119285)
+    assert step4._exact_threshold(_imu((0.1, 5.0), (4.0, 0.0), (3.0, 3.0))) == math.hypot(3.0, 3.0)
+    # a mean that the ways compute apart is passed over: hypot(0.076, 1.624) ends in ...675, the square root ...673
+    x, y = 0.076, 1.624
+    assert math.hypot(x, y) != math.sqrt(x * x + y * y)
+    assert step4._exact_threshold(_imu((5.0, 5.0), (x, y), (0.0, 0.1))) == 0.1
+    with pytest.raises(CaseFailed, match=r"^the Imu messages have no mean that every way to compute hypot\(x, y\)"):
+        step4._exact_threshold(_imu((3.0, 4.0), (0.0, 5.0)))  # no mean below the largest
+
+
+def test_4_x_each_message_after_an_imu_message_is_paired_with_it_and_one_after_another_with_none():
+    node = SimpleNamespace(order=["/Tank/imu", "/Tank/peak", "/Tank/peak", "/Tank/other", "/Tank/imu", "/Tank/peak"])
+    assert step4._follows(node, "/Tank/peak") == [0, None, 1]
+    assert step4._follows(SimpleNamespace(order=["/Tank/peak", "/Tank/imu"]), "/Tank/peak") == [None]
+
+
+def test_4_2_the_threshold_y_decides_lies_between_the_larger_part_and_the_hypot():
+    from tutorial.exercises.grader import CaseFailed
+
+    threshold = step4._y_threshold(_imu((10.0, 0.1), (3.0, 3.0), (0.0, 2.0)))
+    assert 3.0 < threshold < math.hypot(3.0, 3.0) and threshold == (3.0 + math.hypot(3.0, 3.0)) / 2
+    assert step4._y_threshold(_imu((-3.0, 3.0), (0.0, 0.0))) == threshold  # signs and still periods alike
+    with pytest.raises(CaseFailed, match=r"^the Imu messages have no mean whose y part decides"):
+        step4._y_threshold(_imu((10.0, 0.1), (0.0, 2.0), (0.0, 0.0)))  # 10.0005: within 5 % of its larger part
