@@ -51,3 +51,23 @@ def test_a_publisher_made_alone_notes_its_own_destruction_once():
     pub.destroy()
     pub.note_destroyed()
     assert real.destroyed == 1 and pub.destroyed is True and pub._noted == [pub]
+
+
+def test_a_message_the_real_publisher_refuses_is_not_kept_and_bytes_are_kept_as_they_are():
+    from std_msgs.msg import Float64
+
+    class Refusing(RealPublisher):
+        def publish(self, msg):  # as rclpy's Publisher.publish
+            if not isinstance(msg, (Float64, bytes)):
+                raise TypeError(f"Expected {Float64}, got {type(msg)}")
+
+    publisher = CapturingPublisher(Refusing(), Float64, "/Tank/peak")
+    try:
+        publisher.publish(1.5)
+    except TypeError as exc:
+        assert "got <class 'float'>" in str(exc)
+    else:
+        raise AssertionError("a bare float was published")
+    publisher.publish(b"\x00\x01\x00\x00" + bytes(8))
+    publisher.publish(Float64(data=2.5))
+    assert [m.data for m in publisher.messages()] == [0.0, 2.5]

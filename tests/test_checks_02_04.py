@@ -55,6 +55,8 @@ def test_4_1_a_norm_with_z_is_named_only_over_the_periods_own_steps():
 def test_4_1_a_peak_never_started_over_is_named_only_after_the_first_period():
     assert "start over" in hint(9.0)  # the largest since step 0
     assert "start over" not in hint(9.0, first=0)  # the first period starts at step 0: nothing to start over
+    # the second period (steps 1 to 2), step 0 the largest: started over, not one step early
+    assert "start over" in hint(8.0, readings=[(0.0, 8.0, 0.0), (1.0, 1.0, 0.0), (0.0, 3.0, 0.0)], first=1, last=2)
 
 
 def test_4_1_a_peak_one_step_early_is_named_for_the_step_before_the_period_only():
@@ -178,22 +180,25 @@ def _ms(seconds: float) -> float:
 
 
 def test_4_2_the_hidden_parameters_follow_the_statement():
-    draws = [step4._hidden_collision_parameters(random.Random(seed)) for seed in range(400)]
-    ranges = {  # (key, its range), per drawn set; holdoffs in ms
+    draws = [step4._hidden_collision_parameters(random.Random(seed)) for seed in range(3000)]
+    ranges = {  # per drawn set: each key's range; holdoffs in ms, a whole number and a half
         0: {"rate": (30, 50), "threshold": (2.5, 5), "holdoff": (150.5, 399.5)},
         1: {"rate": (9.5, 15), "threshold": (5, 10), "holdoff": (20.5, 599.5)},
     }
     for k, limits in ranges.items():
+        assert all(set(d[k]) == {"rate", "threshold", "holdoff"} for d in draws)
         for key, (low, high) in limits.items():
-            drawn = [d[k][key] * (1000 if key == "holdoff" else 1) for d in draws]
+            drawn = [_ms(d[k][key]) if key == "holdoff" else d[k][key] for d in draws]
             assert all(low <= v <= high for v in drawn), (k, key)
-            spread = (high - low) / 10
-            assert min(drawn) < low + spread and max(drawn) > high - spread, (k, key)
+            if key == "holdoff":  # every whole number of ms drawn: both ends too
+                assert (min(drawn), max(drawn)) == (low, high), (k, key)
+            else:  # spread over the whole range
+                edge = (high - low) / 40
+                assert min(drawn) < low + edge and max(drawn) > high - edge, (k, key)
     tiny = [_ms(d[2]) for d in draws]
     assert min(tiny) == 2.5 and max(tiny) == 44.5
     for holdoff in tiny + [_ms(d[k]["holdoff"]) for d in draws for k in (0, 1)]:
         assert holdoff % 1 == 0.5  # a whole number of ms and a half: never a whole number of steps
-    assert all(set(d[k]) == {"rate", "threshold", "holdoff"} for d in draws for k in (0, 1))
 
 
 def test_2_2_the_same_rotation_is_q_or_minus_q_of_unit_length_up_to_the_tolerance():
@@ -221,6 +226,11 @@ def test_2_2_the_checks_own_runs_are_measured_by_their_turn_and_their_tilt():
     assert math.isclose(step2._tilted([about((1, 0, 0), 0.2), about((0, 1, 0), -1.0)]), math.sin(0.5))
     assert math.isclose(step2._tilted([about((0.6, 0.8, 0), 1.0)]), math.sin(0.5))
     assert step2._tilted([about((0, 0, 1), 2.0)]) == 0.0  # a turn is no tilt
+    # tumbling: the angle turned from the first orientation, about any axis
+    tumble = [about((1, 0, 0), 0.0), about((0.6, 0.8, 0), 0.5), about((0.6, 0.8, 0), 1.5)]
+    assert math.isclose(step2._rotated(tumble), 1.5)
+    assert math.isclose(step2._rotated([about((0, 1, 0), 0.3), about((0, 1, 0), -0.9)]), 1.2)
+    assert step2._rotated([about((0, 0, 1), 0.7)] * 3) == 0.0
 
 
 def _imu(*means):
@@ -254,3 +264,28 @@ def test_4_2_the_threshold_y_decides_lies_between_the_larger_part_and_the_hypot(
     assert step4._y_threshold(_imu((-3.0, 3.0), (0.0, 0.0))) == threshold  # signs and still periods alike
     with pytest.raises(CaseFailed, match=r"^the Imu messages have no mean whose y part decides"):
         step4._y_threshold(_imu((10.0, 0.1), (0.0, 2.0), (0.0, 0.0)))  # 10.0005: within 5 % of its larger part
+    # small means too (a tank at rest): the largest ratio, however small the parts
+    assert step4._y_threshold(_imu((0.9, 0.0), (0.003, 0.003))) == (0.003 + math.hypot(0.003, 0.003)) / 2
+    with pytest.raises(CaseFailed, match=r"^the Imu messages have no mean whose y part decides"):
+        step4._y_threshold(_imu((0.0, 0.0), (0.0, 0.0)))  # nothing moves: no threshold of 0
+
+
+def test_4_x_the_noting_node_gives_rclpy_every_argument_of_a_publisher_and_notes_each_message_in_turn():
+    from std_msgs.msg import Float64
+
+    made, sent = [], []
+
+    class Real:  # what rclpy's Node is asked for
+        def create_publisher(self, msg_type, topic, qos_profile, **kwargs):
+            made.append((msg_type, topic, qos_profile, kwargs))
+            return SimpleNamespace(publish=lambda msg: sent.append((topic, msg.data)), destroy=lambda: None)
+
+    node = step4._NotingNode(Real())
+    imu = node.create_publisher(Float64, "/Tank/imu", 1, callback_group="group")
+    peak = node.create_publisher(Float64, "/Tank/peak", 2)
+    imu.publish(Float64(data=1.0))
+    peak.publish(Float64(data=2.0))
+    imu.publish(Float64(data=3.0))
+    assert made == [(Float64, "/Tank/imu", 1, {"callback_group": "group"}), (Float64, "/Tank/peak", 2, {})]
+    assert node.order == ["/Tank/imu", "/Tank/peak", "/Tank/imu"]
+    assert sent == [("/Tank/imu", 1.0), ("/Tank/peak", 2.0), ("/Tank/imu", 3.0)]

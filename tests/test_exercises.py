@@ -11,6 +11,7 @@ case that catches that mistake, with a message naming the input.
 from __future__ import annotations
 
 import json
+import math
 import re
 
 import pytest
@@ -106,6 +107,19 @@ def test_the_empty_stub_fails_as_not_done(ros, snapshot, number):
     assert str(result).startswith(f"\u2717 Exercise {number}")
     assert "not done yet" in result.message and "NotImplementedError" in result.message
     assert str(result) == snapshot
+
+
+@pytest.mark.more
+@pytest.mark.parametrize(
+    "number,body",
+    [("2.2", "    def control(self) -> bool:\n"), ("4.1", "    def control(self) -> bool:\n")],
+    ids=["2.2-control", "4.1-control"],
+)
+def test_an_answer_half_written_is_told_not_done(ros, number, body):
+    """An answer whose control() is still its stub (raised on the simulation thread) is not done, not a failure."""
+    ex = exercise(number)
+    result = grade(ex, ex["stub"], put_in(ex["solution"], body, body + "        raise NotImplementedError\n"))
+    assert not result.passed and result.message.startswith("not done yet: "), str(result)
 
 
 # (exercise, text of the solution, the mistake put in its place, the case that must catch it)
@@ -582,6 +596,23 @@ MUTANT_MISTAKES = [
         "        self.peak = max(self.recent)\n",
         "rate=10.0",
     ),
+    # the peak published as a bare float: rclpy refuses it, on the simulation thread
+    (
+        "4.1",
+        "self.peak_publisher.publish(Float64(data=self.peak))",
+        "self.peak_publisher.publish(self.peak)",
+        "rate=20.0",
+    ),
+    # the peak as a std_msgs/Float32: "a float is a float"
+    (
+        "4.1",
+        ('            Float64, f"/{config.body_name}/peak_acceleration"', "Float64(data=self.peak)"),
+        (
+            "            __import__('std_msgs.msg').msg.Float32, f\"/{config.body_name}/peak_acceleration\"",
+            "__import__('std_msgs.msg').msg.Float32(data=self.peak)",
+        ),
+        "rate=20.0",
+    ),
     # the pose without its header: geometry_msgs/Pose
     (
         "2.2",
@@ -746,6 +777,30 @@ def test_2_2_a_check_whose_own_tumble_does_not_tilt_the_tank_says_so(ros, gradin
     monkeypatch.setattr(step2, "_tumble", lambda rng: still)  # upright in the air (the tracks' drive tilts it a little)
     ex = exercise("2.2")
     with pytest.raises(RuntimeError, match=r"the check's own run did not tilt the tank \(0\.0\d\d\)"):
+        grade(ex, ex["stub"], ex["solution"])
+
+
+@pytest.mark.more
+def test_2_2_a_check_whose_own_tumble_mujoco_puts_back_upright_says_so(ros, grading_seed, monkeypatch):
+    """A tumble whose velocities MuJoCo cannot step (NaN, as assigning None to them gives) is put back upright."""
+    from tutorial.exercises import step2_joint_state_publisher as step2
+
+    real = step2._tumble
+    monkeypatch.setattr(step2, "_tumble", lambda rng: {**real(rng), "spin": [math.nan] * 3, "drift": [math.nan] * 3})
+    ex = exercise("2.2")
+    with pytest.raises(RuntimeError, match=r"the check's own run did not tilt the tank \(0\.0\d\d\)"):
+        grade(ex, ex["stub"], ex["solution"])
+
+
+@pytest.mark.more
+def test_2_2_a_check_whose_own_tumble_does_not_spin_the_tank_says_so(ros, grading_seed, monkeypatch):
+    """Placed tilted but not spinning: tilted all run, yet no tumble."""
+    from tutorial.exercises import step2_joint_state_publisher as step2
+
+    real = step2._tumble
+    monkeypatch.setattr(step2, "_tumble", lambda rng: {**real(rng), "spin": [0.0] * 3, "drift": [0.0] * 3})
+    ex = exercise("2.2")
+    with pytest.raises(RuntimeError, match=r"the check's own run did not tumble the tank \(0\.\d\d\d rad\)"):
         grade(ex, ex["stub"], ex["solution"])
 
 

@@ -27,9 +27,18 @@ class CapturingPublisher:
             self._noted.append(self)
 
     def publish(self, msg) -> None:
+        """Keep the message's bytes, then publish it on the real publisher.
+
+        Kept first: a message published after its real publisher was destroyed still counts as sent (the checks
+        tell that mistake by its order).  One of another type is not kept.
+
+        Raises:
+            TypeError: ``msg`` is neither a ``msg_type`` nor bytes (rclpy's own refusal, which a learner reads).
+        """
         from rclpy.serialization import serialize_message
 
-        self.sent.append(serialize_message(msg))
+        if isinstance(msg, (self.msg_type, bytes)):
+            self.sent.append(msg if isinstance(msg, bytes) else serialize_message(msg))
         self.real.publish(msg)
 
     def destroy(self) -> None:

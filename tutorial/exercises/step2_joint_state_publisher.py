@@ -99,7 +99,7 @@ def _drive(name: str, cls, parameters: dict, script=None, duration: float = DURA
     if summary.get("error"):
         if "NotImplementedError" in summary["error"]:
             raise NotImplementedError
-        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1])
+        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1].rstrip(".") + ".")
     return node, probe, app
 
 
@@ -468,8 +468,12 @@ def check_pose_publisher(cls) -> Result:
         quats = [state[2] for state in runs[kind][2].controller.states.values()]
         if kind == "turn" and not _turned(quats) > 0.3:
             raise RuntimeError(f"the check's own drive did not turn the tank ({_turned(quats):.3f} rad)")
-        if plans[kind][3] is not None and not _tilted(quats) > 0.3:
-            raise RuntimeError(f"the check's own run did not tilt the tank ({_tilted(quats):.3f})")
+        if plans[kind][3] is not None:  # from the first step on: MuJoCo puts a state it cannot step back upright
+            after = quats[1:]
+            if not _tilted(after) > 0.3:
+                raise RuntimeError(f"the check's own run did not tilt the tank ({_tilted(after):.3f})")
+            if not _rotated(after) > 1.0:
+                raise RuntimeError(f"the check's own run did not tumble the tank ({_rotated(after):.3f} rad)")
 
     def hidden_cases(rng):
         """The statement's rules on this learner's draws: the tank tilted and tumbling in the air, at a rate of a
@@ -535,6 +539,12 @@ def _turned(quats) -> float:
 def _tilted(quats) -> float:
     """The largest ``hypot(x, y)`` of quaternions ``quats`` (w x y z): 0 upright, sin(a / 2) tilted by ``a``."""
     return max(math.hypot(float(q[1]), float(q[2])) for q in quats)
+
+
+def _rotated(quats) -> float:
+    """The largest angle (rad) any of quaternions ``quats`` (w x y z, unit) is turned from the first, about any axis."""
+    first = quats[0]
+    return max(2 * math.acos(min(1.0, abs(sum(float(a) * float(b) for a, b in zip(q, first))))) for q in quats)
 
 
 def _same_rotation(a, b, tol: float) -> bool:

@@ -119,7 +119,7 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
     if summary.get("error"):
         if "NotImplementedError" in summary["error"]:
             raise NotImplementedError
-        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1])
+        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1].rstrip(".") + ".")
     return node, probe
 
 
