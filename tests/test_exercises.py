@@ -804,6 +804,19 @@ def test_2_2_a_check_whose_own_tumble_does_not_spin_the_tank_says_so(ros, gradin
         grade(ex, ex["stub"], ex["solution"])
 
 
+@pytest.mark.more
+def test_2_2_a_slow_tumble_of_the_checks_own_run_still_counts(ros, grading_seed, monkeypatch):
+    """0.5 rad/s about x for 2.5 s turns the tank about 1.25 rad: a tumble (over 1 rad), however slow."""
+    from tutorial.exercises import step2_joint_state_publisher as step2
+
+    real = step2._tumble
+    tilted = [math.cos(0.4), math.sin(0.4), 0.0, 0.0]  # 0.8 rad about x: tilted from the start
+    slow = {"quat": tilted, "spin": [0.5, 0.0, 0.0], "drift": [0.0] * 3}
+    monkeypatch.setattr(step2, "_tumble", lambda rng: {**real(rng), **slow})
+    ex = exercise("2.2")
+    assert grade(ex, ex["stub"], ex["solution"]).passed
+
+
 @pytest.mark.parametrize(
     "added",
     [
