@@ -613,6 +613,39 @@ MUTANT_MISTAKES = [
         ),
         "rate=20.0",
     ),
+    # configure() that raises (a parameter the statement does not name): told with the controller's name
+    ("2.2", 'self.rate = config.parameters["rate"]', 'self.rate = config.parameters["frequency"]', "10 Hz from t = 0"),
+    (
+        "4.1",
+        'Float64, f"/{config.body_name}/peak_acceleration", imu_qos()',
+        'Float64, f"/{config.body_name}/peak_acceleration", imu_qos(10)',
+        "rate=20.0",
+    ),
+    # stamps of k * 0.1 s, the default period written in, while ticking at the rate given: right at 10 Hz only
+    (
+        "2.2",
+        "            stamp.sec, stamp.nanosec = stamp_parts(self.io.current_time)\n",
+        "            self.sent = getattr(self, 'sent', -1) + 1\n"
+        "            stamp.sec, stamp.nanosec = stamp_parts(self.sent * 0.1)\n",
+        "25 Hz from t = 0",
+    ),
+    # the pose read once, in initialize(): right at t = 0 only
+    (
+        "2.2",
+        ("        self.msg = PoseStamped()\n", "(x, y, z), (w, qx, qy, qz) = self.io.body.root_pose()"),
+        (
+            "        self.msg = PoseStamped()\n        self.first = io.body.root_pose()\n",
+            "(x, y, z), (w, qx, qy, qz) = self.first",
+        ),
+        "position",
+    ),
+    # super().configure(config) called twice: two Imu publishers
+    (
+        "4.1",
+        "        if not super().configure(config):\n            return False\n",
+        "        if not super().configure(config):\n            return False\n        super().configure(config)\n",
+        "rate=20.0",
+    ),
     # the pose without its header: geometry_msgs/Pose
     (
         "2.2",

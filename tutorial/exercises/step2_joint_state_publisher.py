@@ -517,7 +517,11 @@ def check_pose_publisher(cls) -> Result:
 
     def cases(rng):
         """The visible cases, then the hidden ones; between them, outside the learner's cases, checks of its runs."""
-        yield Case(f"{call}: 10 Hz from t = 0, stamped with simulation time", timing)
+        yield Case(
+            f"{call}: 10 Hz from t = 0, stamped with simulation time",
+            timing,
+            "read the rate from config.parameters['rate'] (10 Hz by default) and publish at it, the first at t = 0.",
+        )
         yield Case(f"{call}: the root's position, frame world", position)
         yield Case(f"{call}: the root's orientation", orientation)
         yield Case(f"{turning}: 25 Hz from t = 0", lambda: timing("turn", turning))
@@ -548,10 +552,11 @@ def _rotated(quats) -> float:
 
 
 def _same_rotation(a, b, tol: float) -> bool:
-    """Two quaternions (x, y, z, w) give the same rotation (q and -q do), ``a`` of unit length (within 1e-3).
+    """Two quaternions (x, y, z, w) give the same rotation (q and -q do), ``a`` of unit length.
 
-    ``b`` is a unit quaternion; ``1 - |a . b|`` at most ``tol`` passes.  A NaN or an infinity in ``a`` never
-    passes: every comparison with a NaN is false, and an infinity makes the dot product infinite or NaN.
+    ``a``'s squared norm is within 1e-3 of 1; ``b`` is a unit quaternion; ``1 - |a . b|`` at most ``tol``
+    passes.  A NaN or an infinity in ``a`` never passes: every comparison with a NaN is false, and an
+    infinity makes the dot product infinite or NaN.
     """
     dot = abs(sum(x * y for x, y in zip(a, b)))
     return abs(1.0 - dot) <= tol and abs(sum(x * x for x in a) - 1.0) <= 1e-3
