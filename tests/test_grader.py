@@ -431,3 +431,18 @@ def test_expect_qos_names_each_policy_and_fails_on_any_one_of_them():
         "expected reliability reliable, durability volatile, history keep_last, depth 10."
     )
     assert raised.value.hint == "sensor data"
+
+
+def test_a_run_that_stopped_on_an_error_is_told_by_its_last_line_and_a_stub_s_as_not_done():
+    from tutorial.exercises.grader import CaseFailed, raise_run_error
+
+    raise_run_error({})
+    raise_run_error({"error": ""})
+    with pytest.raises(NotImplementedError):
+        raise_run_error({"error": "Traceback (most recent call last):\n  ...\nNotImplementedError\n"})
+    with pytest.raises(CaseFailed) as failed:
+        raise_run_error({"error": "Traceback (most recent call last):\n  ...\nTypeError: Expected Float64.\n\n"})
+    assert failed.value.what == "the simulation failed: TypeError: Expected Float64."
+    with pytest.raises(CaseFailed) as failed:
+        raise_run_error({"error": "KeyError: 'GUN'"})
+    assert failed.value.what == "the simulation failed: KeyError: 'GUN'."

@@ -190,6 +190,22 @@ def not_done(exc: BaseException | None) -> bool:
     return False
 
 
+def raise_run_error(summary: dict) -> None:
+    """Raise as a check must when its scripted run of the learner's controller stopped on an error.
+
+    ``summary``: the run's summary (``run_headless``); nothing happens without an ``"error"`` in it.
+
+    Raises:
+        NotImplementedError: the error is a stub's (the learner's code is not written yet).
+        CaseFailed: any other error, told by its last line.
+    """
+    error = summary.get("error")
+    if error:
+        if "NotImplementedError" in error:
+            raise NotImplementedError
+        raise CaseFailed("the simulation failed: " + error.strip().splitlines()[-1].rstrip(".") + ".")
+
+
 def _number_types() -> frozenset[type]:
     import numpy
 

@@ -29,7 +29,17 @@ import logging
 import math
 
 from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, not_done, show
+from tutorial.exercises.grader import (
+    Case,
+    CaseFailed,
+    Result,
+    expect_qos,
+    grade,
+    hidden_random,
+    not_done,
+    raise_run_error,
+    show,
+)
 
 DURATION = 2.0  # s of simulated time per checked run
 # s of a hidden run of 2.2: it stamps t = 2 s, where the simulation's clock reads a hair under 2 (1.99999999999989)
@@ -96,10 +106,7 @@ def _drive(name: str, cls, parameters: dict, script=None, duration: float = DURA
     if tumble is not None:
         attach.insert(0, ("Tank", "Tumble", tumble))
     summary, app = run_headless(project, duration, node=node, attach=attach)
-    if summary.get("error"):
-        if "NotImplementedError" in summary["error"]:
-            raise NotImplementedError
-        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1].rstrip(".") + ".")
+    raise_run_error(summary)
     return node, probe, app
 
 

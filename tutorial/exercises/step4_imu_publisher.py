@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, raise_run_error, show
 
 DURATION = 3.0  # s of simulated time per checked run: the tank hits the wall at about 2.05 s
 TIME_STEP_NS = 1_000_000  # the tank world's 1 ms step
@@ -117,10 +117,7 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
             ("Tank", "ImuProbe", probe.controller),
         ],
     )
-    if summary.get("error"):
-        if "NotImplementedError" in summary["error"]:
-            raise NotImplementedError
-        raise CaseFailed("the simulation failed: " + summary["error"].strip().splitlines()[-1].rstrip(".") + ".")
+    raise_run_error(summary)
     return node, probe
 
 
