@@ -19,7 +19,7 @@ def generate_launch_description(args) -> LaunchDescription:
         [
             *record_nodes(args, ["/joy", "/Tank/joint_state"]),  # first: up before the publishers start
             joy_node(args),
-            simulation_node(args, "step2.yaml"),
+            simulation_node(args, "reference/step2.yaml"),  # Step 2 as later steps run it: frozen
             NodeProcess("rtt_viewer", "tutorial.tools.rtt_run", viewer_args),
         ]
     )

@@ -21,7 +21,7 @@ def generate_launch_description(args) -> LaunchDescription:
         [
             *record_nodes(args, TOPICS),  # first: up before the publishers start
             joy_node(args, script="wall"),  # ram the wall ahead: the viewer shakes
-            simulation_node(args, "step4.yaml"),
+            simulation_node(args, "reference/step4.yaml"),  # Step 4 as later steps run it: frozen
             NodeProcess("rtt_viewer", "tutorial.tools.rtt_run", viewer_args),
         ]
     )

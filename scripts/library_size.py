@@ -59,7 +59,8 @@ def notebook_imports(numbers=NOTEBOOKS) -> tuple[set[str], set[str]]:
                     continue
                 source = "".join(cell["source"])
                 modules |= _imports_of_code(source)
-                projects |= set(re.findall(r"""["']([\w.-]+\.yaml)["']""", source))
+                found = re.findall(r"""["']((?:project/)?[\w/.-]+\.yaml)["']""", source)
+                projects |= {name.removeprefix("project/") for name in found}
     return modules, projects
 
 

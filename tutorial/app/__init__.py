@@ -12,5 +12,6 @@ module              what
 ``descriptions``    a model taken from a robot description topic
 ``floating_base``   a viewer's floating base: the root link placed where odometry says
 ``summary``         the exit summary a run prints or returns
+``reference``       the earlier steps' worked solutions, frozen, that later steps stand on
 ==================  ==============================================================
 """

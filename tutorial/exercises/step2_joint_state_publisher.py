@@ -90,7 +90,7 @@ def _drive(name: str, cls, parameters: dict, script=None, duration: float = DURA
     """
     import rclpy
 
-    from tutorial.controllers.tank_controller import RttTankController
+    from tutorial.app.reference.tank_controller import RttTankController
     from tutorial.joystick.scripted import ScriptedJoy
     from tutorial.notebook.runs import load, run_headless
 

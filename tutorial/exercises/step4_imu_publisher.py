@@ -98,7 +98,7 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
     """
     import rclpy
 
-    from tutorial.controllers.tank_controller import RttTankController
+    from tutorial.app.reference.tank_controller import RttTankController
     from tutorial.joystick.scripted import ScriptedJoy
     from tutorial.joystick.sources import SCRIPTS
     from tutorial.notebook.runs import load, run_headless

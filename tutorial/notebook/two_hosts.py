@@ -63,12 +63,12 @@ class TwoHosts:
         return program
 
     def simulation(
-        self, host: str = "robot", project: str = "project/step2.yaml", *args: str, **env: str
+        self, host: str = "robot", project: str = "project/reference/step2.yaml", *args: str, **env: str
     ) -> HostProgram:
         return self.start(host, python("tutorial.tools.rtt_run", project, "--headless", "--json", *args), **env)
 
     def monitor(self, host: str = "operator", name: str = "rtt_viewer", **env: str) -> HostProgram:
-        project = "project/step3.yaml"
+        project = "project/reference/step3.yaml"
         argv = python("tutorial.tools.rtt_run", project, "--headless", "--json", "--ros-args", "-r", f"__node:={name}")
         return self.start(host, argv, **env)
 
