@@ -64,9 +64,10 @@ def main() -> int:
     try:
         app.open()
         probes = [c for _, c, _ in app.controllers if hasattr(c, "frame_drawn")]
-        if tape is not None and app.scene is not None and app.scene._pipe is not None:
+        sink = None if app.scene is None else app.scene.sink
+        if tape is not None and hasattr(sink, "socket"):  # a BatchSink (tutorial.view.sinks): its frames' socket
             tape.probes = {probe.config.body_name: probe for probe in probes}
-            app.scene._pipe.socket = tape.tap(app.scene._pipe.socket)
+            sink.socket = tape.tap(sink.socket)
 
         def drawn(seconds: float) -> None:
             for probe in probes:  # every body's probe notes which of its states this frame shows

@@ -206,19 +206,21 @@ def server_of():
 @pytest.mark.parametrize("batch", [True, False], ids=["project_server", "meshcats_own_server"])
 def test_the_scene_sends_a_frame_as_one_message_where_it_can_and_every_pose_arrives(server_of, batch):
     from tutorial.view.scene import Scene
+    from tutorial.view.sinks import BatchSink, frame_sink
 
     server = server_of(batch)
     model, data = tank()
     vis = server.visualizer()
-    scene = Scene(vis, model)
+    scene = Scene(vis, model, sink=frame_sink(vis))  # as the App makes it
+    assert isinstance(scene.sink, BatchSink)
     try:
         scene.build(data)  # the first frame: three moving bodies
-        first = scene._pipe.messages
+        first = scene.sink.messages
         data.qpos[0] += 0.5  # the chassis moves: the turret and the barrel ride on it
         mujoco.mj_kinematics(model, data)
         assert scene.update(data) == 3
-        frame = scene._pipe.messages - first
-        assert scene._pipe.batch is batch
+        frame = scene.sink.messages - first
+        assert scene.sink.batch is batch
         assert first == (1 if batch else 1 + 3)  # meshcat's own server refused the batch, then took three singles
         assert frame == (1 if batch else 3)
         stored = stored_transforms(server)
@@ -565,13 +567,13 @@ FRAME = [("/meshcat/rtt/a", pose(1.0)), ("/meshcat/rtt/b", pose(2.0))]
 
 @pytest.mark.unit
 def test_meshcats_unknown_command_answer_turns_batching_off_and_the_frame_goes_as_singles():
-    from tutorial.view.scene import _Pipeline
+    from tutorial.view.sinks import BatchSink
 
     server = StandInServer([b"error: unrecognized comand", b"ok", b"ok", b"ok", b"ok"])
-    pipe = _Pipeline(server.url)
+    pipe = BatchSink(server.url)
     try:
-        pipe.send_frame(FRAME)
-        pipe.send_frame(FRAME)
+        pipe.send_transforms(FRAME)
+        pipe.send_transforms(FRAME)
     finally:
         pipe.close()
         server.close()
@@ -583,13 +585,13 @@ def test_meshcats_unknown_command_answer_turns_batching_off_and_the_frame_goes_a
 
 @pytest.mark.unit
 def test_any_other_refusal_of_a_frame_is_raised_not_hidden_by_a_fallback():
-    from tutorial.view.scene import _Pipeline
+    from tutorial.view.sinks import BatchSink
 
     server = StandInServer([b"error: not msgpack within the limits: ExtraData"])
-    pipe = _Pipeline(server.url)
+    pipe = BatchSink(server.url)
     try:
         with pytest.raises(RuntimeError, match="refused a frame"):
-            pipe.send_frame(FRAME)
+            pipe.send_transforms(FRAME)
         assert pipe.batch is True
     finally:
         pipe.close()
@@ -600,17 +602,17 @@ def test_any_other_refusal_of_a_frame_is_raised_not_hidden_by_a_fallback():
 def test_after_a_timeout_a_late_reply_is_not_taken_for_the_next_frames():
     import threading
 
-    from tutorial.view.scene import _Pipeline
+    from tutorial.view.sinks import BatchSink
 
     release = threading.Event()
     # The first frame's reply comes late, and says something the next frame must never read as its own.
     server = StandInServer([(release, b"error: the first frame's late reply"), b"ok"])
-    pipe = _Pipeline(server.url)
+    pipe = BatchSink(server.url)
     try:
         with pytest.raises(RuntimeError, match="did not answer"):
-            pipe.send_frame(FRAME, timeout_ms=200)
+            pipe.send_transforms(FRAME, timeout_ms=200)
         release.set()
-        pipe.send_frame(FRAME, timeout_ms=10000)  # its own reply: ok
+        pipe.send_transforms(FRAME, timeout_ms=10000)  # its own reply: ok
         assert pipe.batch is True
     finally:
         release.set()

@@ -10,12 +10,23 @@ from tutorial.view.scene import POSE_TOLERANCE, Scene
 from conftest import MODEL
 
 
+class RecordingWindow:
+    """Stands in for meshcat's window: records each ``SetTransform`` sent, by path."""
+
+    def __init__(self, sent: dict):
+        self.sent = sent
+
+    def send(self, command):
+        self.sent[str(command.path)] = np.array(command.matrix)
+
+
 class RecordingVisualizer:
     """Stands in for ``meshcat.Visualizer``: records the transforms sent, by path (no server, no pipeline)."""
 
     def __init__(self, sent=None, path="meshcat"):
         self.sent = {} if sent is None else sent
         self.path = path
+        self.window = RecordingWindow(self.sent)
 
     def __getitem__(self, path):
         return RecordingVisualizer(self.sent, f"{self.path}/{path}")
@@ -150,7 +161,7 @@ def test_the_pipeline_packs_what_meshcat_python_packs():
     import umsgpack
     from meshcat.commands import SetTransform
 
-    from tutorial.view.scene import pack_command
+    from tutorial.view.sinks import pack_command
 
     class Path:
         def lower(self):

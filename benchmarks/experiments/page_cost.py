@@ -135,6 +135,7 @@ def page_cost(model: str, count: int, details: list[str], seconds: float) -> dic
     from tutorial.core.world import ModelEntry, build_world
     from tutorial.view.meshcat_server import start_server
     from tutorial.view.scene import Scene
+    from tutorial.view.sinks import frame_sink
 
     entries = [ModelEntry(f"M{i}", str(ROOT / "model" / f"{model}.xml")) for i in range(count)]
     m = build_world(entries)
@@ -143,7 +144,10 @@ def page_cost(model: str, count: int, details: list[str], seconds: float) -> dic
     server = start_server()
     out = {}
     try:
-        Scene(server.visualizer(), m).build(d)
+        vis = server.visualizer()
+        scene = Scene(vis, m, sink=frame_sink(vis))
+        scene.build(d)
+        scene.close()
         for detail in details:
             page = Page(server.web_url + f"?detail={detail}")  # closes its browser itself if it fails to open
             try:

@@ -20,26 +20,27 @@ def scene_update_cost(model_file: str, frames: int) -> dict:
 
     from tutorial.core.world import ModelEntry, build_world
     from tutorial.view.meshcat_server import start_server
-    from tutorial.view.scene import Scene
+    from tutorial.view.scene import Scene, VisualizerSink
+    from tutorial.view.sinks import BatchSink
 
     model = build_world([ModelEntry("M", ROOT / model_file)])
     data = mujoco.MjData(model)
     server = start_server()
     try:
-        scene = Scene(server.visualizer(), model)
+        vis = server.visualizer()
+        batch, own = BatchSink(server.zmq_url), VisualizerSink(vis)
+        scene = Scene(vis, model, sink=batch)
         scene.build(data)
-        pipe = scene._pipe
         times = {"one_message": [], "round_trip_per_body": []}
         for i in range(frames):
-            for label, p in (("one_message", pipe), ("round_trip_per_body", None)):
-                scene._pipe = p
-                data.qpos[:] = 0.001 * (2 * i + (p is None))
+            for label, sink in (("one_message", batch), ("round_trip_per_body", own)):
+                scene.sink = sink
+                data.qpos[:] = 0.001 * (2 * i + (sink is own))
                 mujoco.mj_kinematics(model, data)
                 t0 = time.perf_counter()
                 scene.update(data)
                 times[label].append(time.perf_counter() - t0)
-        scene._pipe = pipe
-        scene.close()
+        batch.close()
     finally:
         server.close()
     out = {k: pct(v, 1000.0) for k, v in times.items()}

@@ -226,6 +226,7 @@ class App:
     def _open_view(self) -> None:
         from tutorial.view.meshcat_server import start_server, through_jupyter
         from tutorial.view.scene import Scene, look_at_geoms
+        from tutorial.view.sinks import frame_sink
 
         if self.vis is None:
             self.server = start_server()
@@ -233,7 +234,7 @@ class App:
         # A robot drawn from its description, with no world around it: meshcat's grid is its ground, and the
         # camera frames the robot whatever its size (the tank's close-up assumes the tank's).
         described = self.project.simulator is None and any(m.description for m in self.project.models)
-        self.scene = Scene(self.vis, self.model)
+        self.scene = Scene(self.vis, self.model, sink=frame_sink(self.vis))  # the fastest way its view takes
         self.scene.build(self.data, grid=described)
         self.overlay_view = MeshcatOverlays(self.vis, self.overlays)
         robot = self.bodies[self.project.models[-1].name]

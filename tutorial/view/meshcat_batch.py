@@ -21,8 +21,8 @@ forwards the whole as one WebSocket message.  The page it serves
 (:mod:`tutorial.view.meshcat_page`) hands each inner command to
 meshcat's own ``handle_command``.  meshcat's own server does not know the
 command: it answers ``error: unrecognized comand`` and forwards nothing,
-and the scene then sends one command per transform again
-(:class:`tutorial.view.scene.Scene`).
+and the scene's sink then sends one command per transform again
+(:class:`tutorial.view.sinks.BatchSink`).
 
 Every function here may be called from any thread.
 """

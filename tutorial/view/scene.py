@@ -9,22 +9,12 @@ A body without joints rides in the frame of the body it is welded to (the
 tank's tracks in the chassis'), so a frame sends one transform for each part
 that moves on its own: three for a tank, not five.
 
-A frame's transforms go out as *one message*.  Into a notebook's widget
-(:mod:`tutorial.view.widget`), through its window's ``send_transforms``.
-To a meshcat server: meshcat-python sends one
-command per transform and waits for the server's reply after each (a zmq
-REQ socket), which costs a round trip between processes per body (20 ms a
-frame for a 24-joint arm) and the page one WebSocket message per body.
-The scene sends a frame's ``set_transform`` commands, each as meshcat
-lowers it, inside one ``set_transforms`` command
-(:mod:`tutorial.view.meshcat_batch`) through its own zmq DEALER socket to
-the same server, then waits for the one reply.  A server that does not
-know the command (meshcat's own, when a notebook passes its own
-``meshcat.Visualizer``) answers with an error; the scene then sends that
-frame, and every later one, as single commands, all in flight at once,
-and collects their replies: still one wait per frame.  Commands are packed
-by ``msgpack``'s C extension, byte for byte what meshcat-python's own
-packer makes.
+A frame's transforms go out through one *sink*: an object with
+``send_transforms([(meshcat path, 4x4 pose), ...])``.  By default it is
+meshcat's own ``Visualizer`` (:class:`VisualizerSink`: one ``set_transform``
+per body); the :class:`tutorial.app.app.App` gives the scene a faster one
+that its view can serve (:mod:`tutorial.view.sinks`: a frame as one message
+to a notebook's widget or to the project's meshcat server).
 
 Geoms in group 3 and above are hidden, as in MuJoCo's own viewer (the tank's
 road wheels live there, inside the track covers).
@@ -35,27 +25,14 @@ created its visualizer, and only that thread may call its methods.
 
 from __future__ import annotations
 
-import msgpack
 import mujoco
 import numpy as np
-
-from tutorial.view.meshcat_batch import SET_TRANSFORMS, pack_batch
 
 HIDDEN_GEOM_GROUP = 3
 POSE_TOLERANCE = 1e-7  # m, and rotation-matrix entries: a body that moved less is not sent again
 _PLANE_EXTENT = 20.0  # m, drawn size of an infinite plane
 # meshcat cylinders run along their local Y axis, MuJoCo's along Z.
 _Y_TO_Z = np.array([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 0], [0, 0, 0, 1]], dtype=float)
-
-
-def pack_command(command: dict) -> bytes:
-    """A lowered meshcat command (``SetTransform(...).lower()``) as the bytes the server forwards.
-
-    msgpack's C packer makes byte for byte what meshcat-python's pure-Python
-    umsgpack makes (tests/test_scene.py checks it), many times faster
-    (``benchmarks/RESULTS.md``, *What closed the gaps*).  Any thread.
-    """
-    return msgpack.packb(command)
 
 
 def _pose(pos, mat) -> np.ndarray:
@@ -76,6 +53,24 @@ def _color(rgba) -> tuple[int, float]:
     return (int(r * 255) << 16) | (int(g * 255) << 8) | int(b * 255), a
 
 
+class VisualizerSink:
+    """meshcat's own way to move bodies: one ``set_transform`` command per body, through ``vis``'s window.
+
+    Args:
+        vis: a ``meshcat.Visualizer``, owned by the thread that owns the Scene.
+    """
+
+    def __init__(self, vis):
+        self.vis = vis
+
+    def send_transforms(self, transforms: list) -> None:
+        """``[(meshcat path, 4x4 pose, translation in m), ...]``, as ``vis[path].set_transform(pose)`` sends each."""
+        from meshcat.commands import SetTransform
+
+        for path, matrix in transforms:
+            self.vis.window.send(SetTransform(matrix, path))
+
+
 class Scene:
     """A model drawn in one meshcat visualizer.
 
@@ -83,11 +78,13 @@ class Scene:
         vis: a ``meshcat.Visualizer``; this Scene's thread must own it.
         model: the ``MjModel`` to draw.
         root: meshcat path under which everything is drawn.
+        sink: where each frame's transforms go (``send_transforms``); by default
+            ``vis`` itself, one command per body (:class:`VisualizerSink`).
 
     Call :meth:`build` once, then :meth:`update` each frame.
     """
 
-    def __init__(self, vis, model: mujoco.MjModel, root: str = "rtt"):
+    def __init__(self, vis, model: mujoco.MjModel, root: str = "rtt", sink=None):
         self.vis = vis
         self.model = model
         self.root = root
@@ -95,14 +92,10 @@ class Scene:
         self.moving_bodies: list[int] = []
         # The pose last sent for each moving body, one row each: position (3) and rotation matrix (9).
         self._sent = np.empty((0, 12))
-        self._paths: list = []  # the meshcat handle of each moving body, made once in build()
+        self._paths: list = []  # the meshcat path of each moving body, made once in build()
         self.frames = 0
         self.transforms_sent = 0
-        window = getattr(vis, "window", None)
-        zmq_url = getattr(window, "zmq_url", None)
-        self._pipe = _Pipeline(zmq_url) if zmq_url else None
-        # A window that takes a frame's transforms at once (a notebook's widget, tutorial.view.widget).
-        self._send_transforms = getattr(window, "send_transforms", None)
+        self.sink = VisualizerSink(vis) if sink is None else sink
 
     def body_path(self, body_id: int) -> str:
         """The meshcat path of a body's frame, e.g. ``rtt/Tank/TURRET_Y``."""
@@ -169,7 +162,7 @@ class Scene:
                 self.vis[path].set_object(geometry, material)
                 self.vis[path].set_transform(base @ local)
         self.moving_bodies = sorted(moving)
-        self._paths = [self.vis[self.body_path(b)] for b in self.moving_bodies]
+        self._paths = [self.vis[self.body_path(b)].path for b in self.moving_bodies]
         self._sent = np.full((len(self.moving_bodies), 12), np.nan)  # NaN: never sent
         self.update(data)
 
@@ -219,23 +212,18 @@ class Scene:
         now = np.concatenate((data.xpos[ids], data.xmat[ids]), axis=1)  # (bodies, 12)
         changed = np.flatnonzero(~(np.abs(now - self._sent) <= POSE_TOLERANCE).all(axis=1))
         self._sent[changed] = now[changed]
-        if self._pipe is not None:
-            self._pipe.send_frame([(self._paths[i].path, _pose(now[i, :3], now[i, 3:])) for i in changed])
-        elif self._send_transforms is not None:
-            if len(changed):
-                self._send_transforms([(self._paths[i].path, _pose(now[i, :3], now[i, 3:])) for i in changed])
-        else:
-            for i in changed:
-                self._paths[i].set_transform(_pose(now[i, :3], now[i, 3:]))
+        if len(changed):
+            self.sink.send_transforms([(self._paths[i], _pose(now[i, :3], now[i, 3:])) for i in changed])
         sent = len(changed)
         self.frames += 1
         self.transforms_sent += sent
         return sent
 
     def close(self) -> None:
-        """Close the scene's own zmq socket (the owner thread, once drawing is over)."""
-        if self._pipe is not None:
-            self._pipe.close()
+        """Close the sink, if it has anything to close (the owner thread, once drawing is over)."""
+        close = getattr(self.sink, "close", None)
+        if close is not None:
+            close()
 
     def set_camera(self, position, target=(0.0, 0.0, 0.0)) -> None:
         """Place meshcat's default camera at ``position`` (m, world frame, Z up) looking at ``target``.
@@ -292,72 +280,3 @@ def look_at_geoms(model: mujoco.MjModel, data: mujoco.MjData, geom_ids, directio
     along = np.asarray(direction, dtype=float)
     distance = max(float(np.linalg.norm(along)), 1.8 * float(np.linalg.norm(high - low)) / 2)  # 1/sin(37.5 deg) ~ 1.64
     return target + along / np.linalg.norm(along) * distance, target
-
-
-class _Pipeline:
-    """A frame's ``set_transform`` commands sent at once, then one wait for the server.
-
-    The server's socket is REP: a DEALER talks to it by putting an empty
-    frame before each request, and gets ``[b"", reply]`` back, in order.
-    ``batch`` says whether the server takes ``set_transforms``: True until
-    it answers one with meshcat's ``error: unrecognized comand``.
-    Owned by the thread that owns the Scene.
-    """
-
-    UNKNOWN_COMMAND = b"error: unrecognized"  # how meshcat's own server answers a command it does not know
-
-    def __init__(self, zmq_url: str):
-        self.zmq_url = zmq_url
-        self.socket = None
-        self._connect()
-        self.batch = True
-        self.messages = 0  # sent to the server (a frame is one while batch holds)
-
-    def _connect(self) -> None:
-        import zmq
-
-        if self.socket is not None:
-            self.socket.close()
-        self.socket = zmq.Context.instance().socket(zmq.DEALER)
-        self.socket.setsockopt(zmq.LINGER, 0)
-        self.socket.connect(self.zmq_url)
-
-    def send_frame(self, transforms: list, timeout_ms: int = 5000) -> None:
-        """Send ``[(meshcat path, 4x4 pose in m), ...]`` and wait until the server has applied them all.
-
-        Raises:
-            RuntimeError: the server did not answer within ``timeout_ms`` (the socket is then made
-                anew, so a late reply is never taken for a later frame's), or it refused a command.
-        """
-        from meshcat.commands import SetTransform
-
-        if not transforms:
-            return
-        commands = [SetTransform(matrix, path).lower() for path, matrix in transforms]
-        if self.batch:
-            self.socket.send_multipart([b"", SET_TRANSFORMS.encode(), b"", pack_batch(commands)])
-            self.messages += 1
-            [reply] = self._replies(1, timeout_ms)
-            if reply == b"ok":
-                return
-            if not reply.startswith(self.UNKNOWN_COMMAND):  # the project's server refused it: a bug, said aloud
-                raise RuntimeError(f"the meshcat server refused a frame: {reply[:200]!r}")
-            self.batch = False  # meshcat's own server: it applied nothing; single commands from now on
-        for command in commands:
-            self.socket.send_multipart([b"", b"set_transform", command["path"].encode(), pack_command(command)])
-        self.messages += len(commands)
-        refused = [r for r in self._replies(len(commands), timeout_ms) if r != b"ok"]
-        if refused:
-            raise RuntimeError(f"the meshcat server refused a transform: {refused[0][:200]!r}")
-
-    def _replies(self, n: int, timeout_ms: int) -> list[bytes]:
-        out = []
-        while len(out) < n:
-            if not self.socket.poll(timeout_ms):
-                self._connect()  # the replies still owed would come late and be read as the next frame's
-                raise RuntimeError(f"the meshcat server did not answer within {timeout_ms:d} ms")
-            out.append(self.socket.recv_multipart()[-1])
-        return out
-
-    def close(self) -> None:
-        self.socket.close()

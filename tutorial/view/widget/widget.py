@@ -257,10 +257,10 @@ class WidgetWindow:
 
     It stands in for meshcat's ``ViewerWindow`` (a connection to meshcat's
     server): ``send`` takes one command, and :meth:`send_transforms` a frame's
-    transforms at once (:class:`tutorial.view.scene.Scene` uses it when present).
+    transforms at once: the window is a scene's sink (:func:`tutorial.view.sinks.frame_sink`).
     """
 
-    zmq_url = None  # no server: tutorial.view.scene.Scene sends through this window
+    zmq_url = None  # no server: everything goes through this window
 
     def __init__(self, widget: MeshcatWidget):
         self.widget = widget
