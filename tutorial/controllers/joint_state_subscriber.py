@@ -130,7 +130,6 @@ class RttJointStateMonitor(RttJointStateSubscriber):
 
         self.status = ViewerStatus(config.body.num_joints)
         self.node_name = config.node.get_fully_qualified_name()
-        self.last_stamp = None
         self.late_states = 0
         if not super().configure(config):
             return False
@@ -173,15 +172,13 @@ class RttJointStateMonitor(RttJointStateSubscriber):
     # ---- main thread ------------------------------------------------------
     def update_joint_state(self, msg, arrival: float | None = None):
         stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-        if self.last_stamp is not None and stamp < self.last_stamp:
-            self.status.stamps_back += 1
+        before = self.status.stamp(stamp)  # the one before, if it went back
+        if before is not None:
             self.say(
                 "stamps_back",
                 f"{self.topic}: stamps went back from "
-                f"{self.last_stamp:.3f} s to {stamp:.3f} s (a new run?): "
-                "showing it",
+                f"{before:.3f} s to {stamp:.3f} s (a new run?): showing it",
             )
-        self.last_stamp = stamp
         first = self.status.applied == 0
         report = super().update_joint_state(msg)
         self.status.applied_message(

@@ -54,6 +54,7 @@ class ViewerStatus:
         self.last_positions: dict[str, float] = {}
         self.stale = False
         self.stamps_back = 0  # times a state's stamp was older than the one before (a restarted publisher)
+        self.last_stamp: float | None = None  # s, the newest live state's
         self._received_at_last_report = 0
         self._last_report = clock()
 
@@ -64,6 +65,19 @@ class ViewerStatus:
             self._received += 1
             self._last_arrival = now
         return now
+
+    def stamp(self, stamp: float) -> float | None:
+        """Note a live state's stamp, s (main thread); the stamp before it if this one is older, else None.
+
+        An older stamp is a publisher that restarted (a new run from t = 0):
+        counted in ``stamps_back`` and in the status line; the new run is
+        what the view shows from then on.
+        """
+        before, self.last_stamp = self.last_stamp, stamp
+        if before is not None and stamp < before:
+            self.stamps_back += 1
+            return before
+        return None
 
     def applied_message(
         self, arrival: float, matched: int, rejected: Sequence[tuple[int, str | None, str]], positions: dict[str, float]
