@@ -1,0 +1,252 @@
+"""The parts of the checks of notebooks 05 and 06 that whole answers do not pin down: no simulation, no ROS node.
+
+The exercises' tests (tests/test_exercises.py) run each check on worked
+solutions and on wrong answers.  These hold the hidden runs' draws to what
+their statements promise, and the checks' own model of a rule to the rule
+at its edge (found by make mutate: a mutant of each survived the whole
+answers).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+
+import pytest
+
+from tutorial.exercises import step5_imu_viewer as step5
+
+pytestmark = pytest.mark.unit
+
+SECOND, GRID = step5.SECOND, step5.GRID
+SEEDS = range(400)
+
+
+# ---- 5.2's rule, as the check models it --------------------------------------------------------------
+
+
+def test_5_2_the_rule_a_stamp_up_to_a_second_back_is_old_news_and_further_back_a_restart():
+    newest = 7 * SECOND
+    assert step5._judge(None, 0, "ok") == (None, 0)  # the first message is shown
+    assert step5._judge(newest, newest, "ok") == ("out_of_order", newest)  # the same stamp
+    assert step5._judge(newest, newest - SECOND, "hit") == ("out_of_order", newest)  # exactly a second back
+    assert step5._judge(newest, newest - SECOND - 1, "ok") == (None, newest - SECOND - 1)  # 1 ns more: a restart
+    assert step5._judge(newest, newest + 1, "ok") == (None, newest + 1)
+    assert step5._judge(newest, newest + 1, "nan") == ("not_finite", newest)  # refused, the newest kept
+    assert step5._judge(newest, newest - 1, "nan") == ("out_of_order", newest)  # old news before anything else
+
+
+# ---- 5.2's hidden runs -----------------------------------------------------------------------------
+
+
+def hows(messages) -> list[str]:
+    """What each message after the first is, by the rule: newer, same, late, second (back), restart."""
+    out, newest = [], messages[0][0]
+    for stamp, kind in messages[1:]:
+        if stamp > newest:
+            out.append("nan" if kind == "nan" else "newer")
+        elif stamp == newest:
+            out.append("same")
+        elif stamp == newest - SECOND:
+            out.append("second")
+        elif stamp > newest - SECOND:
+            out.append("late")
+        else:
+            out.append("restart")
+        newest = step5._judge(newest, stamp, kind)[1]
+    return out
+
+
+@pytest.mark.parametrize("n", [1, 2, 14, 30])
+def test_5_2_a_random_run_has_its_length_and_starts_between_1_and_60_s_with_a_plain_message(n):
+    for seed in SEEDS:
+        messages = step5._messages(random.Random(seed), n)
+        assert len(messages) == n
+        first, kind = messages[0]
+        assert SECOND <= first < 60 * SECOND and first % GRID == 0 and kind == "ok"
+
+
+def test_5_2_random_runs_stay_on_the_grid_above_0_and_a_grid_away_from_a_second_back_unless_exactly_on_it():
+    firsts = []
+    for seed in SEEDS:
+        messages = step5._messages(random.Random(seed), 14)
+        firsts.append(messages[0][0])
+        newest = messages[0][0]
+        for stamp, kind in messages[1:]:
+            assert stamp >= 0 and stamp % GRID == 0 and kind in ("ok", "hit", "nan")
+            back = newest - SECOND
+            assert stamp == back or abs(stamp - back) >= GRID
+            if stamp == back:  # exactly a second back: a pair of whole seconds, exact as float seconds
+                assert newest // SECOND in step5.WHOLE_SECONDS and newest % SECOND == 0
+            newest = step5._judge(newest, stamp, kind)[1]
+    assert min(firsts) < 2 * SECOND and max(firsts) > 59 * SECOND  # the whole range of firsts is drawn
+
+
+def test_5_2_random_runs_draw_every_kind_of_message_the_statement_names():
+    seen, kinds = set(), set()
+    steps_newer, steps_late = [], []
+    for seed in SEEDS:
+        messages = step5._messages(random.Random(seed), 14)
+        seen |= set(hows(messages))
+        kinds |= {k for _, k in messages}
+        newest, said = messages[0][0], hows(messages)
+        for i, ((stamp, kind), how) in enumerate(zip(messages[1:], said)):
+            # the first of a pair (a whole second, then a second back of it; the run may end between them)
+            pair = stamp % SECOND == 0 and (i + 1 == len(said) or said[i + 1] == "second")
+            if how == "newer" and not pair:
+                steps_newer.append((stamp - newest) // GRID)
+            elif how == "late":
+                steps_late.append((newest - stamp) // GRID)
+            newest = step5._judge(newest, stamp, kind)[1]
+    assert seen == {"newer", "same", "late", "second", "restart", "nan"}
+    assert kinds == {"ok", "hit", "nan"}
+    # newer by 1 to 99 grid steps, late by 1 to 511: both ends drawn, never a second or more
+    assert min(steps_newer) == 1 and max(steps_newer) == 99
+    assert min(steps_late) == 1 and max(steps_late) == 511
+
+
+def draws(messages) -> list[str]:
+    """The draws a run was made of, in order: a "second" draw is two messages (a whole second, then a second back)."""
+    said, out, i = hows(messages), [], 0
+    while i < len(said):
+        if i + 1 < len(said) and said[i + 1] == "second":
+            out.append("second")
+            i += 2
+        else:
+            out.append(said[i])
+            i += 1
+    return out
+
+
+def test_5_2_random_runs_draw_each_kind_as_often_as_the_statement_weighs_it():
+    """3 newer, 2 late, 1 each of the same stamp, a second back, a restart, a NaN: in 9."""
+    counts: dict[str, int] = {}
+    for seed in SEEDS:
+        for draw in draws(step5._messages(random.Random(seed), 14))[:-1]:  # the last may be a cut pair
+            counts[draw] = counts.get(draw, 0) + 1
+    total = sum(counts.values())
+    weights = {"newer": 3, "late": 2, "same": 1, "second": 1, "restart": 1, "nan": 1}
+    for draw, weight in weights.items():
+        assert abs(counts[draw] / total - weight / 9) < 0.03, (draw, counts[draw] / total, counts)
+
+
+def test_5_2_a_second_back_follows_a_whole_second_newer_than_everything_before_it():
+    pairs = 0
+    for seed in SEEDS:
+        messages = step5._messages(random.Random(seed), 30)
+        newest_before = [None, messages[0][0]]  # the newest shown before each message
+        for stamp, kind in messages[1:]:
+            newest_before.append(step5._judge(newest_before[-1], stamp, kind)[1])
+        for i, how in enumerate(hows(messages), start=1):
+            if how == "second":
+                pairs += 1
+                assert messages[i - 1][0] == messages[i][0] + SECOND
+                assert messages[i - 1][0] > newest_before[i - 1]  # the whole second was newer than all before it
+                # and one of the next three whole seconds: the run stays within a few seconds
+                ahead = [w for w in step5.WHOLE_SECONDS if w * SECOND > newest_before[i - 1]][:3]
+                assert messages[i - 1][0] // SECOND in ahead
+    assert pairs > 100
+
+
+class ScriptedRandom(random.Random):
+    """A Random that draws ``numbers`` in turn, then the lowest number each time, picks a run's next message by
+    ``prefer`` where offered, and keeps what each pick was offered."""
+
+    def __init__(self, numbers: list[int], prefer: list[str]):
+        super().__init__(0)
+        self.numbers, self.prefer, self.offered = list(numbers), list(prefer), []
+
+    def randrange(self, start, stop=None, step=1):
+        return self.numbers.pop(0) if self.numbers else start
+
+    def choice(self, seq):
+        if "newer" in seq:  # the draw of a run's next message
+            self.offered.append(list(seq))
+            for how in self.prefer:
+                if how in seq:
+                    return how
+        return seq[0]
+
+
+def test_5_2_after_a_restart_to_0_no_late_message_and_no_restart_is_offered():
+    rng = ScriptedRandom([1024], prefer=["restart", "late", "newer"])  # 2 s, then a restart to 0, then ...
+    messages = step5._messages(rng, 3)
+    assert messages[:2] == [(2 * SECOND, "ok"), (0, "ok")]
+    assert "restart" in rng.offered[0] and "late" in rng.offered[0]
+    assert "late" not in rng.offered[1] and "restart" not in rng.offered[1]  # nothing below 0 to draw
+    assert all(stamp >= 0 for stamp, _ in messages)
+
+
+def test_5_2_a_late_message_may_land_on_0():
+    rng = ScriptedRandom([1024, 1, 1], prefer=["restart", "late"])  # 2 s, a restart to 1/512 s, late by 1/512 s
+    assert step5._messages(rng, 3) == [(2 * SECOND, "ok"), (GRID, "ok"), (0, "ok")]
+    assert "late" in rng.offered[1]
+
+
+def test_5_2_a_restart_lands_more_than_a_second_back_and_may_go_down_to_0():
+    backs, lowest = [], []
+    for seed in SEEDS:
+        messages = step5._messages(random.Random(seed), 30)
+        newest = messages[0][0]
+        for (stamp, kind), how in zip(messages[1:], hows(messages)):
+            if how == "restart":
+                assert stamp <= newest - SECOND - GRID
+                backs.append(newest - stamp)
+                lowest.append(stamp)
+            newest = step5._judge(newest, stamp, kind)[1]
+    assert min(lowest) == 0 and min(backs) <= SECOND + 64 * GRID
+
+
+def test_5_2_the_second_back_case_is_first_newest_a_second_back_just_over_then_newer():
+    wholes, befores, afters = set(), [], []
+    for seed in SEEDS:
+        (first, k1), (newest, k2), (back, k3), (over, k4), (last, k5) = step5._a_second_back(random.Random(seed))
+        assert {k1, k2, k3, k4, k5} == {"ok"}
+        assert newest % SECOND == 0 and newest // SECOND in step5.WHOLE_SECONDS
+        wholes.add(newest // SECOND)
+        assert (newest - first) % GRID == 0 and (last - over) % GRID == 0
+        assert back == newest - SECOND and over == newest - SECOND - GRID
+        befores.append((newest - first) // GRID)
+        afters.append((last - over) // GRID)
+    assert len(wholes) > 20  # drawn, not one fixed second
+    # the first 1 to 99 grid steps before the newest, the last 1 to 49 after the one just over: both ends drawn
+    assert (min(befores), max(befores), min(afters), max(afters)) == (1, 99, 1, 49)
+
+
+# ---- 5.1's hidden readings -------------------------------------------------------------------------
+
+
+def test_5_1_hidden_readings_are_bumps_drives_and_hits_never_at_the_shortest_arrow_shown():
+    readings = [step5._reading(random.Random(seed)) for seed in range(2000)]
+    horizontal = [max(abs(x), abs(y)) for x, y, _ in readings]
+    assert all(h <= 40.0 for h in horizontal)
+    assert sum(h <= 0.6 for h in horizontal) / len(horizontal) > 0.3  # a bump, one in three
+    assert any(0.6 < h <= 5.0 for h in horizontal)  # a drive
+    assert any(h > 5.0 for h in horizontal) and max(horizontal) > 30.0  # a hit
+    assert sum(5.0 < h <= 6.0 for h in horizontal) / len(horizontal) < 0.02  # a drive stays under 5 m/s^2
+    assert any(x < -5.0 for x, _, _ in readings) and any(y < -5.0 for _, y, _ in readings)  # both signs
+    zs = [z for _, _, z in readings]
+    assert all(0.0 <= z < 20.0 for z in zs) and min(zs) < 0.1 and max(zs) > 19.9
+    for x, y, _ in readings:  # an arrow of 0.05 m is the shortest shown: never drawn that close to it
+        assert abs(0.1 * math.hypot(x, y) - 0.05) > 1e-6
+
+
+class ReadingsRandom(random.Random):
+    """Draws the readings it is given, one (x, y, z) per call of ``_reading``'s loop, at the bumps' scale."""
+
+    def __init__(self, readings):
+        super().__init__(0)
+        self.values = [v for reading in readings for v in reading]
+
+    def choice(self, seq):
+        return seq[0]
+
+    def uniform(self, a, b):
+        return self.values.pop(0)
+
+
+def test_5_1_a_reading_at_the_shortest_arrow_shown_is_drawn_again():
+    # 0.1 m per m/s^2: (0.3, 0.4) is 0.5 m/s^2 horizontally, an arrow of exactly 0.05 m
+    assert step5._reading(ReadingsRandom([(0.3, 0.4, 1.0), (0.2, 0.1, 2.0)])) == (0.2, 0.1, 2.0)
+    assert step5._reading(ReadingsRandom([(0.4, -0.3, 1.0), (0.2, 0.1, 2.0)])) == (0.2, 0.1, 2.0)
+    assert step5._reading(ReadingsRandom([(0.3, 0.41, 1.0)])) == (0.3, 0.41, 1.0)  # 0.0505 m: shown
