@@ -586,6 +586,13 @@ HIDDEN_MISTAKES_04_05 = [
     ),
     # the reason of a message rejected for another reason (a NaN) not returned (passed the old check)
     ("5.2", "        return reason\n", "        return None\n", "a random run of messages"),
+    # a refused message's reason in a word of one's own: the statement says to return "out_of_order"
+    (
+        "5.2",
+        '            return "out_of_order"\n',
+        '            return "late"\n',
+        "a stamp exactly a second older than the newest",
+    ),
     # the newest kept as the largest stamp shown, not the restarted one (passed the old check)
     (
         "5.2",

@@ -177,6 +177,11 @@ def test_5_2_after_a_restart_to_0_no_late_message_and_no_restart_is_offered():
     assert all(stamp >= 0 for stamp, _ in messages)
 
 
+def test_5_2_a_late_message_is_at_least_a_grid_step_back():
+    rng = ScriptedRandom([1024], prefer=["late"])  # 2 s, then late by the fewest steps drawn
+    assert step5._messages(rng, 2) == [(2 * SECOND, "ok"), (2 * SECOND - GRID, "ok")]
+
+
 def test_5_2_a_late_message_may_land_on_0():
     rng = ScriptedRandom([1024, 1, 1], prefer=["restart", "late"])  # 2 s, a restart to 1/512 s, late by 1/512 s
     assert step5._messages(rng, 3) == [(2 * SECOND, "ok"), (GRID, "ok"), (0, "ok")]

@@ -646,6 +646,40 @@ MUTANT_MISTAKES = [
         "        if not super().configure(config):\n            return False\n        super().configure(config)\n",
         "rate=20.0",
     ),
+    # 5.2 judged after the message was shown: drawn first, then counted as refused
+    (
+        "5.2",
+        "        if newest is not None and newest - self.RESTART <= stamp <= newest:\n"
+        '            self.rejected["out_of_order"] += 1\n'
+        '            return "out_of_order"\n'
+        "        reason = super().update_imu(msg, arrival)\n",
+        "        reason = super().update_imu(msg, arrival)  # shown, then judged\n"
+        "        if newest is not None and newest - self.RESTART <= stamp <= newest:\n"
+        "            self.accepted -= reason is None\n"
+        '            self.rejected["out_of_order"] += 1\n'
+        '            return "out_of_order"\n',
+        "(one late)",
+    ),
+    # old news hidden: a refused message takes the arrow away instead of leaving the newest shown
+    (
+        "5.2",
+        '            self.rejected["out_of_order"] += 1\n',
+        '            self.rejected["out_of_order"] += 1\n'
+        "            self.accel_arrow.set(self.data.site_xpos[self.site], (0.0, 0.0, 0.0), visible=False)\n",
+        "(one late)",
+    ),
+    # a collision is news at any time: a late hit still shakes the view
+    (
+        "5.2",
+        "        newest = self.newest\n",
+        "        newest = self.newest\n"
+        "        a = msg.linear_acceleration\n"
+        "        if __import__('tutorial.controllers.imu_state_subscriber', fromlist=['x']).is_hit((a.x, a.y, a.z)):\n"
+        "            self.start_shake((a.x, a.y, a.z))\n",
+        "(a late hit)",
+    ),
+    # configure() that does not return what super().configure() returns: the viewer refuses to start
+    ("5.2", "        return super().configure(config)\n", "        super().configure(config)\n", "(in order)"),
     # the pose without its header: geometry_msgs/Pose
     (
         "2.2",

@@ -335,15 +335,20 @@ def check_in_order(cls) -> Result:
                 if shown is not None:
                     x = controller.accel_arrow.vector[0]
                     if abs(x - 0.1 * (shown + 1)) > 1e-9:
-                        which = round(x / 0.1) - 1
+                        which = round(x / 0.1) - 1  # message k's arrow is 0.1 (k + 1) m long in x
+                        shows = (
+                            f"the message stamped {stamps[which]:.2f} s"
+                            if abs(x - 0.1 * (which + 1)) < 1e-9 and 0 <= which < len(stamps)
+                            else f"none of them (x = {x:.3f} m)"
+                        )
                         raise CaseFailed(
-                            f"{call}: the arrow shows the message stamped "
-                            f"{stamps[which] if 0 <= which < len(stamps) else '?'} s, "
-                            f"expected the one stamped {stamps[shown]:.2f} s.",
+                            f"{call}: the arrow shows {shows}, expected the one stamped {stamps[shown]:.2f} s.",
                             hint,
                         )
                 if shakes is not None and summary["shakes"] != shakes:
-                    raise CaseFailed(f"{call} shook the view {summary['shakes']} times, expected {shakes}.", hint)
+                    got = summary["shakes"]
+                    times = "once" if got == 1 else f"{got} times"
+                    raise CaseFailed(f"{call} shook the view {times}, expected {shakes}.", hint)
 
         return Case(call, run, hint)
 
