@@ -646,6 +646,36 @@ MUTANT_MISTAKES = [
         "        if not super().configure(config):\n            return False\n        super().configure(config)\n",
         "rate=20.0",
     ),
+    # 5.1's arrow not named after the body: another name than the statement's
+    ("5.1", 'f"{config.body_name}/horizontal_acceleration"', '"horizontal_acceleration"', "(driving over a bump)"),
+    # 5.1's green as pure green, not the statement's (0.2, 0.8, 0.2)
+    ("5.1", "(0.2, 0.8, 0.2)", "(0.0, 1.0, 0.0)", "(driving over a bump)"),
+    # 5.1's configure() ending without return True: the viewer refuses to start
+    ("5.1", "        )\n        return True\n", "        )\n", "(driving over a bump)"),
+    # 5.1's arrow drawn from the world's origin ("origin"), not from the IMU (the tank's IMU sits at its root)
+    (
+        "5.1",
+        "origin = self.data.site_xpos[self.site]  # m, world frame",
+        "origin = np.zeros(3)  # the origin, m",
+        "(driving over a bump)",
+    ),
+    # 5.1's arrow drawn where a message arrives, from the message: a NaN, refused, still redraws it
+    (
+        "5.1",
+        (
+            "    def draw_arrows(self) -> None:\n        super().draw_arrows()\n        if self.accel is None:\n"
+            "            return\n",
+            "np.array([self.accel[0], self.accel[1], 0.0])",
+        ),
+        (
+            "    def update_imu(self, msg, arrival):\n        reason = super().update_imu(msg, arrival)\n"
+            "        a = msg.linear_acceleration  # drawn where the message arrives\n"
+            "        self.draw_horizontal((a.x, a.y, a.z))\n        return reason\n\n"
+            "    def draw_horizontal(self, accel) -> None:\n",
+            "np.array([accel[0], accel[1], 0.0])",
+        ),
+        "then of a NaN",
+    ),
     # 5.2 judged after the message was shown: drawn first, then counted as refused
     (
         "5.2",

@@ -280,7 +280,11 @@ def check_horizontal_arrow(cls) -> Result:
                 turn=math.pi / 2,
                 hint=hint_turn,
             ),
-            Case(f"{name}.update_imu() of (3, 4, 11.8) m/s^2, then of a NaN", keeps_after_rejection),
+            Case(
+                f"{name}.update_imu() of (3, 4, 11.8) m/s^2, then of a NaN",
+                keeps_after_rejection,
+                "a rejected message changes nothing: draw from self.accel, which only an accepted message sets.",
+            ),
             Case(f"{name}: a hit of (-30, 0, 9.8) m/s^2, then a shake tick 20 ms later", follows_the_shake),
             *hidden,
         ],
