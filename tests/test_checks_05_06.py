@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import random
 
+import numpy as np
 import pytest
 
 from tutorial.exercises import step5_imu_viewer as step5
@@ -219,6 +220,19 @@ def test_5_2_the_second_back_case_is_first_newest_a_second_back_just_over_then_n
 
 
 # ---- 5.1's hidden readings -------------------------------------------------------------------------
+
+
+def test_5_1_hidden_poses_are_four_anywhere_within_2_m_and_turned_any_way():
+    poses = [step5._hidden_poses(random.Random(seed)) for seed in SEEDS]
+    assert {len(p) for p in poses} == {4}
+    positions = np.array([position for p in poses for position, _ in p])  # (1600, 3)
+    quaternions = np.array([q for p in poses for _, q in p])  # (1600, 4)
+    assert positions.shape == (1600, 3) and quaternions.shape == (1600, 4)
+    assert np.all(np.abs(positions) <= 2.0)
+    assert np.all(positions.min(axis=0) < -1.95) and np.all(positions.max(axis=0) > 1.95)  # each axis, both ways
+    # each component a standard normal: turned and tilted any way, with no direction preferred
+    assert np.all(np.abs(quaternions.mean(axis=0)) < 0.1)
+    assert np.all(np.abs(quaternions.std(axis=0) - 1.0) < 0.1)
 
 
 def test_5_1_hidden_readings_are_bumps_drives_and_hits_never_at_the_shortest_arrow_shown():

@@ -234,7 +234,7 @@ def check_horizontal_arrow(cls) -> Result:
     hidden = []
     rng = hidden_random("5.1")  # while grading: this learner's own poses and readings
     for _ in range(3 if rng else 0):
-        poses = [([rng.uniform(-2, 2) for _ in "xyz"], [rng.gauss(0, 1) for _ in "wxyz"]) for _ in range(4)]
+        poses = _hidden_poses(rng)
         accels = [_reading(rng) for _ in poses]
         hidden.append(
             Case(
@@ -289,6 +289,12 @@ def check_horizontal_arrow(cls) -> Result:
             *hidden,
         ],
     )
+
+
+def _hidden_poses(rng) -> list[tuple[list[float], list[float]]]:
+    """Four random poses of the tank ``(position m, quaternion w, x, y, z)``: anywhere within 2 m of the origin
+    on each axis, turned and tilted any way (four normal components; :func:`_place` normalizes them)."""
+    return [([rng.uniform(-2, 2) for _ in "xyz"], [rng.gauss(0, 1) for _ in "wxyz"]) for _ in range(4)]
 
 
 def _reading(rng) -> tuple[float, float, float]:
