@@ -222,6 +222,14 @@ def test_5_2_the_second_back_case_is_first_newest_a_second_back_just_over_then_n
 # ---- 5.1's hidden readings -------------------------------------------------------------------------
 
 
+def test_5_1_the_exact_length_reading_is_half_a_m_s2_along_any_horizontal_axis():
+    readings = [step5._exact_reading(random.Random(seed)) for seed in SEEDS]
+    assert {(x, y) for x, y, _ in readings} == {(0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5)}
+    assert all(0.1 * math.hypot(x, y) == 0.05 for x, y, _ in readings)  # exactly the shortest arrow shown
+    zs = [z for _, _, z in readings]
+    assert all(5.0 <= z <= 15.0 for z in zs) and min(zs) < 5.1 and max(zs) > 14.9
+
+
 def test_5_1_hidden_poses_are_four_anywhere_within_2_m_and_turned_any_way():
     poses = [step5._hidden_poses(random.Random(seed)) for seed in SEEDS]
     assert {len(p) for p in poses} == {4}

@@ -246,7 +246,7 @@ def check_horizontal_arrow(cls) -> Result:
             )
         )
     if rng:
-        exact = (*rng.choice(((0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5))), rng.uniform(5, 15))
+        exact = _exact_reading(rng)
         hidden.append(
             Case(
                 "an arrow exactly as long as ACCEL_MIN_LENGTH: shown",
@@ -295,6 +295,12 @@ def _hidden_poses(rng) -> list[tuple[list[float], list[float]]]:
     """Four random poses of the tank ``(position m, quaternion w, x, y, z)``: anywhere within 2 m of the origin
     on each axis, turned and tilted any way (four normal components; :func:`_place` normalizes them)."""
     return [([rng.uniform(-2, 2) for _ in "xyz"], [rng.gauss(0, 1) for _ in "wxyz"]) for _ in range(4)]
+
+
+def _exact_reading(rng) -> tuple[float, float, float]:
+    """A reading, m/s^2, whose green arrow is exactly ACCEL_MIN_LENGTH (0.05 m) long: 0.5 along +x, -x, +y or -y
+    (exact in binary, so the arrow's length is exactly 0.05 m in floats too), and a z of 5 to 15."""
+    return (*rng.choice(((0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5))), rng.uniform(5, 15))
 
 
 def _reading(rng) -> tuple[float, float, float]:
