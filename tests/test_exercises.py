@@ -676,6 +676,17 @@ MUTANT_MISTAKES = [
         ),
         "then of a NaN",
     ),
+    # 5.1's arrow blanked by a rejected message ("nothing valid to show"), instead of left as it was
+    (
+        "5.1",
+        "        self.horizontal_arrow.set(origin, to_world @ horizontal, visible=visible)\n",
+        "        self.horizontal_arrow.set(origin, to_world @ horizontal, visible=visible)\n\n"
+        "    def update_imu(self, msg, arrival):\n        reason = super().update_imu(msg, arrival)\n"
+        "        if reason is not None:  # nothing valid to show: blank it\n"
+        "            self.horizontal_arrow.set(self.data.site_xpos[self.site], (0.0, 0.0, 0.0), visible=False)\n"
+        "        return reason\n",
+        "then of a NaN",
+    ),
     # 5.2 judged after the message was shown: drawn first, then counted as refused
     (
         "5.2",
