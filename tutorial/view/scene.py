@@ -64,7 +64,7 @@ class VisualizerSink:
         self.vis = vis
 
     def send_transforms(self, transforms: list) -> None:
-        """``[(meshcat path, 4x4 pose, translation in m), ...]``, as ``vis[path].set_transform(pose)`` sends each."""
+        """``[(meshcat path, 4x4 pose), ...]`` (translation in m): ``vis[path].set_transform(pose)`` for each."""
         from meshcat.commands import SetTransform
 
         for path, matrix in transforms:

@@ -2,7 +2,7 @@
 
 A :class:`tutorial.view.scene.Scene` sends each frame through one sink, an
 object with ``send_transforms(transforms)``, ``transforms`` being
-``[(meshcat path, 4x4 pose, translation in m), ...]``.  Its default is
+``[(meshcat path, 4x4 pose), ...]`` (translation in m).  Its default is
 meshcat's own ``Visualizer`` (:class:`tutorial.view.scene.VisualizerSink`:
 one ``set_transform`` each, and meshcat-python waits for its server's reply
 after each).  The faster ways are here, and :func:`frame_sink` picks one for

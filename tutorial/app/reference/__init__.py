@@ -19,6 +19,7 @@ module                      step      what the later steps use it for
 ``joint_state_publisher``   2         ``/Tank/joint_state`` (Steps 4 to 6)
 ``joint_state_subscriber``  3         the joint-state monitor (Step 5's viewer)
 ``imu_state_publisher``     4         ``/Tank/imu`` (notebook 05's simulation)
+``camera_image_publisher``  6         ``/Tank/camera/image`` (notebook 08's two hosts)
 ``robot_model_publisher``   9         ``/Tank/robot_description`` and ``/Tank/odom``
                                       for the stock ROS 2 tools (Steps 2, 4, 6)
 ==========================  ========  ===========================================

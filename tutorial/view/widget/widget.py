@@ -271,7 +271,7 @@ class WidgetWindow:
         self.widget.put([command.lower()])
 
     def send_transforms(self, transforms: list) -> None:
-        """A frame: ``[(meshcat path, 4x4 pose, translation in m), ...]``, sent as one message."""
+        """A frame: ``[(meshcat path, 4x4 pose), ...]`` (translation in m), sent as one message."""
         from meshcat.commands import SetTransform
 
         self.widget.put([SetTransform(np.asarray(matrix), path).lower() for path, matrix in transforms])
