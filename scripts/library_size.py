@@ -49,6 +49,13 @@ def _imports_of_code(source: str) -> set[str]:
     return found
 
 
+def project_files(source: str) -> set[str]:
+    """The project files (relative to ``project/``) code ``source`` names: ``"step2.yaml"``,
+    ``"project/reference/step6.yaml"``, ``"../project/step2.yaml"`` or an absolute path."""
+    found = re.findall(r"""["']([\w/.-]+\.yaml)["']""", source)
+    return {name.rpartition("project/")[2] for name in found}
+
+
 def notebook_imports(numbers=NOTEBOOKS) -> tuple[set[str], set[str]]:
     """The ``tutorial`` modules the notebooks' code cells import, and the project files they load."""
     modules, projects = set(), set()
@@ -59,8 +66,7 @@ def notebook_imports(numbers=NOTEBOOKS) -> tuple[set[str], set[str]]:
                     continue
                 source = "".join(cell["source"])
                 modules |= _imports_of_code(source)
-                found = re.findall(r"""["']((?:project/)?[\w/.-]+\.yaml)["']""", source)
-                projects |= {name.removeprefix("project/") for name in found}
+                projects |= project_files(source)
     return modules, projects
 
 

@@ -23,6 +23,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+import mutation_report  # this folder's: how make mutate's report names a mutant's module
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -46,8 +48,7 @@ def mutant_change(mutmut_dir: Path, name: str) -> tuple[str, str] | None:
 
 def module_path(name: str) -> str:
     """``tutorial/exercises/step5_imu_viewer.py`` for ``tutorial.exercises.step5_imu_viewer.x_f__mutmut_3``."""
-    module = name.split(".x_")[0].split(".xǁ")[0]
-    return module.replace(".", "/") + ".py"
+    return mutation_report.module(name).replace(".", "/") + ".py"
 
 
 def recheck(mutmut_dir: Path, name: str, pytest_args: list[str], work: Path) -> str:

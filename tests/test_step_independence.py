@@ -33,6 +33,9 @@ import pytest
 pytestmark = pytest.mark.unit
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+import library_size  # noqa: E402  (scripts/: what a notebook imports and loads, read as the size script reads it)
+
 LESSON = "tutorial.controllers."
 # step (its notebook's number) -> the lesson module its notebook builds, and its checks' modules
 STEPS = {
@@ -104,12 +107,6 @@ def project_file_lessons(text: str) -> set[str]:
     return set(re.findall(r"""class:\s*["']?tutorial\.controllers\.(\w+):""", text))
 
 
-def project_files_loaded(source: str) -> set[str]:
-    """The project files (relative to ``project/``) a notebook cell or launch file names."""
-    found = re.findall(r"""["']([\w/.-]+\.yaml)["']""", source)
-    return {name.rpartition("project/")[2] for name in found}  # "../project/step2.yaml", an absolute path too
-
-
 def step_of_project(name: str) -> str | None:
     """The step a project file is the own project of (``step3_description.yaml``: 03); None for the rest.
 
@@ -121,17 +118,12 @@ def step_of_project(name: str) -> str | None:
 
 def notebook_violations(step: str, sources: list[str]) -> list[str]:
     """What step ``step``'s notebook, of code cells ``sources``, reaches of another step."""
-    sys.path.insert(0, str(ROOT / "scripts"))
-    try:
-        import library_size
-    finally:
-        sys.path.remove(str(ROOT / "scripts"))
     wrong = []
     for source in sources:
         imported = library_size._imports_of_code(source)  # "from m import n" gives m and m.n: one module each
         lessons = {m.removeprefix(LESSON).split(".")[0] for m in imported if m.startswith(LESSON)}
         wrong += [f"imports {LESSON}{lesson}" for lesson in sorted(lessons - {STEPS[step][0]})]
-        for name in sorted(project_files_loaded(source)):
+        for name in sorted(library_size.project_files(source)):
             owner = step_of_project(name)
             if owner is not None and owner != step:
                 wrong.append(f"loads {name} (Step {owner}'s own project)")
@@ -202,6 +194,6 @@ def test_the_project_rule_catches_another_steps_class():
 @pytest.mark.parametrize("path", sorted((ROOT / "launch_py").glob("step*_launch.py")), ids=lambda p: p.name)
 def test_a_launch_file_runs_only_its_own_steps_project(path):
     step = "0" + re.search(r"step(\d)", path.name).group(1)
-    loaded = project_files_loaded(path.read_text("utf-8"))
+    loaded = library_size.project_files(path.read_text("utf-8"))
     assert loaded, f"{path.name} runs no project file"
     assert {n for n in loaded if step_of_project(n) not in (None, step)} == set()
