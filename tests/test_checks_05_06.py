@@ -40,10 +40,18 @@ def test_5_2_the_rule_a_stamp_up_to_a_second_back_is_old_news_and_further_back_a
 # ---- 5.2's hidden runs -----------------------------------------------------------------------------
 
 
+def newest_before(messages) -> list:
+    """The newest stamp shown before each message, by the rule (None before the first)."""
+    out = [None]
+    for stamp, kind in messages[:-1]:
+        out.append(step5._judge(out[-1], stamp, kind)[1])
+    return out
+
+
 def hows(messages) -> list[str]:
     """What each message after the first is, by the rule: newer, same, late, second (back), restart."""
-    out, newest = [], messages[0][0]
-    for stamp, kind in messages[1:]:
+    out = []
+    for (stamp, kind), newest in zip(messages[1:], newest_before(messages)[1:]):
         if stamp > newest:
             out.append("nan" if kind == "nan" else "newer")
         elif stamp == newest:
@@ -54,7 +62,6 @@ def hows(messages) -> list[str]:
             out.append("late")
         else:
             out.append("restart")
-        newest = step5._judge(newest, stamp, kind)[1]
     return out
 
 
@@ -72,14 +79,12 @@ def test_5_2_random_runs_stay_on_the_grid_above_0_and_a_grid_away_from_a_second_
     for seed in SEEDS:
         messages = step5._messages(random.Random(seed), 14)
         firsts.append(messages[0][0])
-        newest = messages[0][0]
-        for stamp, kind in messages[1:]:
+        for (stamp, kind), newest in zip(messages[1:], newest_before(messages)[1:]):
             assert stamp >= 0 and stamp % GRID == 0 and kind in ("ok", "hit", "nan")
             back = newest - SECOND
             assert stamp == back or abs(stamp - back) >= GRID
             if stamp == back:  # exactly a second back: a pair of whole seconds, exact as float seconds
                 assert newest // SECOND in step5.WHOLE_SECONDS and newest % SECOND == 0
-            newest = step5._judge(newest, stamp, kind)[1]
     assert min(firsts) < 2 * SECOND and max(firsts) > 59 * SECOND  # the whole range of firsts is drawn
 
 
@@ -88,17 +93,16 @@ def test_5_2_random_runs_draw_every_kind_of_message_the_statement_names():
     steps_newer, steps_late = [], []
     for seed in SEEDS:
         messages = step5._messages(random.Random(seed), 14)
-        seen |= set(hows(messages))
+        said = hows(messages)
+        seen |= set(said)
         kinds |= {k for _, k in messages}
-        newest, said = messages[0][0], hows(messages)
-        for i, ((stamp, kind), how) in enumerate(zip(messages[1:], said)):
+        for i, ((stamp, _), how, newest) in enumerate(zip(messages[1:], said, newest_before(messages)[1:])):
             # the first of a pair (a whole second, then a second back of it; the run may end between them)
             pair = stamp % SECOND == 0 and (i + 1 == len(said) or said[i + 1] == "second")
             if how == "newer" and not pair:
                 steps_newer.append((stamp - newest) // GRID)
             elif how == "late":
                 steps_late.append((newest - stamp) // GRID)
-            newest = step5._judge(newest, stamp, kind)[1]
     assert seen == {"newer", "same", "late", "second", "restart", "nan"}
     assert kinds == {"ok", "hit", "nan"}
     # newer by 1 to 99 grid steps, late by 1 to 511: both ends drawn, never a second or more
@@ -135,16 +139,14 @@ def test_5_2_a_second_back_follows_a_whole_second_newer_than_everything_before_i
     pairs = 0
     for seed in SEEDS:
         messages = step5._messages(random.Random(seed), 30)
-        newest_before = [None, messages[0][0]]  # the newest shown before each message
-        for stamp, kind in messages[1:]:
-            newest_before.append(step5._judge(newest_before[-1], stamp, kind)[1])
+        newest = newest_before(messages)
         for i, how in enumerate(hows(messages), start=1):
             if how == "second":
                 pairs += 1
                 assert messages[i - 1][0] == messages[i][0] + SECOND
-                assert messages[i - 1][0] > newest_before[i - 1]  # the whole second was newer than all before it
+                assert messages[i - 1][0] > newest[i - 1]  # the whole second was newer than all before it
                 # and one of the next three whole seconds: the run stays within a few seconds
-                ahead = [w for w in step5.WHOLE_SECONDS if w * SECOND > newest_before[i - 1]][:3]
+                ahead = [w for w in step5.WHOLE_SECONDS if w * SECOND > newest[i - 1]][:3]
                 assert messages[i - 1][0] // SECOND in ahead
     assert pairs > 100
 
@@ -193,13 +195,11 @@ def test_5_2_a_restart_lands_more_than_a_second_back_and_may_go_down_to_0():
     backs, lowest = [], []
     for seed in SEEDS:
         messages = step5._messages(random.Random(seed), 30)
-        newest = messages[0][0]
-        for (stamp, kind), how in zip(messages[1:], hows(messages)):
+        for (stamp, _), how, newest in zip(messages[1:], hows(messages), newest_before(messages)[1:]):
             if how == "restart":
                 assert stamp <= newest - SECOND - GRID
                 backs.append(newest - stamp)
                 lowest.append(stamp)
-            newest = step5._judge(newest, stamp, kind)[1]
     assert min(lowest) == 0 and min(backs) <= SECOND + 64 * GRID
 
 
