@@ -11,7 +11,8 @@
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does two; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
 #       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 2.5 min),
-#       make test-hub (the hub with learners as Unix users: slow), make test-robots (the UR5, SO-100 and Go2 in Chromium),
+#       make test-hub (the hub with learners as Unix users: slow),
+#       make test-robots (the Step 3 monitor on every robot of example-robot-data; the UR5, SO-100 and Go2 in Chromium),
 #       make image (the learner image, podman), make hub-containers (the class on containers), make test-containers,
 #       make assignments (the class's nbgrader assignments from the notebooks, into course/),
 #       make grade (collect, autograde, feedback and course/grades.csv), make test-grade (every assignment graded),
@@ -120,9 +121,11 @@ test-more: $(VENV)/.installed
 test-fast: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m unit -q
 
-# The UR5's, SO-100's and Go2's pictures in Chromium (make test draws the Panda's): about 20 s.
+# The Step 3 monitor on all 68 robots of example-robot-data that urdfdom accepts (make test keeps 6), and the UR5's,
+# SO-100's and Go2's pictures in Chromium (make test draws the Panda's): about 2.5 min, the meshes converted cold.
 test-robots: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
+	bash scripts/ensure-urdfdom.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_any_robot.py -m slow -q
 
 # Every notebook's Run All in JupyterLab, as a learner runs it (tests/test_jupyterlab.py; make test runs the

@@ -17,8 +17,9 @@ because absolute times on a shared machine vary:
   meshcat cost per frame, frames per second, CPU per process;
 * start-up: from the launch command to the first state shown;
 * a real robot's description: the Panda's first frame from its
-  description's arrival, cold, started again and a second monitor
-  (:mod:`benchmarks.experiments.any_robot`; a figure, not a target);
+  description's arrival, cold, started again and a second monitor; and
+  every robot of example-robot-data's, cold and cached, the median and
+  the slowest (:mod:`benchmarks.experiments.any_robot`; figures, not targets);
 * late join: a viewer's and a recorder's wait for the state a running
   publisher keeps, under the project's Fast DDS profile and Fast DDS's
   defaults, and what each profile costs an idle participant;
@@ -62,6 +63,7 @@ import traceback
 from pathlib import Path
 
 from benchmarks.experiments.any_robot import measure as description_first_frame
+from benchmarks.experiments.any_robot import measure_all as every_robot_first_frame
 from benchmarks.experiments.browser import CASES as BROWSER_CASES
 from benchmarks.experiments.browser import pixel_latency
 from benchmarks.experiments.cross_process import latency_rounds
@@ -215,6 +217,15 @@ def _suite(args) -> int:
         print(
             f"the Panda from its description, first frame after its arrival: cold {a['cold_median_s']} s, "
             f"started again (cached) {a['restart_median_s']} s, second monitor {a['warm_median_s']} s",
+            flush=True,
+        )
+    if not args.quick and measure("every_robot", every_robot_first_frame):  # not a target: about 3 min
+        e = r["every_robot"]
+        print(
+            f"every robot of example-robot-data ({e['robots']}), first frame after its description's arrival: "
+            f"cold median {e['cold_median_s']} s, slowest {e['cold_slowest']['s']} s ({e['cold_slowest']['file']}); "
+            f"cached median {e['cached_median_s']} s, slowest {e['cached_slowest']['s']} s "
+            f"({e['cached_slowest']['file']})",
             flush=True,
         )
     late = (4, 4, 5.0) if args.quick else (20, 8, 20.0)  # starts, idle participants, idle seconds

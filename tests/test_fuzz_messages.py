@@ -443,8 +443,8 @@ def test_a_viewer_takes_any_robot_description():
     @given(text=texts())
     def property_(text):
         try:
-            urdf, _, _ = load_description(text, "/Tank/robot_description")
-            build_world([ModelEntry("Tank", None, description="/Tank/robot_description", text=urdf)])
+            prepared, _ = load_description(text, "/Tank/robot_description")
+            build_world([ModelEntry("Tank", None, description="/Tank/robot_description", text=prepared.text)])
         except (DescriptionError, ValueError):
             pass  # refused, as rtt-run reports it: one line, exit status 2
 

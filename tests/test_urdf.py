@@ -217,10 +217,10 @@ def test_a_description_mujoco_reads_back(exported):
     from tutorial.urdf.mujoco_load import mujoco_text
 
     _, urdf, _ = exported("Tank", None)
-    text, left_out = mujoco_text(urdf.description())
+    text, left_out, changed = mujoco_text(urdf.description())
     model = mujoco.MjModel.from_xml_string(text)
     names = [model.joint(j).name for j in range(model.njnt)]
-    assert names == ["TURRET_Y", "TURRET_P"] and left_out == []
+    assert names == ["TURRET_Y", "TURRET_P"] and left_out == [] and changed == []
     assert model.jnt_range[1] == pytest.approx([np.radians(-10), np.radians(45)])
     assert model.ngeom == sum(len(link.visuals) for link in urdf.links)  # visuals only
 

@@ -1,6 +1,8 @@
-"""A real robot's description to its first drawn frame: the Panda (Collada meshes), cold and cached.
+"""A real robot's description to its first drawn frame: the Panda (Collada meshes), and every robot of
+example-robot-data, cold and cached.
 
     python -m benchmarks.experiments.any_robot [--repeats 3]   (each repeat a fresh process)
+    python -m benchmarks.experiments.any_robot --all           (every robot: the median and the slowest)
 
 A publisher keeps the Franka Panda's description (``example-robot-data``,
 ``package://`` URIs as shipped) on ``/Panda/robot_description``; a monitor
@@ -10,6 +12,12 @@ description's arrival to the end of that frame: the meshes found, the
 Collada files converted to STL (cold: an empty cache) or read from the
 cache (warm), the MuJoCo model compiled, and the scene sent to meshcat;
 beside it, the same from the App's start (node, discovery, reception).
+
+``--all`` does the same for each of example-robot-data's 69 files whose
+description the monitor accepts (68: one is an empty ``<robot>``), one
+after another in one process with an empty cache (cold; the mesh readers
+imported by the first), then in a second process with the cache full
+(cached), and reports the median and the slowest robot of each.
 """
 
 from __future__ import annotations
@@ -25,7 +33,8 @@ import time
 from pathlib import Path
 
 PREFIX = Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix"
-PANDA = PREFIX / "share" / "example-robot-data" / "robots" / "panda_description" / "urdf" / "panda.urdf"
+ROBOTS = PREFIX / "share" / "example-robot-data" / "robots"
+PANDA = ROBOTS / "panda_description" / "urdf" / "panda.urdf"
 
 
 def first_frame_s(project: Path) -> tuple[float, float]:
@@ -34,7 +43,7 @@ def first_frame_s(project: Path) -> tuple[float, float]:
     The description is already kept for the monitor (transient local): from
     the App's start, the time also holds the node's creation and its
     discovery of the publisher.  The arrival is when
-    ``receive_robot_description`` returns the URDF it received.
+    ``receive_robot_description`` hands the URDF it received to the monitor.
     """
     import tutorial.interfaces.robot_description as descriptions
     from tutorial.app.app import App
@@ -43,10 +52,12 @@ def first_frame_s(project: Path) -> tuple[float, float]:
     arrived = []
     receive = descriptions.receive_robot_description
 
-    def timed(*args, **kwargs):
-        urdf = receive(*args, **kwargs)
-        arrived.append(time.perf_counter())
-        return urdf
+    def timed(node, topic, timeout, use=None, on_refused=None):
+        def use_timed(text):  # the description has arrived: what follows is the monitor's work on it
+            arrived.append(time.perf_counter())
+            return use(text)
+
+        return receive(node, topic, timeout, use=use_timed, on_refused=on_refused)
 
     records = []
     descriptions.receive_robot_description = timed  # the App imports it when it opens: it finds this one
@@ -92,6 +103,79 @@ def one_process(cache: Path) -> dict:
         rclpy.try_shutdown()
 
 
+def all_robots(cache: Path) -> dict:
+    """Each robot's first frame in this process, one after another: ``{file: seconds from arrival}``.
+
+    A file whose description the monitor refuses (an empty ``<robot>``) is
+    not published: a monitor would wait for a corrected one.
+    """
+    import rclpy
+    from std_msgs.msg import String
+
+    from tutorial.interfaces.robot_description import DescriptionError, check_robot_description, robot_description_qos
+    from tutorial.ros.spin import SpinThread
+
+    os.environ["AMENT_PREFIX_PATH"] = str(PREFIX)
+    os.environ["RTT_MESH_CACHE"] = str(cache)
+    rclpy.init()
+    node = rclpy.create_node("any_robot_descriptions")
+    files = {}
+    for i, path in enumerate(sorted(ROBOTS.rglob("*.urdf"))):
+        try:
+            check_robot_description(path.read_text())
+        except DescriptionError:
+            continue
+        files[str(path.relative_to(ROBOTS))] = i
+        topic = f"/robot{i}/robot_description"
+        node.create_publisher(String, topic, robot_description_qos()).publish(String(data=path.read_text()))
+    spin = SpinThread(node).start()  # serves the kept descriptions
+    try:
+        out = {}
+        for rel, i in files.items():
+            project = cache.parent / f"robot{i}.yaml"
+            project.write_text(f"name: r{i}\nmodels:\n  - name: R{i}\n    description: /robot{i}/robot_description\n")
+            out[rel] = round(first_frame_s(project)[0], 3)
+        return out
+    finally:
+        spin.stop()
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def _child(*args: str, timeout: float = 120) -> dict:
+    import subprocess
+
+    done = subprocess.run(
+        [sys.executable, "-m", "benchmarks.experiments.any_robot", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    if done.returncode != 0:
+        raise RuntimeError(f"a run failed: {done.stderr[-2000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def measure_all() -> dict:
+    """:func:`all_robots` in a fresh process with an empty cache (cold), then in another with it full (cached).
+
+    Returns the robots' count, and per case the median (s, from each
+    description's arrival to its first frame), the slowest robot and its
+    time, and every robot's time.
+    """
+    out = {}
+    with tempfile.TemporaryDirectory() as d:
+        cache = Path(d) / "meshes"
+        for case in ("cold", "cached"):
+            times = _child("--all-one", str(cache), timeout=1800)
+            slowest = max(times, key=times.get)
+            out["robots"] = len(times)
+            out[f"{case}_median_s"] = round(statistics.median(times.values()), 3)
+            out[f"{case}_slowest"] = {"file": slowest, "s": times[slowest]}
+            out[f"{case}_s"] = times
+    return out
+
+
 def measure(repeats: int = 3) -> dict:
     """``repeats`` times: :func:`one_process` in a fresh process, then again in another with its cache full.
 
@@ -100,18 +184,9 @@ def measure(repeats: int = 3) -> dict:
     ``restart`` (a new process whose conversions are cached: a monitor
     started again); ``*_from_start_median_s`` from the App's start.
     """
-    import subprocess
 
     def child(cache: Path) -> dict:
-        done = subprocess.run(
-            [sys.executable, "-m", "benchmarks.experiments.any_robot", "--one", str(cache)],
-            capture_output=True,
-            text=True,
-            timeout=120,
-        )
-        if done.returncode != 0:
-            raise RuntimeError(f"a run failed: {done.stderr[-2000:]}")
-        return json.loads(done.stdout.strip().splitlines()[-1])
+        return _child("--one", str(cache))
 
     # cold: a fresh process, an empty cache; warm: the same process again; restart: a fresh process, the cache full
     runs: dict[str, list] = {"cold": [], "warm": [], "restart": []}
@@ -134,14 +209,19 @@ def measure(repeats: int = 3) -> dict:
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--all", action="store_true", help="every robot of example-robot-data, cold and cached")
     p.add_argument("--one", type=Path, help=argparse.SUPPRESS)  # a child process: one run, into this cache
+    p.add_argument("--all-one", type=Path, help=argparse.SUPPRESS)  # a child process: every robot, this cache
     args = p.parse_args(argv)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(60 + os.getpid() % 40))  # the children inherit it
     if args.one is not None:
         print(json.dumps(one_process(args.one)))
         return 0
-    print(json.dumps(measure(args.repeats), indent=1))
+    if args.all_one is not None:
+        print(json.dumps(all_robots(args.all_one)))
+        return 0
+    print(json.dumps(measure_all() if args.all else measure(args.repeats), indent=1))
     return 0
 
 

@@ -20,11 +20,16 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
 
     Waits up to ``timeout`` s for each on ``node`` (the publisher keeps it,
     transient local: a simulation already running answers at once), and
-    says where the model came from, one record to ``output`` per model.
-    The App's owner thread calls it, before the node's spin thread starts.
+    says where the model came from, one record to ``output`` per model.  A
+    description that cannot be drawn (not a URDF, a joint without its
+    parent, a model MuJoCo cannot compile) is said in a warning record, and
+    the wait goes on for a corrected one, with no deadline, as a robot's
+    ``robot_state_publisher`` publishes a fixed file again.  The App's owner
+    thread calls it, before the node's spin thread starts.
 
     Raises:
-        tutorial.interfaces.robot_description.DescriptionError: none came, or not a URDF.
+        tutorial.interfaces.robot_description.DescriptionError: none came
+            within ``timeout`` s.
     """
     waiting = [m for m in project.models if m.description is not None and m.text is None]
     if not waiting:
@@ -36,14 +41,28 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
     models = list(project.models)
     fqn = node.get_fully_qualified_name()
     for entry in waiting:
-        urdf = receive_robot_description(node, entry.description, timeout)
-        text, left_out, tree = load_description(urdf, entry.description)
-        models[models.index(entry)] = dataclasses.replace(entry, text=text)
-        note = f"; {len(left_out)} mesh visuals left out" if left_out else ""
-        mimic = sum(j.mimic is not None for j in tree.moving)
-        # a mimic joint moves with its leader: a joint state need not carry it (the status line counts the others)
+
+        def refused(exc, entry=entry):
+            message = f"{exc}: waiting for a corrected description on {entry.description}"
+            output({"event": "warning", "node": fqn, "body": entry.name, "message": message})
+
+        prepared, tree = receive_robot_description(
+            node,
+            entry.description,
+            timeout,
+            use=lambda urdf, entry=entry: load_description(urdf, entry.description),
+            on_refused=refused,
+        )
+        models[models.index(entry)] = dataclasses.replace(entry, text=prepared.text)
+        notes = [*prepared.changed]
+        if prepared.left_out:
+            notes.append(f"{len(prepared.left_out)} mesh visuals left out")
+        # a mimic joint moves with its leader: a joint state need not carry it (the status line counts the others);
+        # one whose leader is not in the file moves by its own position, as robot_state_publisher moves it
+        leaders = {j.name for j in tree.moving}
+        mimic = sum(j.mimic is not None and j.mimic[0] in leaders for j in tree.moving)
         following = f", {mimic} of them following another (mimic)" if mimic else ""
-        for line in left_out:  # which mesh, and why: the rest of the robot is drawn
+        for line in prepared.left_out:  # which mesh, and why: the rest of the robot is drawn
             output({"event": "warning", "node": fqn, "body": entry.name, "message": f"{entry.description}: {line}"})
         output(
             {
@@ -53,9 +72,10 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
                 "topic": entry.description,
                 "links": len(tree.links),
                 "moving_joints": [j.name for j in tree.moving],
+                "changed": list(prepared.changed),
                 "line": f"[{fqn}] {entry.name}: no model file of its own: drawing the robot description "
                 f"on {entry.description} (robot {tree.name}, {len(tree.links)} links, "
-                f"{len(tree.moving)} moving joints{following}{note})",
+                f"{len(tree.moving)} moving joints{following}{''.join(f'; {n}' for n in notes)})",
             }
         )
     return dataclasses.replace(project, models=models)

@@ -68,7 +68,7 @@ class ModelEntry:
         yaw: rotation of the model's frame about +Z, rad.
         description: a robot-description topic to take the model from instead
             of a file (a viewer project); whoever receives it sets ``text``.
-        text: the model as text (MJCF, or URDF prepared by
+        text: the model as text (MJCF, or a robot description prepared by
             :func:`tutorial.urdf.mujoco_load.mujoco_text`), used instead of ``file``.
         odometry: an odometry topic a viewer places the model's root link by
             (:mod:`tutorial.app.floating_base`); the root then gets a free
@@ -191,10 +191,27 @@ def _float_root(spec: mujoco.MjSpec, entry: ModelEntry) -> None:
     root.add_freejoint(name=name)
 
 
+def drawing_spec(text: str) -> mujoco.MjSpec:
+    """The ``MjSpec`` of a model that is drawn, never simulated (a received robot description; any thread).
+
+    Each mesh's inertia is its surface's (MuJoCo's ``inertia="shell"``): a
+    mesh's inertia only places it in its geom, and a thin or open visual
+    mesh has no volume for MuJoCo's default to measure ("mesh volume is too
+    small").  Computing a surface's is also faster.
+
+    Raises:
+        ValueError: MuJoCo cannot read the text.
+    """
+    spec = mujoco.MjSpec.from_string(text)
+    for mesh in spec.meshes:
+        mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+    return spec
+
+
 def _parse(entry: ModelEntry) -> mujoco.MjSpec:
     if entry.text is not None:
         try:
-            child = mujoco.MjSpec.from_string(entry.text)
+            child = drawing_spec(entry.text) if entry.description else mujoco.MjSpec.from_string(entry.text)
             name_unnamed_elements(child)
         except Exception as exc:  # noqa: BLE001 - mujoco raises ValueError with the parser's text
             raise ModelError(

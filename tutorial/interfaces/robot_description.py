@@ -83,24 +83,35 @@ def check_robot_description(text, source: str = "the robot description") -> str:
     return text
 
 
-def receive_robot_description(node, topic: str, timeout: float) -> str:
-    """Wait for the description on ``topic`` and return it, checked (owner thread of ``node``).
+def receive_robot_description(node, topic: str, timeout: float, use=None, on_refused=None):
+    """Wait for a usable description on ``topic``; what ``use`` made of it (owner thread of ``node``).
 
     Subscribes with :func:`robot_description_qos`, so the message a
     transient-local publisher kept arrives at once, and spins ``node`` on an
-    executor of its own until it has come or ``timeout`` s have passed.  The
-    node must not be spinning elsewhere yet (the App calls this before its
-    spin thread starts).
+    executor of its own until one has come that ``use`` takes, or
+    ``timeout`` s have passed with none at all.  The node must not be
+    spinning elsewhere yet (the App calls this before its spin thread starts).
+
+    Args:
+        use: called with each description's text, on this thread; returns
+            what this function returns, or raises :class:`DescriptionError`.
+            Default: :func:`check_robot_description` (the text, checked).
+        on_refused: called with each :class:`DescriptionError` ``use``
+            raised; then the wait goes on for a corrected description, with
+            no deadline (a publisher is there, and ``robot_state_publisher``
+            publishes a fixed file again).  None: the first refusal is raised.
 
     Raises:
         DescriptionError: nothing arrived within ``timeout`` s (with a hint),
-            or what arrived is not a usable URDF (:func:`check_robot_description`).
+            or, without ``on_refused``, what arrived is not usable.
     """
     from rclpy.event_handler import SubscriptionEventCallbacks
     from rclpy.executors import SingleThreadedExecutor
     from std_msgs.msg import String
 
-    received: list[str] = []
+    use = use or (lambda text: check_robot_description(text, topic))
+    received: list[str] = []  # filled by the callback, on this thread (the executor below runs here)
+    heard = False  # a description has arrived, usable or not: the deadline no longer applies
     refused: list[str] = []  # a publisher that offers too little (volatile, best effort): the policy it lacks
     subscription = node.create_subscription(
         String,
@@ -117,25 +128,32 @@ def receive_robot_description(node, topic: str, timeout: float) -> str:
     executor.add_node(node)
     try:
         deadline = time.monotonic() + timeout
-        while not received and time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=min(0.1, max(0.0, deadline - time.monotonic())))
+        while heard or time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.1 if heard else min(0.1, max(0.0, deadline - time.monotonic())))
+            if received:
+                heard, text = True, received[-1]  # the newest: an older one is superseded
+                received.clear()
+                try:
+                    return use(text)
+                except DescriptionError as exc:
+                    if on_refused is None:
+                        raise
+                    on_refused(exc)
     finally:
         executor.remove_node(node)
         executor.shutdown(timeout_sec=0)
         node.destroy_subscription(subscription)
-    if not received and refused:
+    if refused:
         raise DescriptionError(
             f"no robot description on {topic} within {timeout:g} s: a publisher offers it with an incompatible "
             f"QoS ({refused[-1]}): publish it as robot_state_publisher does, reliable, keep last 1, transient "
             "local, so a program that starts later still gets it"
         )
-    if not received:
-        raise DescriptionError(
-            f"no robot description on {topic} within {timeout:g} s: start its publisher first (the tank's "
-            "simulation: its RttRobotModelPublisher; another robot: robot_state_publisher, or a publisher of "
-            "your own, transient local), or name a model file instead"
-        )
-    return check_robot_description(received[-1], topic)
+    raise DescriptionError(
+        f"no robot description on {topic} within {timeout:g} s: start its publisher first (the tank's "
+        "simulation: its RttRobotModelPublisher; another robot: robot_state_publisher, or a publisher of "
+        "your own, transient local), or name a model file instead"
+    )
 
 
 def _policy_name(kind) -> str:

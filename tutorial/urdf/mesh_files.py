@@ -15,7 +15,10 @@ one per colour the file's materials give, so the colours are kept; the
 conversions are cached by the file's content (``RTT_MESH_CACHE``, or
 ``~/.cache/ros-tank-tutorial/meshes``), so a restart does not redo them.
 A file that is not a mesh (truncated, another format) raises
-:class:`MeshError` with one line saying why.
+:class:`MeshError` with one line saying why.  A mesh over MuJoCo's limit of
+:data:`MAX_FACES` triangles (its STL reader refuses more) is simplified to
+that many (``trimesh``'s quadric decimation, ``fast-simplification``), and
+the part says how many it had.
 
 Any thread may call these functions; two processes converting the same file
 at once each write their own temporary files and rename them into place.
@@ -28,10 +31,20 @@ import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import NamedTuple
 from urllib.parse import unquote, urlparse
 
 MUJOCO_FORMATS = (".stl", ".obj", ".msh")  # what MuJoCo's compiler reads itself
-CONVERTER_VERSION = 1  # bumped when a conversion's output changes: older cache entries are not used
+MAX_FACES = 200_000  # MuJoCo's STL reader takes at most this many triangles per file
+CONVERTER_VERSION = 2  # bumped when a conversion's output changes: older cache entries are not used
+
+
+class Part(NamedTuple):
+    """One drawable file of a mesh: the file MuJoCo reads, its colour, and its triangles before simplifying."""
+
+    path: Path
+    rgba: tuple[float, ...] | None  # 0 to 1; None: the visual's own colour
+    simplified_from: int | None = None  # the triangle count over MAX_FACES it had; None: drawn as it is
 
 
 class MeshError(ValueError):
@@ -82,29 +95,30 @@ def cache_folder(environ: Mapping[str, str] | None = None) -> Path:
     return base / "ros-tank-tutorial" / "meshes"
 
 
-def drawable_meshes(path: Path, cache: Path | None = None) -> list[tuple[Path, tuple[float, ...] | None]]:
-    """``[(file MuJoCo reads, rgba or None)]`` for the mesh file ``path``.
+def drawable_meshes(path: Path, cache: Path | None = None) -> list[Part]:
+    """The :class:`Part` files MuJoCo draws the mesh file ``path`` with.
 
     A format MuJoCo reads is returned as it is, with no colour, once
     ``trimesh`` has read it (so a broken file is named here, not in MuJoCo's
-    compiler).  Another format is converted: one STL per colour its
-    materials give (rgba, 0 to 1), in the file's own frame and units.
+    compiler) and found within :data:`MAX_FACES`.  Another format, or a
+    larger mesh, is converted: one STL per colour its materials give (rgba,
+    0 to 1), in the file's own frame and units, each simplified to
+    :data:`MAX_FACES` triangles if it had more.
 
     Raises:
         MeshError: the file is not a mesh ``trimesh`` can read, or holds no triangles.
     """
     data = path.read_bytes()
-    if path.suffix.lower() in MUJOCO_FORMATS:
-        _load(path, data)  # checked: MuJoCo's compiler would fail the whole robot on it
-        return [(path, None)]
     key = hashlib.sha256(data + f"|{path.suffix.lower()}|{CONVERTER_VERSION}".encode()).hexdigest()[:32]
-    folder = (cache or cache_folder()) / key
+    folder = (Path(cache) if cache else cache_folder()) / key
     index = folder / "parts.json"
     if index.is_file():
         parts = json.loads(index.read_text())
         if all((folder / p["file"]).is_file() for p in parts):
-            return [(folder / p["file"], tuple(p["rgba"]) if p["rgba"] else None) for p in parts]
+            return [_part(folder, p) for p in parts]
     scene = _load(path, data)
+    if path.suffix.lower() in MUJOCO_FORMATS and _faces(scene) <= MAX_FACES:
+        return [Part(path, None)]  # checked: MuJoCo's compiler would fail the whole robot on it
     by_colour: dict[tuple | None, list] = {}
     for mesh in scene.dump(concatenate=False) if hasattr(scene, "dump") else [scene]:
         if len(getattr(mesh, "faces", ())) == 0:
@@ -119,13 +133,26 @@ def drawable_meshes(path: Path, cache: Path | None = None) -> list[tuple[Path, t
     for i, (rgba, meshes) in enumerate(sorted(by_colour.items(), key=lambda kv: str(kv[0]))):
         name = f"part{i}.stl"
         tmp = folder / f".{name}.{os.getpid()}"
-        trimesh.util.concatenate(meshes).export(tmp, file_type="stl")
+        mesh, faces = trimesh.util.concatenate(meshes), None
+        if len(mesh.faces) > MAX_FACES:
+            faces, mesh = len(mesh.faces), mesh.simplify_quadric_decimation(face_count=MAX_FACES)
+        mesh.export(tmp, file_type="stl")
         os.replace(tmp, folder / name)
-        parts.append({"file": name, "rgba": list(rgba) if rgba else None})
+        parts.append({"file": name, "rgba": list(rgba) if rgba else None, "simplified_from": faces})
     tmp = folder / f".parts.json.{os.getpid()}"
     tmp.write_text(json.dumps(parts))
     os.replace(tmp, index)
-    return [(folder / p["file"], tuple(p["rgba"]) if p["rgba"] else None) for p in parts]
+    return [_part(folder, p) for p in parts]
+
+
+def _part(folder: Path, entry: dict) -> Part:
+    return Part(folder / entry["file"], tuple(entry["rgba"]) if entry["rgba"] else None, entry["simplified_from"])
+
+
+def _faces(scene) -> int:
+    return sum(
+        len(getattr(m, "faces", ())) for m in (scene.geometry.values() if hasattr(scene, "geometry") else [scene])
+    )
 
 
 def _load(path: Path, data: bytes):
@@ -137,9 +164,34 @@ def _load(path: Path, data: bytes):
         loaded = trimesh.load(io.BytesIO(data), file_type=path.suffix.lower().lstrip("."), force="scene")
     except Exception as exc:  # noqa: BLE001 - every reader's own error: a broken or foreign file
         raise MeshError(f"{path}: not a {path.suffix} mesh trimesh can read ({type(exc).__name__}: {exc})") from None
+    if hasattr(loaded, "geometry") and not loaded.geometry and path.suffix.lower() == ".dae":
+        loaded = _without_textures(path, data) or loaded
     if hasattr(loaded, "geometry") and not loaded.geometry:
         raise MeshError(f"{path}: no triangles in it")
     return loaded
+
+
+def _without_textures(path: Path, data: bytes):
+    """The Collada file read again without its texture parameters, or None.
+
+    ``pycollada`` drops a material whose texture names a surface it cannot
+    find (ANYmal B's feet), and ``trimesh`` then drops the triangles bound to
+    that material.  Without the texture parameters the materials, with their
+    colours, and the triangles load.
+    """
+    import io
+
+    import trimesh
+    from lxml import etree
+
+    try:
+        root = etree.fromstring(data, parser=etree.XMLParser(resolve_entities=False))
+        for param in list(root.iter("{*}newparam")):
+            param.getparent().remove(param)
+        loaded = trimesh.load(io.BytesIO(etree.tostring(root)), file_type="dae", force="scene")
+    except Exception:  # noqa: BLE001 - as broken as before: the caller names it
+        return None
+    return loaded if loaded.geometry else None
 
 
 def _colour(mesh) -> tuple[float, ...] | None:
