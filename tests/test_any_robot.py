@@ -40,7 +40,7 @@ FAST = {  # file: what its description line must say
     "tiago_description/robots/tiago.urdf": "the inertia of 2 links replaced, which MuJoCo refuses",  # eigenvalues < 0
     "baxter_description/urdf/baxter.urdf": "",  # visual meshes too thin for a volume: drawn, nothing to say
     "go1_description/urdf/go1.urdf": "1 mesh over MuJoCo's 200,000 triangles simplified to that many (trunk.dae "
-    "(351,394))",
+    "had 351,394)",
     "anymal_b_simple_description/robots/anymal.urdf": "",  # Collada feet whose texture is missing: drawn
 }
 # what urdfdom (Debian's check_urdf) refuses, and why: the monitor is not asked to draw these
@@ -334,7 +334,7 @@ def test_a_mesh_over_mujocos_limit_is_simplified_and_one_it_refuses_is_left_out(
     )
     urdf = urdf.replace("</link>", f"<visual><geometry><mesh filename='file://{one}'/></geometry></visual></link>", 1)
     prepared = mujoco_text(urdf, cache=tmp_path / "cache")
-    assert prepared.changed == ["1 mesh over MuJoCo's 200,000 triangles simplified to that many (big.stl (327,680))"]
+    assert prepared.changed == ["1 mesh over MuJoCo's 200,000 triangles simplified to that many (big.stl had 327,680)"]
     assert len(prepared.left_out) == 1 and prepared.left_out[0].startswith(
         f"link l: visual left out: file://{one}: MuJoCo refuses it (at least 4 vertices required"
     ), prepared.left_out

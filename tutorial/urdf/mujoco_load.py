@@ -109,7 +109,7 @@ def mujoco_text(urdf: str, environ=None, cache=None) -> MujocoText:
             continue
         for i, part in enumerate(parts):
             if part.simplified_from is not None:
-                said = f"{mesh.get('filename', '').rsplit('/', 1)[-1]} ({part.simplified_from:,})"
+                said = f"{mesh.get('filename', '').rsplit('/', 1)[-1]} had {part.simplified_from:,}"
                 simplified += [] if said in simplified else [said]  # a file drawn twice is said once
             drawn = visual if i == len(parts) - 1 else copy.deepcopy(visual)
             if drawn is not visual:
