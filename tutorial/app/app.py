@@ -147,6 +147,8 @@ class App:
 
                 self._configure_instance(entry.name, f"{entry.name}/floating_base", FloatingBase(entry.odometry), {})
         self.node_fqn = self.node.get_fully_qualified_name()
+        # registered before the spin thread starts, which runs it (a parameter service's callback)
+        self.node.add_on_set_parameters_callback(self._refuse_controller_parameters)
         if self.spin is not None:
             self.spin.start()
         self.loop.call_every(GRAPH_CHECK_PERIOD, self.check_node_name)
@@ -222,6 +224,26 @@ class App:
 
             values[name] = check_parameter(typ, value, fail)
         return values
+
+    def _refuse_controller_parameters(self, parameters):
+        """A controller's parameter set while it runs (``rtt-ros2 param set``): refused, saying when it is read.
+
+        The controllers read their parameters when they are configured, so a
+        later value would be accepted and change nothing.  Any other
+        parameter (``use_sim_time``) is left to rclpy.  The spin thread runs it.
+        """
+        from rcl_interfaces.msg import SetParametersResult
+
+        ours = {f"{c.name}.{n}" for m in self.project.models for c in m.controllers for n in c.cls.PARAMETERS}
+        read = [p.name for p in parameters if p.name in ours]
+        if not read:
+            return SetParametersResult(successful=True)
+        example = f"{read[0]}:={parameters[[p.name for p in parameters].index(read[0])].value}"
+        return SetParametersResult(
+            successful=False,
+            reason=f"{', '.join(read)}: read when the controller is configured, not while it runs: start the "
+            f"program again with --ros-args -p {example}",
+        )
 
     def _open_view(self) -> None:
         from tutorial.view.meshcat_server import start_server, through_jupyter
