@@ -44,6 +44,7 @@ FUZZED = {
     "CompressedImage": "test_rtt_image_receiver_takes_any_compressed_image",
     "String": "test_a_viewer_takes_any_robot_description",
     "Odometry": "test_a_floating_base_takes_any_odometry",
+    "any_type": "test_rtt_ros2_echo_prints_any_message (rtt-ros2 echo and hz: any topic's type)",
 }
 
 
@@ -447,5 +448,38 @@ def test_a_viewer_takes_any_robot_description():
             build_world([ModelEntry("Tank", None, description="/Tank/robot_description", text=prepared.text)])
         except (DescriptionError, ValueError):
             pass  # refused, as rtt-run reports it: one line, exit status 2
+
+    property_()
+
+
+def test_rtt_ros2_echo_prints_any_message():
+    """``rtt-ros2 topic echo`` prints whatever arrives: NaN, infinities, any text, long arrays, as YAML that
+    reads back with the message's fields in their order (``hz`` only counts arrivals)."""
+    import yaml
+    from nav_msgs.msg import Odometry
+    from sensor_msgs.msg import Imu, JointState
+
+    from tutorial.ros.messages import to_yaml
+
+    @examples(40)
+    @given(
+        name=st.lists(TEXT, max_size=300),
+        position=st.lists(st.floats(), max_size=300),
+        frame=TEXT,
+        q=st.floats(),
+        covariance=st.lists(st.floats(), min_size=36, max_size=36),
+    )
+    def property_(name, position, frame, q, covariance):
+        state = JointState(name=name, position=position)
+        state.header.frame_id = frame
+        imu = Imu()
+        imu.orientation.w = q
+        odometry = Odometry()
+        odometry.pose.covariance = covariance
+        for msg in (state, imu, odometry):
+            text = to_yaml(msg)
+            assert list(yaml.safe_load(text)) == list(msg.get_fields_and_field_types())
+        shown = yaml.safe_load(to_yaml(state))
+        assert len(shown["name"]) == min(len(name), 128) + (len(name) > 128)  # cut at 128, then '...'
 
     property_()

@@ -220,6 +220,21 @@ def test_a_broken_description_waits_for_a_fixed_one(procs, node, tmp_path):
     assert view.summary()["controllers"]["RttJointStateMonitor"]["last_positions"] == {"shoulder": 0.5}
 
 
+def test_ctrl_c_ends_the_wait_for_a_corrected_description(procs, node, tmp_path):
+    """Waiting, with no deadline, for a description that can be drawn: one Ctrl-C ends it, cleanly."""
+    from std_msgs.msg import String
+
+    from tutorial.interfaces.robot_description import robot_description_qos
+
+    (tmp_path / "arm.yaml").write_text("name: arm\nmodels:\n  - name: Arm\n    description: /Arm/robot_description\n")
+    description = node.create_publisher(String, "/Arm/robot_description", robot_description_qos())
+    description.publish(String(data=ARM.format(parent="shoulder_link")))
+    view = procs(module_command("tutorial.tools.rtt_run", str(tmp_path / "arm.yaml"), "--headless", "--json"))
+    view.wait_for_line(lambda line: '"event": "warning"' in line, timeout=30)
+    view.p.send_signal(signal.SIGINT)
+    assert view.wait(10) == 0, view.err
+
+
 @pytest.mark.unit
 def test_the_rviz_config_draws_the_tank_from_our_topics():
     """rviz/tank.rviz (not run here: no RViz2): YAML with the displays the README's commands rely on."""

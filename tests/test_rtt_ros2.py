@@ -62,7 +62,7 @@ def test_the_beginner_commands_against_a_running_simulation(step2):
     assert "  frame_id: ''\n" in echoed.stdout and "name:\n- TURRET_Y\n- TURRET_P\n" in echoed.stdout
 
     # hz: within 2 % of the publisher's 50 Hz (the simulation keeps real time)
-    rates = ros2("topic", "hz", "/Tank/joint_state", "--timeout", "4.5", timeout=60).stdout
+    rates = ros2("topic", "hz", "/Tank/joint_state", "--timeout", "3.2", timeout=60).stdout
     measured = [float(r) for r in re.findall(r"average rate: ([0-9.]+)", rates)]
     assert len(measured) >= 3 and re.search(r"\tmin: [0-9.]+s max: [0-9.]+s std dev: [0-9.]+s window: \d+", rates)
     assert abs(measured[-1] - 50.0) <= 1.0, rates

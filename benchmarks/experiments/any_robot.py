@@ -52,12 +52,12 @@ def first_frame_s(project: Path) -> tuple[float, float]:
     arrived = []
     receive = descriptions.receive_robot_description
 
-    def timed(node, topic, timeout, use=None, on_refused=None):
+    def timed(node, topic, timeout, use=None, **kwargs):
         def use_timed(text):  # the description has arrived: what follows is the monitor's work on it
             arrived.append(time.perf_counter())
             return use(text)
 
-        return receive(node, topic, timeout, use=use_timed, on_refused=on_refused)
+        return receive(node, topic, timeout, use=use_timed, **kwargs)
 
     records = []
     descriptions.receive_robot_description = timed  # the App imports it when it opens: it finds this one

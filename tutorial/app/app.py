@@ -11,6 +11,9 @@ This is what Choreonoid does when it opens a ``.cnoid`` project, and what
 * **simulation thread** (:class:`tutorial.core.simulator.Simulator`, only when the
   project has a simulator): owns the simulation's ``MjData``; the main thread
   copies a snapshot of it once per frame to draw.
+
+It does one job, a project's run, over 400 lines because it wires those three
+threads together in one place (and says, for each method, which may call it).
 """
 
 from __future__ import annotations
@@ -125,7 +128,9 @@ class App:
             from rclpy.node import Node
 
             self.node = Node(self.node_name)
-        self.project = receive_descriptions(self.project, self.node, self.description_timeout, self.output)
+        self.project = receive_descriptions(
+            self.project, self.node, self.description_timeout, self.output, stopped=lambda: self.stop_requested
+        )
         self.model = build_world(self.project.models, **kwargs)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)

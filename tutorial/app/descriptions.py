@@ -15,7 +15,9 @@ from tutorial.core.project import Project
 DESCRIPTION_TIMEOUT = 10.0  # s a viewer waits for a robot description it takes its model from
 
 
-def receive_descriptions(project: Project, node, timeout: float, output: Callable[[dict], None]) -> Project:
+def receive_descriptions(
+    project: Project, node, timeout: float, output: Callable[[dict], None], stopped: Callable[[], bool] | None = None
+) -> Project:
     """``project`` with each model that names a description topic taken from the URDF published there.
 
     Waits up to ``timeout`` s for each on ``node`` (the publisher keeps it,
@@ -24,12 +26,14 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
     description that cannot be drawn (not a URDF, a joint without its
     parent, a model MuJoCo cannot compile) is said in a warning record, and
     the wait goes on for a corrected one, with no deadline, as a robot's
-    ``robot_state_publisher`` publishes a fixed file again.  The App's owner
-    thread calls it, before the node's spin thread starts.
+    ``robot_state_publisher`` publishes a fixed file again.  ``stopped``
+    (the App's stop request, Ctrl-C in ``rtt-run``) ends any wait.  The App's
+    owner thread calls it, before the node's spin thread starts.
 
     Raises:
         tutorial.interfaces.robot_description.DescriptionError: none came
             within ``timeout`` s.
+        KeyboardInterrupt: ``stopped`` said True while it waited.
     """
     waiting = [m for m in project.models if m.description is not None and m.text is None]
     if not waiting:
@@ -52,6 +56,7 @@ def receive_descriptions(project: Project, node, timeout: float, output: Callabl
             timeout,
             use=lambda urdf, entry=entry: load_description(urdf, entry.description),
             on_refused=refused,
+            stopped=stopped,
         )
         models[models.index(entry)] = dataclasses.replace(entry, text=prepared.text)
         notes = [*prepared.changed]

@@ -83,7 +83,7 @@ def check_robot_description(text, source: str = "the robot description") -> str:
     return text
 
 
-def receive_robot_description(node, topic: str, timeout: float, use=None, on_refused=None):
+def receive_robot_description(node, topic: str, timeout: float, use=None, on_refused=None, stopped=None):
     """Wait for a usable description on ``topic``; what ``use`` made of it (owner thread of ``node``).
 
     Subscribes with :func:`robot_description_qos`, so the message a
@@ -100,10 +100,13 @@ def receive_robot_description(node, topic: str, timeout: float, use=None, on_ref
             raised; then the wait goes on for a corrected description, with
             no deadline (a publisher is there, and ``robot_state_publisher``
             publishes a fixed file again).  None: the first refusal is raised.
+        stopped: asked every 0.1 s; when it says True (Ctrl-C in ``rtt-run``),
+            the wait ends with ``KeyboardInterrupt``, as a Ctrl-C would.
 
     Raises:
         DescriptionError: nothing arrived within ``timeout`` s (with a hint),
             or, without ``on_refused``, what arrived is not usable.
+        KeyboardInterrupt: ``stopped`` said True.
     """
     from rclpy.event_handler import SubscriptionEventCallbacks
     from rclpy.executors import SingleThreadedExecutor
@@ -130,6 +133,8 @@ def receive_robot_description(node, topic: str, timeout: float, use=None, on_ref
         deadline = time.monotonic() + timeout
         while heard or time.monotonic() < deadline:
             executor.spin_once(timeout_sec=0.1 if heard else min(0.1, max(0.0, deadline - time.monotonic())))
+            if stopped is not None and stopped():
+                raise KeyboardInterrupt
             if received:
                 heard, text = True, received[-1]  # the newest: an older one is superseded
                 received.clear()

@@ -9,5 +9,6 @@ module              job
 ``launch``          ``launch_py/``'s launcher: one process per node, a clean stop
 ``shm``             Fast DDS's shared-memory files, and removing what killed nodes left
 ``graph``           which nodes publish and subscribe which topics, and a picture of it
+``messages``        any message as ``ros2 topic echo``'s YAML, and its fields set from YAML
 ==================  ================================================================
 """

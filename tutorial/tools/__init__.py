@@ -11,6 +11,7 @@ module              program
 ``rtt_bag``         ``rtt-bag``: record, list, replay and recover MCAP bags (``ros2 bag``'s stand-in)
 ``rtt_urdf``        ``rtt-urdf``: a MuJoCo model as a URDF
 ``rtt_foxglove``    ``rtt-foxglove``: every topic, and TF, to Foxglove over its WebSocket
+``rtt_ros2``        ``rtt-ros2``: the ``ros2`` commands of ROS 2's beginner tutorials
 ==================  ================================================================
 
 Nothing in the library imports these modules (``make lint``'s import contracts).

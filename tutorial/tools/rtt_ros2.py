@@ -18,7 +18,9 @@ output: ``topic echo`` prints each message as YAML followed by ``---``,
 and window each second, ``param get`` prints ``Boolean value is: False``.
 It is not ros2cli: there is no daemon (each command discovers for
 ``--spin-time`` s first), and a command or option it does not have is
-refused with what it does instead.  Discovery stays on this machine unless
+refused with what it does instead.  It does one job, the ``ros2`` command line, in one
+module: each command is a function of a few lines, and the table at the end
+(``COMMANDS``) maps the words to them.  Discovery stays on this machine unless
 ``ROS_AUTOMATIC_DISCOVERY_RANGE`` says otherwise, as for every ``rtt-*``
 program.
 """
@@ -255,7 +257,7 @@ def _subscribe(node, topic: str, seconds: float, callback):
         time.sleep(0.05)
     if not publishers:
         raise ValueError(f"no publisher of {topic} seen within {seconds:g} s (its type is taken from one)")
-    cls = interface_type(publishers[0].topic_type)
+    any_type = interface_type(publishers[0].topic_type)  # whatever the topic carries: only printed or counted
     reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
     latched = all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
     qos = QoSProfile(
@@ -263,7 +265,7 @@ def _subscribe(node, topic: str, seconds: float, callback):
         reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
         durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE,
     )
-    return node.create_subscription(cls, topic, callback, qos)
+    return node.create_subscription(any_type, topic, callback, qos)
 
 
 def _spin_until(node, done, timeout: float | None) -> None:
