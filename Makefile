@@ -125,7 +125,7 @@ test-fast: $(VENV)/.installed
 # SO-100's and Go2's pictures in Chromium (make test draws the Panda's): about 2.5 min, the meshes converted cold.
 test-robots: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh
-	bash scripts/ensure-urdfdom.sh
+	bash scripts/ensure-debian-package.sh check_urdf liburdfdom-tools "make test-robots (urdfdom's check_urdf)"
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_any_robot.py -m slow -q
 
 # Every notebook's Run All in JupyterLab, as a learner runs it (tests/test_jupyterlab.py; make test runs the

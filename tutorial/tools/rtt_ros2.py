@@ -225,11 +225,16 @@ def node_info(node, args) -> int:
     return 0
 
 
+def _print_names(items, show_types: bool) -> int:
+    """``name`` or ``name [type]`` per line, as ``ros2 ... list [-t]`` prints them; 0."""
+    for name, types in sorted(items):
+        print(f"{name} [{', '.join(types)}]" if show_types else name)
+    return 0
+
+
 def topic_list(node, args) -> int:
     _discover(node, args.spin_time)
-    for name, types in sorted(node.get_topic_names_and_types()):
-        print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-    return 0
+    return _print_names(node.get_topic_names_and_types(), args.show_types)
 
 
 def topic_info(node, args) -> int:
@@ -348,9 +353,7 @@ def topic_pub(node, args) -> int:
 
 def service_list(node, args) -> int:
     _discover(node, args.spin_time)
-    for name, types in sorted(node.get_service_names_and_types()):
-        print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-    return 0
+    return _print_names(node.get_service_names_and_types(), args.show_types)
 
 
 def _call(node, client, request, timeout: float = 10.0):
@@ -472,9 +475,7 @@ def action_list(node, args) -> int:
     from rclpy.action import get_action_names_and_types
 
     _discover(node, args.spin_time)
-    for name, types in sorted(get_action_names_and_types(node)):
-        print(f"{name} [{', '.join(types)}]" if args.show_types else name)
-    return 0
+    return _print_names(get_action_names_and_types(node), args.show_types)
 
 
 def interface_show(node, args) -> int:
