@@ -32,11 +32,13 @@ def step2():
     from conftest import Proc
 
     sim = Proc(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json"))
-    deadline = time.monotonic() + 60
-    while "Publisher count: 1" not in ros2("topic", "info", "/Tank/joint_state").stdout:
-        assert time.monotonic() < deadline and sim.p.poll() is None, sim.err  # each try discovers for 2 s
-    yield sim
-    sim.kill()
+    try:  # stopped also when it never came up: a simulation left running costs every later test
+        deadline = time.monotonic() + 60
+        while "Publisher count: 1" not in ros2("topic", "info", "/Tank/joint_state").stdout:
+            assert time.monotonic() < deadline and sim.p.poll() is None, sim.err  # each try discovers for 2 s
+        yield sim
+    finally:
+        sim.kill()
 
 
 def test_the_beginner_commands_against_a_running_simulation(step2):
@@ -86,6 +88,7 @@ def test_the_beginner_commands_against_a_running_simulation(step2):
     assert "'RttJointStatePublisher.rate'" in called.stdout
 
 
+@pytest.mark.more  # make test keeps the other commands against the running simulation
 def test_topic_pub_drives_the_tank(step2):
     """``topic pub /joy`` with the left stick pushed: the simulated tank drives forward (Step 1's controller)."""
     before = ros2("topic", "echo", "/Tank/odom", "--once", timeout=30)
@@ -118,6 +121,7 @@ def test_a_bad_command_says_what_is_wrong_in_one_line(ros, args, says):
     assert done.returncode == 2 and says in done.stderr and done.stderr.count("\n") == 1, done
 
 
+@pytest.mark.more  # a managed node of rclpy's: make test keeps the other commands against a running node
 def test_lifecycle_set_walks_every_transition(ros):
     """A managed node (rclpy's LifecycleNode): ``lifecycle set`` takes it through every transition, ``get`` says
     where it is, and a transition its state does not have is refused naming the ones it has."""
