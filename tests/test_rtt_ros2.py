@@ -49,6 +49,7 @@ def test_the_beginner_commands_against_a_running_simulation(step2):
     info = ros2("node", "info", "/rtt").stdout
     assert "  Publishers:\n" in info and "    /Tank/joint_state: sensor_msgs/msg/JointState\n" in info, info
     assert "  Subscribers:\n    /joy: sensor_msgs/msg/Joy\n" in info, info
+    assert "  Service Clients:\n\n  Action Servers:\n\n" in info, info  # an empty section: an empty line
     topics = ros2("topic", "list", "-t").stdout.splitlines()
     assert "/Tank/joint_state [sensor_msgs/msg/JointState]" in topics and "/joy [sensor_msgs/msg/Joy]" in topics
     described = ros2("topic", "info", "/Tank/joint_state").stdout
@@ -96,9 +97,8 @@ def test_topic_pub_drives_the_tank(step2):
     sent = ros2(
         "topic", "pub", "/joy", "sensor_msgs/msg/Joy", "{axes: [0.0, 1.0, 0.0, 0.0, 0.0, 0.0]}", "-t", "20", "-r", "20"
     )
-    assert sent.returncode == 0 and sent.stdout.startswith(
-        "publisher: beginning loop\npublishing #1: sensor_msgs.msg.Joy("
-    )
+    began = "Waiting for at least 1 matching subscription(s)...\npublisher: beginning loop\n"
+    assert sent.returncode == 0 and sent.stdout.startswith(began + "publishing #1: sensor_msgs.msg.Joy("), sent
     assert sent.stdout.count("publishing #") == 20
     after = ros2("topic", "echo", "/Tank/odom", "--once", timeout=30)
     x1 = yaml.safe_load(after.stdout.removesuffix("---\n"))["pose"]["pose"]["position"]["x"]
@@ -114,11 +114,26 @@ def test_topic_pub_drives_the_tank(step2):
         (("topic", "pub", "/joy", "tf2_msgs/msg/TFMessage", "{}"), "no package tf2_msgs here"),
         (("topic", "pub", "/joy", "sensor_msgs/msg/Joy", "{axes: [1.0"), "the message: not YAML"),
         (("action", "send_goal", "/turret", "x", "{}"), "not here: actions on the tank come with notebook 11"),
+        (("topic", "pub", "/joy", "std_srvs/srv/Trigger", "{}"), "a srv type, where a msg type is asked for"),
+        (("topic", "pub", "/a b", "sensor_msgs/msg/Joy", "{}"), "Invalid topic name"),
+        (("param", "set", "/rtt", "x", "'unbalanced"), "the value: not YAML"),
     ],
 )
 def test_a_bad_command_says_what_is_wrong_in_one_line(ros, args, says):
     done = ros2(*args)
     assert done.returncode == 2 and says in done.stderr and done.stderr.count("\n") == 1, done
+
+
+def test_what_could_not_be_done_exits_1_saying_why(ros):
+    """A command whose request was right but could not be carried out (here: nobody publishes the topic)."""
+    done = ros2("topic", "echo", "/nobody_publishes_this", "--once", "--spin-time", "0.3")
+    assert done.returncode == 1 and "no publisher of /nobody_publishes_this seen within 0.3 s" in done.stderr, done
+
+
+@pytest.mark.more  # one more process against the simulation: make test keeps the single node's list
+def test_param_list_of_every_node(step2):
+    listed = ros2("param", "list").stdout
+    assert "/rtt:\n" in listed and "  RttJointStatePublisher.rate\n" in listed, listed
 
 
 @pytest.mark.more  # a managed node of rclpy's: make test keeps the other commands against a running node
@@ -170,8 +185,10 @@ def test_interface_show_and_what_is_not_here(ros):
 
 @pytest.mark.unit
 def test_messages_print_as_ros2cli_prints_them():
+    from geometry_msgs.msg import Twist
     from nav_msgs.msg import Path
-    from sensor_msgs.msg import JointState
+    from rcl_interfaces.msg import ParameterValue
+    from sensor_msgs.msg import Imu, JointState
 
     from tutorial.ros.messages import set_fields, to_yaml
 
@@ -183,6 +200,19 @@ def test_messages_print_as_ros2cli_prints_them():
     )
     long = JointState(position=[0.0] * 200)
     assert "position:\n- 0.0\n- 0.0\n- 0.0\n- '...'\nvelocity" in to_yaml(long, truncate_length=3)
+    twist = Twist()
+    set_fields(twist, {"linear": {"x": 2}, "angular": {"z": 1.8}})  # a whole number into a float, as ros2 takes it
+    assert twist.linear.x == 2.0 and isinstance(twist.linear.x, float)
+    value = ParameterValue()
+    set_fields(value, {"type": 5, "byte_array_value": [1, 2, 255]})
+    assert "byte_array_value:\n- 1\n- 2\n- 255\n" in to_yaml(value)  # octets as numbers
+    for bad, says in (
+        ({"orientation_covariance": [1.0] * 8}, r"does not fit double\[9\] \(expected a list of 9\)"),
+        ({"linear_acceleration_covariance": [True] * 9}, r"linear_acceleration_covariance\[0\]: True does not fit"),
+        ({"orientation": {"x": "a"}}, "orientation.x: 'a' does not fit double"),
+    ):
+        with pytest.raises(ValueError, match=says):
+            set_fields(Imu(), bad)
     path = Path()
     set_fields(path, {"header": {"frame_id": "map"}, "poses": [{"pose": {"position": {"x": 1.0}}}, {}]})
     assert path.header.frame_id == "map" and len(path.poses) == 2 and path.poses[0].pose.position.x == 1.0

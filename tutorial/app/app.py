@@ -112,6 +112,7 @@ class App:
         self.frames = FramePacer()  # when the view draws (owner thread)
         self._drawn_step = -1
         self.stop_requested = False
+        self._refusing = False  # our parameter callback is on the node (open), to be taken off a lent node (close)
 
     # ---- lifecycle (owner thread) -------------------------------------------------
     def open(self) -> App:
@@ -154,6 +155,7 @@ class App:
         self.node_fqn = self.node.get_fully_qualified_name()
         # registered before the spin thread starts, which runs it (a parameter service's callback)
         self.node.add_on_set_parameters_callback(self._refuse_controller_parameters)
+        self._refusing = True
         if self.spin is not None:
             self.spin.start()
         self.loop.call_every(GRAPH_CHECK_PERIOD, self.check_node_name)
@@ -243,7 +245,9 @@ class App:
         read = [p.name for p in parameters if p.name in ours]
         if not read:
             return SetParametersResult(successful=True)
-        example = f"{read[0]}:={parameters[[p.name for p in parameters].index(read[0])].value}"
+        import shlex
+
+        example = shlex.quote(f"{read[0]}:={parameters[[p.name for p in parameters].index(read[0])].value}")
         return SetParametersResult(
             successful=False,
             reason=f"{', '.join(read)}: read when the controller is configured, not while it runs: start the "
@@ -377,6 +381,9 @@ class App:
                     self.log.error("controller %s failed to unconfigure: %r", name, exc)
         if self._own_node and self.node is not None:
             self.node.destroy_node()
+        elif self._refusing:  # a node lent to us goes on: it stops asking this App about its parameters
+            self.node.remove_on_set_parameters_callback(self._refuse_controller_parameters)
+        self._refusing = False
         if self.scene is not None:
             self.scene.close()
         if self.server is not None:

@@ -17,8 +17,8 @@ output: ``topic echo`` prints each message as YAML followed by ``---``,
 ``topic hz`` prints ``average rate`` with its min, max, standard deviation
 and window each second, ``param get`` prints ``Boolean value is: False``.
 It is not ros2cli: there is no daemon (each command discovers for
-``--spin-time`` s first), and a command or option it does not have is
-refused with what it does instead.  It does one job, the ``ros2`` command line, in one
+``--spin-time`` s first), and a command it does not have is refused (those
+in ``NOT_HERE`` saying what to do instead).  It does one job, the ``ros2`` command line, in one
 module: each command is a function of a few lines, and the table at the end
 (``COMMANDS``) maps the words to them.  Discovery stays on this machine unless
 ``ROS_AUTOMATIC_DISCOVERY_RANGE`` says otherwise, as for every ``rtt-*``
@@ -57,9 +57,14 @@ NOT_HERE = {  # what ros2 has and this does not: refused, saying what to do inst
 }
 
 
+class CommandFailed(Exception):
+    """What was asked could not be done (no publisher, no server, no answer in time): exit status 1."""
+
+
 def main(argv: list[str] | None = None) -> int:
     """``rtt-ros2 VERB SUBVERB ...``; the exit status (0, 1 when what was asked failed, 2 for a bad command)."""
     import rclpy
+    from rclpy.exceptions import NameValidationException
 
     argv = list(sys.argv if argv is None else argv)
     p = _parser()
@@ -81,8 +86,11 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # | head: the reader has what it wanted
         sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - Python's own advice: no second error at exit
         return 0
-    except ValueError as exc:  # a bad type name, field or value: one line
+    except CommandFailed as exc:
         print(f"rtt-ros2: {exc}", file=sys.stderr)
+        return 1
+    except (ValueError, NameValidationException) as exc:  # a bad type, field, value or name: one line
+        print(f"rtt-ros2: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
     finally:
         node.destroy_node()
@@ -100,10 +108,13 @@ def _parser() -> argparse.ArgumentParser:
     )
     verbs = p.add_subparsers(dest="verb")
 
+    common = argparse.ArgumentParser(add_help=False)  # --spin-time after the command too, as ros2 takes it
+    common.add_argument("--spin-time", type=float, default=argparse.SUPPRESS, help=argparse.SUPPRESS)
+
     def verb(name: str, subverbs: dict[str, callable]) -> None:
         sub = verbs.add_parser(name).add_subparsers(dest="subverb")
         for subverb, add in subverbs.items():
-            add(sub.add_parser(subverb))
+            add(sub.add_parser(subverb, parents=[common]))
 
     def nothing(_):
         return None
@@ -125,7 +136,7 @@ def _parser() -> argparse.ArgumentParser:
 
     def hz(q):
         topic_name(q)
-        q.add_argument("--window", "-w", type=int, default=10_000, help="messages the rate is taken over")
+        q.add_argument("--window", "-w", type=_positive_int, default=10_000, help="intervals the rate is taken over")
         q.add_argument("--timeout", type=float, default=None, help="exit after this many seconds")
 
     def pub(q):
@@ -133,9 +144,15 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("message_type", help="e.g. sensor_msgs/msg/Joy")
         q.add_argument("values", nargs="?", default="{}", help="the fields, in YAML: '{axes: [0.0, 1.0]}'")
         q.add_argument("-1", "--once", action="store_true", help="publish one message and exit")
-        q.add_argument("-t", "--times", type=int, default=0, help="publish this many and exit")
-        q.add_argument("-r", "--rate", type=float, default=1.0, help="messages per second (default 1)")
-        q.add_argument("-w", "--wait-matching-subscriptions", type=int, default=1, help="wait for this many first")
+        q.add_argument("-t", "--times", type=_positive_int, default=0, help="publish this many and exit")
+        q.add_argument("-r", "--rate", type=_positive_float, default=1.0, help="messages per second (default 1)")
+        q.add_argument(
+            "-w",
+            "--wait-matching-subscriptions",
+            type=int,
+            default=None,
+            help="wait for this many subscribers first (default 1 with --once or --times, else 0)",
+        )
 
     def call(q):
         q.add_argument("service_name")
@@ -143,7 +160,10 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("values", nargs="?", default="{}", help="the request's fields, in YAML")
 
     def param(q, value=False, name=True):
-        node_name(q)
+        if name:
+            node_name(q)
+        else:
+            q.add_argument("node_name", nargs="?", default=None, help="a node's full name; none: every node")
         if name:
             q.add_argument("parameter_name")
         if value:
@@ -176,6 +196,25 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text}: must be 1 or more")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not value > 0 or math.isinf(value):
+        raise argparse.ArgumentTypeError(f"{text}: must be a number above 0")
+    return value
+
+
+def _hidden(name: str) -> bool:
+    """A name ROS 2 hides (a part starting with ``_``: an action's own topics and services), as ros2 hides it."""
+    return any(part.startswith("_") for part in name.split("/"))
+
+
 def _discover(node, seconds: float) -> None:
     end = time.monotonic() + seconds
     while time.monotonic() < end:
@@ -190,7 +229,8 @@ def _split(full_name: str) -> tuple[str, str]:
 
 def _nodes(node) -> list[str]:
     names = node.get_node_names_and_namespaces()
-    return sorted(f"{ns.rstrip('/')}/{n}" for n, ns in names if not (n == NODE_NAME and ns == "/"))
+    full = (f"{ns.rstrip('/')}/{n}" for n, ns in names if not (n == NODE_NAME and ns == "/"))
+    return sorted(name for name in full if not _hidden(name))
 
 
 def node_list(node, args) -> int:
@@ -219,15 +259,14 @@ def node_info(node, args) -> int:
     print(args.node_name)
     for title, items in sections:
         print(f"  {title}:")
-        for item, types in sorted(items):
-            if "/_action/" not in item:  # an action's own topics and services: listed as the action
-                print(f"    {item}: {', '.join(types)}")
+        shown = [f"    {item}: {', '.join(types)}" for item, types in sorted(items) if not _hidden(item)]
+        print(*shown, sep="\n")  # as ros2 prints it: an empty section is an empty line
     return 0
 
 
 def _print_names(items, show_types: bool) -> int:
-    """``name`` or ``name [type]`` per line, as ``ros2 ... list [-t]`` prints them; 0."""
-    for name, types in sorted(items):
+    """``name`` or ``name [type]`` per line, as ``ros2 ... list [-t]`` prints them, hidden ones left out; 0."""
+    for name, types in sorted(i for i in items if not _hidden(i[0])):
         print(f"{name} [{', '.join(types)}]" if show_types else name)
     return 0
 
@@ -261,7 +300,7 @@ def _subscribe(node, topic: str, seconds: float, callback):
             break
         time.sleep(0.05)
     if not publishers:
-        raise ValueError(f"no publisher of {topic} seen within {seconds:g} s (its type is taken from one)")
+        raise CommandFailed(f"no publisher of {topic} seen within {seconds:g} s (its type is taken from one)")
     any_type = interface_type(publishers[0].topic_type)  # whatever the topic carries: only printed or counted
     reliable = all(p.qos_profile.reliability == ReliabilityPolicy.RELIABLE for p in publishers)
     latched = all(p.qos_profile.durability == DurabilityPolicy.TRANSIENT_LOCAL for p in publishers)
@@ -297,23 +336,30 @@ def topic_echo(node, args) -> int:
 
 
 def topic_hz(node, args) -> int:
-    """Each second: the rate of the messages received, from their arrival times on this machine's clock."""
-    arrivals: list[float] = []
-    _subscribe(node, args.topic_name, args.spin_time, lambda msg: arrivals.append(time.monotonic()))
+    """Each second with new messages: their rate, from their arrival times on this machine's clock, over the
+    last ``--window`` intervals (as ``ros2 topic hz`` prints it; nothing while none arrive)."""
+    from collections import deque
+
+    arrivals: deque[float] = deque(maxlen=args.window + 1)
+    received = [0]
+
+    def arrived(msg):
+        arrivals.append(time.monotonic())
+        received[0] += 1
+
+    _subscribe(node, args.topic_name, args.spin_time, arrived)
     end = math.inf if args.timeout is None else time.monotonic() + args.timeout
-    shown = time.monotonic()
+    shown, seen = time.monotonic(), 0
     while time.monotonic() < end:
         _spin_until(node, lambda: False, min(1.0 - (time.monotonic() - shown), end - time.monotonic()))
         shown = time.monotonic()
-        recent = arrivals[-(args.window + 1) :]
-        if len(recent) < 2:
-            print("no new messages" if arrivals else "waiting for messages", flush=True)
-            continue
-        gaps = [b - a for a, b in zip(recent, recent[1:], strict=False)]
-        mean = statistics.fmean(gaps)
+        if received[0] == seen or len(arrivals) < 2:
+            continue  # nothing new since the last line
+        seen = received[0]
+        gaps = [b - a for a, b in zip(list(arrivals), list(arrivals)[1:], strict=False)]
         print(
-            f"average rate: {1.0 / mean:.3f}\n\tmin: {min(gaps):.3f}s max: {max(gaps):.3f}s "
-            f"std dev: {statistics.pstdev(gaps):.5f}s window: {len(gaps) + 1}",
+            f"average rate: {1.0 / statistics.fmean(gaps):.3f}\n\tmin: {min(gaps):.3f}s max: {max(gaps):.3f}s "
+            f"std dev: {statistics.pstdev(gaps):.5f}s window: {len(gaps)}",
             flush=True,
         )
     return 0
@@ -336,8 +382,11 @@ def topic_pub(node, args) -> int:
     set_fields(msg, _yaml(args.values, "the message"))
     publisher = node.create_publisher(cls, args.topic_name, QoSProfile(depth=10))
     times = 1 if args.once else args.times
-    end = time.monotonic() + 10.0  # waiting for a subscriber: ros2 topic pub's -w
-    while publisher.get_subscription_count() < args.wait_matching_subscriptions and time.monotonic() < end:
+    wait = args.wait_matching_subscriptions
+    wait = (1 if times else 0) if wait is None else wait
+    if wait:
+        print(f"Waiting for at least {wait} matching subscription(s)...", flush=True)
+    while publisher.get_subscription_count() < wait:  # as ros2 topic pub -w: until then (Ctrl-C ends it)
         time.sleep(0.05)
     print("publisher: beginning loop", flush=True)
     count = 0
@@ -356,15 +405,17 @@ def service_list(node, args) -> int:
     return _print_names(node.get_service_names_and_types(), args.show_types)
 
 
-def _call(node, client, request, timeout: float = 10.0):
+def _call(node, client, request, timeout: float = 10.0, say_waiting: bool = False):
     import rclpy
 
+    if say_waiting and not client.wait_for_service(timeout_sec=1.0):  # as ros2 service call says it
+        print("waiting for service to become available...", flush=True)
     if not client.wait_for_service(timeout_sec=timeout):
-        raise ValueError(f"{client.srv_name}: no server answered within {timeout:g} s")
+        raise CommandFailed(f"{client.srv_name}: no server answered within {timeout:g} s")
     future = client.call_async(request)
     rclpy.spin_until_future_complete(node, future, timeout_sec=timeout)
     if not future.done():
-        raise ValueError(f"{client.srv_name}: no response within {timeout:g} s")
+        raise CommandFailed(f"{client.srv_name}: no response within {timeout:g} s")
     return future.result()
 
 
@@ -374,33 +425,45 @@ def service_call(node, args) -> int:
     set_fields(request, _yaml(args.values, "the request"))
     client = node.create_client(cls, args.service_name)
     print(f"requester: making request: {request!r}\n", flush=True)
-    response = _call(node, client, request)
+    response = _call(node, client, request, say_waiting=True)
     print(f"response:\n{response!r}\n", flush=True)
     return 0
 
 
-def _parameters(node, args):
+def _parameters(node, node_name: str, timeout: float = 10.0):
     from rclpy.parameter_client import AsyncParameterClient
 
-    client = AsyncParameterClient(node, args.node_name)
-    if not client.wait_for_services(timeout_sec=10.0):
-        raise ValueError(f"{args.node_name}: no parameter services answered within 10 s (is the node running?)")
+    client = AsyncParameterClient(node, node_name)
+    if not client.wait_for_services(timeout_sec=timeout):
+        raise CommandFailed(f"{node_name}: no parameter services answered within {timeout:g} s (is the node running?)")
     return client
 
 
-def _done(node, future):
+def _done(node, future, timeout: float = 10.0):
     import rclpy
 
-    rclpy.spin_until_future_complete(node, future, timeout_sec=10.0)
+    rclpy.spin_until_future_complete(node, future, timeout_sec=timeout)
     if not future.done():
-        raise ValueError("no response within 10 s")
+        raise CommandFailed(f"no response within {timeout:g} s")
     return future.result()
 
 
 def param_list(node, args) -> int:
-    result = _done(node, _parameters(node, args).list_parameters())
-    for name in sorted(result.result.names):
-        print(f"  {name}")
+    """``param list NODE``: its parameters, indented; ``param list``: every node's, under its name."""
+    if args.node_name is not None:
+        result = _done(node, _parameters(node, args.node_name).list_parameters())
+        for name in sorted(result.result.names):
+            print(f"  {name}")
+        return 0
+    _discover(node, args.spin_time)
+    for other in _nodes(node):
+        try:
+            result = _done(node, _parameters(node, other, timeout=1.0).list_parameters(), timeout=2.0)
+        except CommandFailed:
+            continue  # a node without parameter services (ros2 leaves it out too)
+        print(f"{other}:")
+        for name in sorted(result.result.names):
+            print(f"  {name}")
     return 0
 
 
@@ -418,11 +481,11 @@ DESCRIPTIONS = {  # how ros2 param get says each type
 
 
 def param_get(node, args) -> int:
-    result = _done(node, _parameters(node, args).get_parameters([args.parameter_name]))
+    result = _done(node, _parameters(node, args.node_name).get_parameters([args.parameter_name]))
     value = result.values[0] if result.values else None
     if value is None or value.type not in DESCRIPTIONS:
         print("Parameter not set.")
-        return 1
+        return 0
     words, field = DESCRIPTIONS[value.type]
     shown = getattr(value, field)
     print(f"{words} {list(shown) if value.type >= 5 else shown}")
@@ -433,9 +496,10 @@ def param_set(node, args) -> int:
     from rcl_interfaces.msg import Parameter
     from rclpy.parameter import get_parameter_value
 
+    _yaml(args.value, "the value")  # rclpy's reader lets a YAML scanner's error through as a traceback
     value = get_parameter_value(args.value)  # as ros2 param set reads it: YAML, typed (true, 3, 2.5, text)
     parameters = [Parameter(name=args.parameter_name, value=value)]
-    result = _done(node, _parameters(node, args).set_parameters(parameters)).results[0]
+    result = _done(node, _parameters(node, args.node_name).set_parameters(parameters)).results[0]
     reason = f": {result.reason}" if result.reason else ""
     if result.successful:
         print(f"Set parameter successful{reason}")
@@ -467,8 +531,11 @@ def lifecycle_set(node, args) -> int:
     request = ChangeState.Request()
     request.transition.id = labels[args.transition]
     done = _call(node, node.create_client(ChangeState, f"{args.node_name}/change_state"), request)
-    print("Transitioning successful" if done.success else "Transitioning failed")
-    return 0 if done.success else 1
+    if not done.success:
+        print("Transitioning failed", file=sys.stderr)
+        return 1
+    print("Transitioning successful")
+    return 0
 
 
 def action_list(node, args) -> int:
@@ -487,7 +554,7 @@ def interface_show(node, args) -> int:
     interface_type(args.type_name, kind)  # a package or type that is not here: said as for every command
     path = os.path.join(sys.prefix, "share", package, kind, f"{name}.{kind}")
     if not os.path.isfile(path):
-        raise ValueError(f"{args.type_name}: no definition file at {path}")
+        raise CommandFailed(f"{args.type_name}: no definition file at {path}")
     with open(path, encoding="utf-8") as f:
         print(f.read(), end="")
     return 0

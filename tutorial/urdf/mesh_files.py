@@ -134,9 +134,12 @@ def drawable_meshes(path: Path, cache: Path | None = None) -> list[Part]:
         name = f"part{i}.stl"
         tmp = folder / f".{name}.{os.getpid()}"
         mesh, faces = trimesh.util.concatenate(meshes), None
-        if len(mesh.faces) > MAX_FACES:
-            faces, mesh = len(mesh.faces), mesh.simplify_quadric_decimation(face_count=MAX_FACES)
-        mesh.export(tmp, file_type="stl")
+        try:
+            if len(mesh.faces) > MAX_FACES:
+                faces, mesh = len(mesh.faces), mesh.simplify_quadric_decimation(face_count=MAX_FACES)
+            mesh.export(tmp, file_type="stl")
+        except Exception as exc:  # noqa: BLE001 - a mesh the simplifier or writer cannot take: said, not raised
+            raise MeshError(f"{path}: cannot be made drawable ({type(exc).__name__}: {exc})") from None
         os.replace(tmp, folder / name)
         parts.append({"file": name, "rgba": list(rgba) if rgba else None, "simplified_from": faces})
     tmp = folder / f".parts.json.{os.getpid()}"

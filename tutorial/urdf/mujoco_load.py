@@ -197,7 +197,9 @@ def _leave_out_refused_meshes(root, visuals: dict, left_out: list[str]) -> None:
                 mesh = next((m for m in spec.meshes if _names_mesh(reason, m)), None)
                 if mesh is None:
                     raise ValueError(f"MuJoCo cannot compile it: {reason}") from None
-                link, uri, elements = visuals.get(mesh.file, ("?", mesh.file, []))
+                if mesh.file not in visuals:  # not a mesh this function put there: nothing to leave out
+                    raise ValueError(f"MuJoCo cannot compile it: {reason}") from None
+                link, uri, elements = visuals[mesh.file]
                 for geom in [g for g in spec.geoms if g.meshname == mesh.name]:
                     spec.delete(geom)
                 spec.delete(mesh)
