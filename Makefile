@@ -121,7 +121,7 @@ test-more: $(VENV)/.installed
 test-fast: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m unit -q
 
-# The Step 3 monitor on all 68 robots of example-robot-data that urdfdom accepts (make test keeps 6), and the UR5's,
+# The Step 3 monitor on all 68 robots of example-robot-data that urdfdom accepts (make test keeps 3), and the UR5's,
 # SO-100's and Go2's pictures in Chromium (make test draws the Panda's): about 2.5 min, the meshes converted cold.
 test-robots: $(VENV)/.installed
 	bash scripts/ensure-chromium.sh

@@ -221,6 +221,7 @@ def test_a_broken_description_waits_for_a_fixed_one(procs, node, tmp_path):
     assert view.summary()["controllers"]["RttJointStateMonitor"]["last_positions"] == {"shoulder": 0.5}
 
 
+@pytest.mark.more  # make test keeps the wait itself (test_a_broken_description_waits_for_a_fixed_one)
 def test_ctrl_c_ends_the_wait_for_a_corrected_description(procs, node, tmp_path):
     """Waiting, with no deadline, for a description that can be drawn: one Ctrl-C ends it, cleanly."""
     from std_msgs.msg import String
