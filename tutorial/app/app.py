@@ -242,16 +242,16 @@ class App:
         from rcl_interfaces.msg import SetParametersResult
 
         ours = {f"{c.name}.{n}" for m in self.project.models for c in m.controllers for n in c.cls.PARAMETERS}
-        read = [p.name for p in parameters if p.name in ours]
+        read = [p for p in parameters if p.name in ours]
         if not read:
             return SetParametersResult(successful=True)
         import shlex
 
-        example = shlex.quote(f"{read[0]}:={parameters[[p.name for p in parameters].index(read[0])].value}")
+        example = shlex.quote(f"{read[0].name}:={read[0].value}")
         return SetParametersResult(
             successful=False,
-            reason=f"{', '.join(read)}: read when the controller is configured, not while it runs: start the "
-            f"program again with --ros-args -p {example}",
+            reason=f"{', '.join(p.name for p in read)}: read when the controller is configured, not while it "
+            f"runs: start the program again with --ros-args -p {example}",
         )
 
     def _open_view(self) -> None:

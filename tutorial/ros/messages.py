@@ -43,12 +43,6 @@ def interface_type(name: str, kind: str = "msg"):
     return cls
 
 
-def type_name(cls) -> str:
-    """``pkg/msg/Name`` of a message or service class, as ``ros2 topic list -t`` prints it."""
-    package, folder = cls.__module__.split(".")[:2]
-    return f"{package}/{folder.removeprefix('_')}/{cls.__name__}"
-
-
 def to_dict(msg, truncate_length: int | None = None) -> dict:
     """``msg`` as plain Python (dicts, lists, numbers, strings), its fields in their declared order."""
     return {field: _plain(getattr(msg, field), truncate_length) for field in msg.get_fields_and_field_types()}

@@ -159,15 +159,16 @@ def _parser() -> argparse.ArgumentParser:
         q.add_argument("service_type", help="e.g. std_srvs/srv/Trigger")
         q.add_argument("values", nargs="?", default="{}", help="the request's fields, in YAML")
 
-    def param(q, value=False, name=True):
-        if name:
-            node_name(q)
-        else:
-            q.add_argument("node_name", nargs="?", default=None, help="a node's full name; none: every node")
-        if name:
-            q.add_argument("parameter_name")
-        if value:
-            q.add_argument("value", help="in YAML: true, 3, 2.5, text, [1, 2]")
+    def param_list(q):
+        q.add_argument("node_name", nargs="?", default=None, help="a node's full name; none: every node")
+
+    def param_get(q):
+        node_name(q)
+        q.add_argument("parameter_name")
+
+    def param_set(q):
+        param_get(q)
+        q.add_argument("value", help="in YAML: true, 3, 2.5, text, [1, 2]")
 
     def transition(q):
         node_name(q)
@@ -180,7 +181,7 @@ def _parser() -> argparse.ArgumentParser:
         "node": {"list": nothing, "info": node_name},
         "topic": {"list": show_types, "info": topic_name, "echo": echo, "hz": hz, "pub": pub},
         "service": {"list": show_types, "call": call},
-        "param": {"list": lambda q: param(q, name=False), "get": param, "set": lambda q: param(q, value=True)},
+        "param": {"list": param_list, "get": param_get, "set": param_set},
         "lifecycle": {"get": node_name, "set": transition},
         "action": {"list": show_types},
         "interface": {"show": lambda q: q.add_argument("type_name", help="e.g. sensor_msgs/msg/Joy")},
@@ -406,17 +407,11 @@ def service_list(node, args) -> int:
 
 
 def _call(node, client, request, timeout: float = 10.0, say_waiting: bool = False):
-    import rclpy
-
     if say_waiting and not client.wait_for_service(timeout_sec=1.0):  # as ros2 service call says it
         print("waiting for service to become available...", flush=True)
     if not client.wait_for_service(timeout_sec=timeout):
         raise CommandFailed(f"{client.srv_name}: no server answered within {timeout:g} s")
-    future = client.call_async(request)
-    rclpy.spin_until_future_complete(node, future, timeout_sec=timeout)
-    if not future.done():
-        raise CommandFailed(f"{client.srv_name}: no response within {timeout:g} s")
-    return future.result()
+    return _done(node, client.call_async(request), timeout, f"{client.srv_name}: ")
 
 
 def service_call(node, args) -> int:
@@ -439,12 +434,13 @@ def _parameters(node, node_name: str, timeout: float = 10.0):
     return client
 
 
-def _done(node, future, timeout: float = 10.0):
+def _done(node, future, timeout: float = 10.0, what: str = ""):
+    """The future's result, ``node`` spun until it came; :class:`CommandFailed` after ``timeout`` s."""
     import rclpy
 
     rclpy.spin_until_future_complete(node, future, timeout_sec=timeout)
     if not future.done():
-        raise CommandFailed(f"no response within {timeout:g} s")
+        raise CommandFailed(f"{what}no response within {timeout:g} s")
     return future.result()
 
 

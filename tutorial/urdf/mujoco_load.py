@@ -147,7 +147,7 @@ def _replace_refused_inertias(root) -> list[str]:
     """
     import numpy as np
 
-    replaced = []
+    bound, replaced = float(COMPILER["boundinertia"]), []
     for link in root.iter("link"):
         inertia = link.find("inertial/inertia")
         if inertia is None:
@@ -160,9 +160,9 @@ def _replace_refused_inertias(root) -> list[str]:
         if not np.isfinite(matrix).all():
             continue
         moments = np.linalg.eigvalsh(matrix)  # ascending
-        a, b, c = np.maximum(moments, float(COMPILER["boundinertia"]))
+        a, b, c = np.maximum(moments, bound)
         if moments[0] < -1e-14 or a + b < c:
-            mean = max(float(np.abs(moments).mean()), float(COMPILER["boundinertia"]))
+            mean = max(float(np.abs(moments).mean()), bound)
             for k, value in zip(_MATCHING, (mean, 0.0, 0.0, mean, 0.0, mean), strict=True):
                 inertia.set(k, repr(value))
             replaced.append(link.get("name", "?"))
@@ -195,9 +195,7 @@ def _leave_out_refused_meshes(root, visuals: dict, left_out: list[str]) -> None:
             except ValueError as exc:
                 reason = _one_line(exc)
                 mesh = next((m for m in spec.meshes if _names_mesh(reason, m)), None)
-                if mesh is None:
-                    raise ValueError(f"MuJoCo cannot compile it: {reason}") from None
-                if mesh.file not in visuals:  # not a mesh this function put there: nothing to leave out
+                if mesh is None or mesh.file not in visuals:  # not a mesh of a visual: nothing to leave out
                     raise ValueError(f"MuJoCo cannot compile it: {reason}") from None
                 link, uri, elements = visuals[mesh.file]
                 for geom in [g for g in spec.geoms if g.meshname == mesh.name]:
