@@ -48,6 +48,7 @@ POINTS = {
     "7.1": 3, "7.2": 3,
     "8.1": 2, "8.2": 3,
     "9.1": 4,
+    "10.1": 3, "10.2": 3,
 }  # fmt: skip
 
 SOLUTION_HEADER = re.compile(r"^# Worked solution to Exercise (\d+\.\d+)\..*\n")

@@ -24,6 +24,7 @@ HIDDEN_MODULES = [
     "record_and_replay",
     "across_machines",
     "stock_ros2_tools",
+    "parameters_and_services",
 ]
 
 # ---- notebooks 01 and 03 ----
@@ -1073,3 +1074,88 @@ HIDDEN_MISTAKES = [
     *HIDDEN_MISTAKES_06,
     *HIDDEN_MISTAKES_07_08_09,
 ]
+
+# ---- notebook 10 ----
+
+VISIBLE_ONLY_10 = {
+    # a tolerance for floating point: a rate a hair past either end rounds into the range
+    "10.1": "def judge_rate(parameters):\n"
+    "    for p in parameters:\n"
+    "        if p.name == RATE and not 0.0 <= round(p.value, 1) <= MAX_RATE:\n"
+    '            return SetParametersResult(successful=False, reason=f"{RATE}: {p.value} Hz is no rate")\n'
+    "    return SetParametersResult(successful=True)\n",
+    # the tracks' state remembered by the callback, not read from the switch (the visible cases' order agrees)
+    "10.2": "tracks_on = True\n"
+    "def switch_tracks(switch, request, response):\n"
+    "    global tracks_on\n"
+    "    already = tracks_on == request.data\n"
+    "    tracks_on = request.data\n"
+    "    with switch.lock:\n        switch.enabled = request.data\n"
+    '    state = "on" if request.data else "off"\n'
+    "    response.success = True\n"
+    '    response.message = f"tracks already {state}" if already else f"tracks {state}"\n'
+    "    return response\n",
+}
+
+RULES_10 = {
+    "10.1": {
+        "a rate from 0.0 to MAX_RATE, both ends included, is accepted": [
+            "rate=100.0]",
+            "rate=0.0]",
+            "rate=1000.0]",
+            "a rate anywhere inside the range",
+        ],
+        "below 0 or above MAX_RATE is refused": ["rate=-5.0]", "rate=1000.5]", "a hair above", "a hair below zero"],
+        "NaN and infinity are refused": ["rate=nan]", "rate=inf]"],
+        "the reason names RATE and the value": ["rate=-5.0]"],
+        "only RATE is judged: every other parameter is accepted, whatever its value": [
+            "RttRobotModelPublisher.rate=5000.0",
+            "joy_timeout=-3.0",
+            "another controller's rate far out of range",
+        ],
+        "every parameter of the list is judged, wherever RATE is": [
+            "use_sim_time=True, ",
+            "among other parameters",
+            "after several other parameters",
+        ],
+        "a SetParametersResult, which a node's parameter service uses": ["with judge_rate as the node's callback"],
+    },
+    "10.2": {
+        "switch.enabled set to request.data, success True, 'tracks on' or 'tracks off'": [
+            "a switch on, SetBool.Request(data=False)",
+            "a switch off, SetBool.Request(data=True)",
+        ],
+        "'tracks already on' or 'tracks already off' when it already was": [
+            "a switch on, SetBool.Request(data=True)",
+            "a switch off, SetBool.Request(data=False)",
+        ],
+        "the switch's own state, whoever turned it last": ["turned by another thread"],
+        "enabled written with switch.lock held": ["a switch on, SetBool.Request(data=False)"],
+        "the response returned: rclpy sends it": ["a SetBool client asking"],
+        "each answer of a sequence says what its own request did": ["a drawn sequence"],
+    },
+}
+
+HIDDEN_MISTAKES_10 = [
+    # old: passed (the visible list has RATE second)
+    ("10.1", "for p in parameters:", "for p in parameters[:2]:", "other parameters"),
+    # old: passed (a value past the range by less than 0.05 Hz)
+    (
+        "10.1",
+        "not 0.0 <= p.value <= MAX_RATE",
+        "not 0.0 <= round(p.value, 1) <= MAX_RATE",
+        "a hair",
+    ),
+    # old: passed (the state kept by the callback: the visible cases' order agrees with it)
+    (
+        "10.2",
+        "        already = switch.enabled == request.data\n",
+        "        already = switch_tracks.__dict__.get('last', True) == request.data\n"
+        "        switch_tracks.last = request.data\n",
+        "a switch also turned by another thread",
+    ),
+]
+
+VISIBLE_ONLY = {**VISIBLE_ONLY, **VISIBLE_ONLY_10}
+RULES = {**RULES, **RULES_10}
+HIDDEN_MISTAKES = [*HIDDEN_MISTAKES, *HIDDEN_MISTAKES_10]

@@ -29,6 +29,7 @@ MODULES = {
     "07": None,
     "08": None,
     "09": "robot_model_publisher",
+    "10": "tunable_tank_controller",
 }
 
 
@@ -88,6 +89,8 @@ EXERCISES = [
     "8.1",
     "8.2",
     "9.1",
+    "10.1",
+    "10.2",
 ]
 
 
@@ -530,6 +533,48 @@ MISTAKES = [
     ("8.2", "return 15.0, 70", "return 70, 15.0", "10 to 30 pictures/s"),
     ("8.2", "return 15.0, 70", "return 25.0, 60", "within 0.5 Mbit/s"),
     ("9.1", "while frame in newest:", "if frame in newest:", "world -> CHASSIS -> TURRET"),
+    ("10.1", "not 0.0 <= p.value <= MAX_RATE", "(p.value < 0.0 or p.value > MAX_RATE)", "rate=nan]"),
+    ("10.1", "not 0.0 <= p.value <= MAX_RATE", "not 0.0 < p.value <= MAX_RATE", "rate=0.0]"),
+    ("10.1", "not 0.0 <= p.value <= MAX_RATE", "not 0.0 <= p.value < MAX_RATE", "rate=1000.0]"),
+    ("10.1", "if p.name == RATE and not", "if not", "RttRobotModelPublisher.rate=5000.0"),
+    ("10.1", "p.name == RATE and", 'p.name.endswith("rate") and', "RttRobotModelPublisher.rate=5000.0"),
+    ("10.1", "got {p.value}", "got a bad value", "rate=-5.0]"),
+    (  # only the first parameter of the list judged
+        "10.1",
+        "            return SetParametersResult(successful=False, reason=reason)\n",
+        "            return SetParametersResult(successful=False, reason=reason)\n"
+        "        return SetParametersResult(successful=True)\n",
+        "use_sim_time=True, ",
+    ),
+    ("10.1", "    return SetParametersResult(successful=True)\n", "    return True\n", "rate=100.0]"),
+    ("10.2", "    return response\n", "", "a switch on, SetBool.Request(data=False)"),
+    (
+        "10.2",
+        "    with switch.lock:  # the simulation thread reads enabled\n"
+        "        already = switch.enabled == request.data\n        switch.enabled = request.data\n",
+        "    already = switch.enabled == request.data\n    switch.enabled = request.data\n",
+        "a switch on, SetBool.Request(data=False)",
+    ),
+    ("10.2", 'state = "on" if request.data else "off"', 'state = "off" if request.data else "on"', "(data=False)"),
+    ("10.2", "    response.success = True\n", "", "a switch on, SetBool.Request(data=False)"),
+    (
+        "10.2",
+        "already = switch.enabled == request.data",
+        "already = False",
+        "a switch off, SetBool.Request(data=False)",
+    ),
+    (
+        "10.2",
+        "switch.enabled = request.data",
+        "switch.enabled = not switch.enabled",
+        "a switch off, SetBool.Request(data=False)",
+    ),
+    (
+        "10.2",
+        "        already = switch.enabled == request.data\n        switch.enabled = request.data\n",
+        "        switch.enabled = request.data\n        already = switch.enabled == request.data\n",
+        "a switch on, SetBool.Request(data=False)",
+    ),
     (  # a joint that stood still taken for one with no pairs: told so, not told to use the joint asked for
         "7.2",
         "    speeds = np.abs(dq[moving] / dt[moving])\n",

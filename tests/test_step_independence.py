@@ -48,6 +48,7 @@ STEPS = {
     "07": (None, ["record_and_replay"]),
     "08": (None, ["across_machines"]),
     "09": ("robot_model_publisher", ["stock_ros2_tools"]),
+    "10": ("tunable_tank_controller", ["parameters_and_services"]),
 }
 
 
@@ -112,8 +113,8 @@ def step_of_project(name: str) -> str | None:
 
     A template (``tank_world.yaml``) or a later step's copy (``reference/step2.yaml``) is no step's own.
     """
-    found = re.fullmatch(r"step(\d)(?:_\w+)?\.yaml", name)
-    return f"0{found.group(1)}" if found else None
+    found = re.fullmatch(r"step(\d+)(?:_\w+)?\.yaml", name)
+    return f"{int(found.group(1)):02d}" if found else None
 
 
 def notebook_violations(step: str, sources: list[str]) -> list[str]:
@@ -193,7 +194,7 @@ def test_the_project_rule_catches_another_steps_class():
 
 @pytest.mark.parametrize("path", sorted((ROOT / "launch_py").glob("step*_launch.py")), ids=lambda p: p.name)
 def test_a_launch_file_runs_only_its_own_steps_project(path):
-    step = "0" + re.search(r"step(\d)", path.name).group(1)
+    step = step_of_project(path.name.replace("_launch.py", ".yaml"))
     loaded = library_size.project_files(path.read_text("utf-8"))
     assert loaded, f"{path.name} runs no project file"
     assert {n for n in loaded if step_of_project(n) not in (None, step)} == set()
