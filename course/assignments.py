@@ -49,6 +49,7 @@ POINTS = {
     "8.1": 2, "8.2": 3,
     "9.1": 4,
     "10.1": 3, "10.2": 3,
+    "11.1": 3,
 }  # fmt: skip
 
 SOLUTION_HEADER = re.compile(r"^# Worked solution to Exercise (\d+\.\d+)\..*\n")

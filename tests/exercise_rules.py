@@ -25,6 +25,7 @@ HIDDEN_MODULES = [
     "across_machines",
     "stock_ros2_tools",
     "parameters_and_services",
+    "managed_nodes_and_actions",
 ]
 
 # ---- notebooks 01 and 03 ----
@@ -1156,6 +1157,61 @@ HIDDEN_MISTAKES_10 = [
     ),
 ]
 
-VISIBLE_ONLY = {**VISIBLE_ONLY, **VISIBLE_ONLY_10}
-RULES = {**RULES, **RULES_10}
-HIDDEN_MISTAKES = [*HIDDEN_MISTAKES, *HIDDEN_MISTAKES_10]
+# ---- notebook 11 ----
+
+VISIBLE_ONLY_11 = {
+    # the path a tank's controller walks, learned from the visible cases: shutdown only from active
+    "11.1": "PATH = {('unconfigured', 'configure'): 'inactive', ('inactive', 'activate'): 'active',\n"
+    "        ('active', 'deactivate'): 'inactive', ('inactive', 'cleanup'): 'unconfigured',\n"
+    "        ('active', 'shutdown'): 'finalized'}\n"
+    "def after(state, transition):\n"
+    "    return PATH.get((state, transition))\n",
+}
+
+RULES_11 = {
+    "11.1": {
+        "configure: unconfigured -> inactive": [
+            "after('unconfigured', 'configure')",
+            "every transition from unconfigured and inactive",
+        ],
+        "activate: inactive -> active": ["after('inactive', 'activate')"],
+        "deactivate: active -> inactive": ["after('active', 'deactivate')"],
+        "cleanup: inactive -> unconfigured": ["after('inactive', 'cleanup')"],
+        "shutdown: every state but finalized -> finalized": [
+            "after('active', 'shutdown')",
+            "every transition from unconfigured and inactive",
+        ],
+        "any other pair: None": [
+            "after('unconfigured', 'activate')",
+            "after('active', 'cleanup')",
+            "every transition from active and finalized",
+        ],
+        "finalized has no transition": [
+            "after('finalized', 'configure')",
+            "every transition from active and finalized",
+        ],
+        "a name that is no state or no transition: None": ["a name that is no transition"],
+        "the state after a transition is where the next one starts": ["a walk along drawn transitions"],
+    },
+}
+
+HIDDEN_MISTAKES_11 = [
+    # old: passed (no visible case asks for a shutdown from unconfigured)
+    (
+        "11.1",
+        '"unconfigured": {"configure": "inactive", "shutdown": "finalized"},',
+        '"unconfigured": {"configure": "inactive"},',
+        "every transition from unconfigured",
+    ),
+    # old: passed (names taken whatever their case)
+    (
+        "11.1",
+        "return machine.get(state, {}).get(transition)",
+        "return machine.get(state.lower(), {}).get(transition.lower())",
+        "a name that is no transition",
+    ),
+]
+
+VISIBLE_ONLY = {**VISIBLE_ONLY, **VISIBLE_ONLY_10, **VISIBLE_ONLY_11}
+RULES = {**RULES, **RULES_10, **RULES_11}
+HIDDEN_MISTAKES = [*HIDDEN_MISTAKES, *HIDDEN_MISTAKES_10, *HIDDEN_MISTAKES_11]

@@ -30,6 +30,7 @@ MODULES = {
     "08": None,
     "09": "robot_model_publisher",
     "10": "tunable_tank_controller",
+    "11": "managed_tank_controller",
 }
 
 
@@ -91,6 +92,7 @@ EXERCISES = [
     "9.1",
     "10.1",
     "10.2",
+    "11.1",
 ]
 
 
@@ -575,6 +577,38 @@ MISTAKES = [
         "        switch.enabled = request.data\n        already = switch.enabled == request.data\n",
         "a switch on, SetBool.Request(data=False)",
     ),
+    (
+        "11.1",
+        '"active": {"deactivate": "inactive", "shutdown": "finalized"},',
+        '"active": {"deactivate": "inactive"},',
+        "after('active', 'shutdown')",
+    ),
+    ("11.1", '"finalized": {},', '"finalized": {"configure": "inactive"},', "after('finalized', 'configure')"),
+    (
+        "11.1",
+        '"active": {"deactivate": "inactive", "shutdown": "finalized"},',
+        '"active": {"deactivate": "inactive", "shutdown": "finalized", "cleanup": "unconfigured"},',
+        "after('active', 'cleanup')",
+    ),
+    (
+        "11.1",
+        '"unconfigured": {"configure": "inactive", "shutdown": "finalized"},',
+        '"unconfigured": {"configure": "inactive", "activate": "active", "shutdown": "finalized"},',
+        "after('unconfigured', 'activate')",
+    ),
+    (
+        "11.1",
+        "return machine.get(state, {}).get(transition)",
+        "return machine[state][transition]",
+        "after('unconfigured', 'activate')",
+    ),
+    (
+        "11.1",
+        '"active": {"deactivate": "inactive", "shutdown": "finalized"},',
+        '"active": {"deactivate": "unconfigured", "shutdown": "finalized"},',
+        "after('active', 'deactivate')",
+    ),
+    ("11.1", '"cleanup": "unconfigured",', '"cleanup": "inactive",', "after('inactive', 'cleanup')"),
     (  # a joint that stood still taken for one with no pairs: told so, not told to use the joint asked for
         "7.2",
         "    speeds = np.abs(dq[moving] / dt[moving])\n",

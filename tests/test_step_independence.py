@@ -49,6 +49,7 @@ STEPS = {
     "08": (None, ["across_machines"]),
     "09": ("robot_model_publisher", ["stock_ros2_tools"]),
     "10": ("tunable_tank_controller", ["parameters_and_services"]),
+    "11": ("managed_tank_controller", ["managed_nodes_and_actions"]),
 }
 
 

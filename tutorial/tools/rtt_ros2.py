@@ -10,6 +10,7 @@
     rtt-ros2 param set /rtt use_sim_time false
     rtt-ros2 lifecycle get /node           rtt-ros2 lifecycle set /node configure
     rtt-ros2 action list [-t]              rtt-ros2 interface show sensor_msgs/msg/Joy
+    rtt-ros2 action send_goal /Tank/turn_turret test_msgs/action/NestedMessage '{nested_field: {float64_value: 1.0}}' -f
 
 (the book's page *The ros2 commands* says what differs, and which of ROS 2's beginner tutorials can be
 followed with it).  The same spelling as ``ros2`` and, where a tutorial shows it, the same
@@ -40,7 +41,6 @@ from tutorial.ros.messages import interface_type, set_fields, to_yaml
 
 NODE_NAME = "rtt_ros2"
 NOT_HERE = {  # what ros2 has and this does not: refused, saying what to do instead
-    "action send_goal": "actions on the tank come with notebook 11; only test_msgs' action types exist as wheels",
     "action info": "rtt-ros2 node info NODE lists each node's action servers and clients",
     "service type": "rtt-ros2 service list -t lists each service with its type",
     "service find": "rtt-ros2 service list -t lists each service with its type",
@@ -65,6 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     """``rtt-ros2 VERB SUBVERB ...``; the exit status (0, 1 when what was asked failed, 2 for a bad command)."""
     import rclpy
     from rclpy.exceptions import NameValidationException
+    from rclpy.signals import SignalHandlerOptions
 
     argv = list(sys.argv if argv is None else argv)
     p = _parser()
@@ -77,7 +78,9 @@ def main(argv: list[str] | None = None) -> int:
         p.print_help()
         return 2
     ros_env.use_localhost_by_default()
-    rclpy.init(args=argv)
+    # Ctrl-C is Python's KeyboardInterrupt, raised between two spins of at most 0.1 s: the context stays up,
+    # so a goal can still be cancelled (rclpy's own handler would shut the context down first).
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     node = rclpy.create_node(NODE_NAME, start_parameter_services=False)
     try:
         return COMMANDS[(args.verb, args.subverb)](node, args)
@@ -174,6 +177,12 @@ def _parser() -> argparse.ArgumentParser:
         node_name(q)
         q.add_argument("transition", help="a transition's label: configure, activate, deactivate, cleanup, shutdown")
 
+    def send_goal(q):
+        q.add_argument("action_name", help="e.g. /Tank/turn_turret")
+        q.add_argument("action_type", help="e.g. test_msgs/action/NestedMessage")
+        q.add_argument("goal", nargs="?", default="{}", help="the goal's fields, in YAML")
+        q.add_argument("-f", "--feedback", action="store_true", help="print each feedback message")
+
     def anything(q):  # a command that is not here: its arguments are not read
         q.add_argument("rest", nargs=argparse.REMAINDER)
 
@@ -183,7 +192,7 @@ def _parser() -> argparse.ArgumentParser:
         "service": {"list": show_types, "call": call},
         "param": {"list": param_list, "get": param_get, "set": param_set},
         "lifecycle": {"get": node_name, "set": transition},
-        "action": {"list": show_types},
+        "action": {"list": show_types, "send_goal": send_goal},
         "interface": {"show": lambda q: q.add_argument("type_name", help="e.g. sensor_msgs/msg/Joy")},
     }
     for asked in NOT_HERE:
@@ -435,10 +444,8 @@ def _parameters(node, node_name: str, timeout: float = 10.0):
 
 
 def _done(node, future, timeout: float = 10.0, what: str = ""):
-    """The future's result, ``node`` spun until it came; :class:`CommandFailed` after ``timeout`` s."""
-    import rclpy
-
-    rclpy.spin_until_future_complete(node, future, timeout_sec=timeout)
+    """The future's result, ``node`` spun until it came; :class:`CommandFailed` after ``timeout`` s (None: no end)."""
+    _spin_until(node, future.done, timeout)
     if not future.done():
         raise CommandFailed(f"{what}no response within {timeout:g} s")
     return future.result()
@@ -541,6 +548,49 @@ def action_list(node, args) -> int:
     return _print_names(get_action_names_and_types(node), args.show_types)
 
 
+GOAL_STATUS = {4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}  # action_msgs/msg/GoalStatus, as ros2 names them
+
+
+def action_send_goal(node, args) -> int:
+    """The goal, each feedback (with ``-f``), the result and its status, as ``ros2 action send_goal`` prints them.
+
+    It waits for the result as long as the goal runs; Ctrl-C cancels the goal first.  Exit status 1 when the
+    goal was rejected or did not succeed.
+    """
+    from rclpy.action import ActionClient
+
+    cls = interface_type(args.action_type, "action")
+    goal = cls.Goal()
+    set_fields(goal, _yaml(args.goal, "the goal"))
+    client = ActionClient(node, cls, args.action_name)
+    print("Waiting for an action server to become available...", flush=True)
+    if not client.wait_for_server(timeout_sec=10.0):
+        raise CommandFailed(f"{args.action_name}: no action server answered within 10 s")
+    print(f"Sending goal:\n     {to_yaml(goal)}", flush=True)
+
+    def feedback(msg) -> None:
+        print(f"Feedback:\n    {to_yaml(msg.feedback)}", flush=True)
+
+    sent = client.send_goal_async(goal, feedback_callback=feedback if args.feedback else None)
+    handle = _done(node, sent, what=f"{args.action_name}: ")
+    if not handle.accepted:
+        print("Goal was rejected.", flush=True)
+        return 1
+    print(f"Goal accepted with ID: {bytes(handle.goal_id.uuid).hex()}\n", flush=True)
+    try:
+        result = _done(node, handle.get_result_async(), None)
+    except KeyboardInterrupt:
+        print("Canceling goal...", flush=True)
+        if not _done(node, handle.cancel_goal_async(), what=f"{args.action_name}: ").goals_canceling:
+            raise CommandFailed(f"{args.action_name}: the goal was not canceled (it had ended)") from None
+        print("Goal canceled.")
+        return 1
+    status = GOAL_STATUS.get(result.status, "UNKNOWN")
+    print(f"Result:\n    {to_yaml(result.result)}")
+    print(f"Goal finished with status: {status}")
+    return 0 if status == "SUCCEEDED" else 1
+
+
 def interface_show(node, args) -> int:
     """The interface's definition file as its package installed it (nested types are not expanded)."""
     parts = args.type_name.strip("/").split("/")
@@ -572,6 +622,7 @@ COMMANDS = {
     ("lifecycle", "get"): lifecycle_get,
     ("lifecycle", "set"): lifecycle_set,
     ("action", "list"): action_list,
+    ("action", "send_goal"): action_send_goal,
     ("interface", "show"): interface_show,
 }
 
