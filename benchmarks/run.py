@@ -20,6 +20,9 @@ because absolute times on a shared machine vary:
   description's arrival, cold, started again and a second monitor; and
   every robot of example-robot-data's, cold and cached, the median and
   the slowest (:mod:`benchmarks.experiments.any_robot`; figures, not targets);
+* a service's and a parameter set's round trip: notebook 10's tank
+  (``/Tank/reset``, ``max_track_speed``) against a bare rclpy node, p50
+  and p99 (:mod:`benchmarks.experiments.round_trips`; figures, not targets);
 * late join: a viewer's and a recorder's wait for the state a running
   publisher keeps, under the project's Fast DDS profile and Fast DDS's
   defaults, and what each profile costs an idle participant;
@@ -70,6 +73,7 @@ from benchmarks.experiments.cross_process import latency_rounds
 from benchmarks.experiments.late_join import late_join
 from benchmarks.experiments.learners import LEARNERS, learners_per_server
 from benchmarks.experiments.network import measure as across_hosts
+from benchmarks.experiments.round_trips import measure as round_trips
 from benchmarks.experiments.scale import scale_curves
 from benchmarks.experiments.scene_update import scene_update_cost
 from benchmarks.experiments.speed import (
@@ -228,6 +232,15 @@ def _suite(args) -> int:
             f"({e['cached_slowest']['file']})",
             flush=True,
         )
+    if measure("round_trips", lambda: round_trips(50 if args.quick else 300, 1 if args.quick else 3)):  # not a target
+        t = r["round_trips"]
+        for kind, what in (("service", "/Tank/reset"), ("parameter_set", "a parameter set")):
+            f, ours, bare = t[kind], t[kind]["tutorial_ms"], t[kind]["bare_ms"]
+            print(
+                f"{what}'s round trip: p50 {ours['p50']} ms, p99 {ours['p99']} ms; a bare rclpy node's "
+                f"{bare['p50']} ms, {bare['p99']} ms (ratios {f['p50_ratio']}, {f['p99_ratio']})",
+                flush=True,
+            )
     late = (4, 4, 5.0) if args.quick else (20, 8, 20.0)  # starts, idle participants, idle seconds
     measure("late_join", lambda: late_join(*late))
     with tempfile.TemporaryDirectory() as d:

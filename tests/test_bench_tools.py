@@ -237,3 +237,18 @@ def test_a_gpu_only_target_reads_n_a_without_a_gpu_and_is_held_with_one():
     # the same cases' ratio to the bare page is held without a GPU (50 ms against 451 ms: met)
     ratios = [t for t in BROWSER_TARGETS if not t.gpu_only and "x the bare page" in t.label and "arm" in t.label]
     assert len(ratios) == 1 and ratios[0].row(run)["pass"] is True
+
+
+@pytest.mark.more  # a smoke test of one experiment's processes: make bench runs it in full
+def test_round_trips_times_both_targets_and_stops_their_processes():
+    import psutil
+
+    from benchmarks.experiments.round_trips import measure
+
+    before = {p.pid for p in psutil.Process().children(recursive=True)}
+    figures = measure(calls=5, rounds=1)
+    assert figures["calls"] == 5
+    for kind in ("service", "parameter_set"):
+        assert figures[kind]["tutorial_ms"]["n"] == 5 and figures[kind]["bare_ms"]["n"] == 5
+        assert 0 < figures[kind]["tutorial_ms"]["p50"] < 1000 and figures[kind]["p50_ratio"] > 0
+    assert {p.pid for p in psutil.Process().children(recursive=True)} <= before  # the tank and the bare node ended
