@@ -161,6 +161,7 @@ def ros2(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
     return subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
+@pytest.mark.more  # make test runs notebook 10 under nbval: the limit set live, rtt-ros2 param set, the reset
 def test_param_set_and_service_call_change_the_running_tank(ros):
     """Notebook 10's controller under ``rtt-run project/step10.yaml``: ``param set`` slows the driving tank
     down (its odometry's speed), a bad value is refused with the controller's reason and changes nothing, and
