@@ -14,6 +14,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import threading
+import time
 
 import mujoco
 import numpy as np
@@ -75,6 +76,11 @@ def test_a_speed_limit_is_judged_then_used_from_the_next_step(tank):
     assert node.set_parameters([Parameter(LIMIT, value=3.0)])[0].successful  # raised again: at once, no new Joy
     step(controller, model, data)
     assert [t.dq_target for t in controller.tracks] == [2.0, 2.0]
+    # full stick forward and to the left: (1.0, 3.0) asked; under 1.5 m/s both halved, so it still turns
+    controller.on_joy(Joy(axes=[1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0], buttons=[0] * 8))
+    assert node.set_parameters([Parameter(LIMIT, value=1.5)])[0].successful
+    step(controller, model, data)
+    assert [t.dq_target for t in controller.tracks] == [0.5, 1.5]
     # an integer is refused by rclpy itself: the parameter was declared as a float
     assert not node.set_parameters([Parameter(LIMIT, value=1)])[0].successful
 
@@ -97,12 +103,10 @@ def test_the_reset_waits_for_the_simulation_thread_and_puts_the_tank_back(tank):
 
     caller = threading.Thread(target=spin_thread)
     caller.start()
-    deadline_steps = 0
-    while caller.is_alive() and deadline_steps < 10_000:  # the callback waits for a step
+    deadline = time.monotonic() + 10
+    while not controller.resets:  # the callback's request is taken at the first step after it was left
+        assert time.monotonic() < deadline and caller.is_alive(), errors
         step(controller, model, data)
-        deadline_steps += 1
-        if controller.resets:
-            break
     caller.join(timeout=5)
     assert not errors and not caller.is_alive() and controller.resets == 1
     assert answers[0].success and answers[0].message.startswith("back at the start at t = ")

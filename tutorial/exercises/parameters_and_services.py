@@ -241,6 +241,11 @@ def check_switch_tracks(func) -> Result:
     def ask(switch, data: bool, call: str, hint: str):
         response = SetBool.Response()
         got = func(switch, SetBool.Request(data=data), response)
+        if switch.lock.locked():
+            raise CaseFailed(
+                f"{call} returned with switch.lock still held: the simulation thread would wait for it forever.",
+                "`with switch.lock:` lets the lock go however the block ends.",
+            )
         if not isinstance(got, SetBool.Response):
             raise CaseFailed(f"{call} returned {got!r}, expected the response (a service callback returns it).", hint)
         return got

@@ -57,6 +57,27 @@ NOT_HERE = {  # what ros2 has and this does not: refused, saying what to do inst
 }
 
 
+_STOP = ros_program.StopRequest()  # Ctrl-C and SIGTERM: a flag the waits below look at (installed by main)
+
+
+def _check_stop() -> None:
+    """Raise ``KeyboardInterrupt`` here, at a point of this module's choosing, once Ctrl-C was pressed.
+
+    Not wherever the main thread happens to be (Python's own handler): inside
+    rclpy's executor, an interrupted spin can leave a goal's answer half
+    taken, and a cancel that follows never hears back.
+    """
+    if _STOP.requested:
+        _STOP.requested = False  # a second Ctrl-C asks again
+        raise KeyboardInterrupt
+
+
+def _pause(seconds: float) -> None:
+    _check_stop()
+    time.sleep(seconds)
+    _check_stop()
+
+
 class CommandFailed(Exception):
     """What was asked could not be done (no publisher, no server, no answer in time): exit status 1."""
 
@@ -78,9 +99,10 @@ def main(argv: list[str] | None = None) -> int:
         p.print_help()
         return 2
     ros_env.use_localhost_by_default()
-    # Ctrl-C is Python's KeyboardInterrupt, raised between two spins of at most 0.1 s: the context stays up,
+    # Ctrl-C sets a flag that every wait here looks at, at least every 0.1 s (_check_stop): the context stays up,
     # so a goal can still be cancelled (rclpy's own handler would shut the context down first).
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    _STOP.install()
     node = rclpy.create_node(NODE_NAME, start_parameter_services=False)
     try:
         return COMMANDS[(args.verb, args.subverb)](node, args)
@@ -228,7 +250,7 @@ def _hidden(name: str) -> bool:
 def _discover(node, seconds: float) -> None:
     end = time.monotonic() + seconds
     while time.monotonic() < end:
-        time.sleep(min(0.05, max(0.0, end - time.monotonic())))  # the graph is filled in by rmw's own thread
+        _pause(min(0.05, max(0.0, end - time.monotonic())))  # the graph is filled in by rmw's own thread
 
 
 def _split(full_name: str) -> tuple[str, str]:
@@ -308,7 +330,7 @@ def _subscribe(node, topic: str, seconds: float, callback):
         publishers = node.get_publishers_info_by_topic(topic)
         if publishers or time.monotonic() >= end:
             break
-        time.sleep(0.05)
+        _pause(0.05)
     if not publishers:
         raise CommandFailed(f"no publisher of {topic} seen within {seconds:g} s (its type is taken from one)")
     any_type = interface_type(publishers[0].topic_type)  # whatever the topic carries: only printed or counted
@@ -327,7 +349,8 @@ def _spin_until(node, done, timeout: float | None) -> None:
 
     end = math.inf if timeout is None else time.monotonic() + timeout
     while not done() and time.monotonic() < end:
-        rclpy.spin_once(node, timeout_sec=0.1)
+        _check_stop()
+        rclpy.spin_once(node, timeout_sec=min(0.1, max(0.0, end - time.monotonic())))
 
 
 def topic_echo(node, args) -> int:
@@ -397,7 +420,7 @@ def topic_pub(node, args) -> int:
     if wait:
         print(f"Waiting for at least {wait} matching subscription(s)...", flush=True)
     while publisher.get_subscription_count() < wait:  # as ros2 topic pub -w: until then (Ctrl-C ends it)
-        time.sleep(0.05)
+        _pause(0.05)
     print("publisher: beginning loop", flush=True)
     count = 0
     while not times or count < times:
@@ -405,7 +428,7 @@ def topic_pub(node, args) -> int:
         publisher.publish(msg)
         print(f"publishing #{count}: {msg!r}\n", flush=True)
         if not times or count < times:
-            time.sleep(1.0 / args.rate)
+            _pause(1.0 / args.rate)
     time.sleep(0.2)  # a reliable message still in the writer's queue: let it go before the node is destroyed
     return 0
 
@@ -554,8 +577,13 @@ GOAL_STATUS = {4: "SUCCEEDED", 5: "CANCELED", 6: "ABORTED"}  # action_msgs/msg/G
 def action_send_goal(node, args) -> int:
     """The goal, each feedback (with ``-f``), the result and its status, as ``ros2 action send_goal`` prints them.
 
-    It waits for the result as long as the goal runs; Ctrl-C cancels the goal first.  Exit status 1 when the
-    goal was rejected or did not succeed.
+    It waits for the result as long as the goal runs, as ``ros2`` does; Ctrl-C cancels the goal (once it was
+    accepted) and exits 1.  Exit status 1 also when the goal was rejected or did not succeed.
+
+    Raises:
+        ValueError: a type or a goal field that is not there, or a value that does not fit its field.
+        CommandFailed: no action server within 10 s, no answer to the goal or the cancel within 10 s, or a
+            goal that had ended before its cancel arrived.
     """
     from rclpy.action import ActionClient
 
@@ -572,23 +600,32 @@ def action_send_goal(node, args) -> int:
         print(f"Feedback:\n    {to_yaml(msg.feedback)}", flush=True)
 
     sent = client.send_goal_async(goal, feedback_callback=feedback if args.feedback else None)
-    handle = _done(node, sent, what=f"{args.action_name}: ")
+    try:
+        handle = _done(node, sent, what=f"{args.action_name}: ")
+    except KeyboardInterrupt:  # before the goal was answered: it may be accepted all the same
+        handle = _done(node, sent, what=f"{args.action_name}: ")
+        return _cancel(node, handle, args.action_name) if handle.accepted else 1
     if not handle.accepted:
         print("Goal was rejected.", flush=True)
         return 1
     print(f"Goal accepted with ID: {bytes(handle.goal_id.uuid).hex()}\n", flush=True)
     try:
-        result = _done(node, handle.get_result_async(), None)
+        result = _done(node, handle.get_result_async(), None)  # as long as the goal runs
     except KeyboardInterrupt:
-        print("Canceling goal...", flush=True)
-        if not _done(node, handle.cancel_goal_async(), what=f"{args.action_name}: ").goals_canceling:
-            raise CommandFailed(f"{args.action_name}: the goal was not canceled (it had ended)") from None
-        print("Goal canceled.")
-        return 1
+        return _cancel(node, handle, args.action_name)
     status = GOAL_STATUS.get(result.status, "UNKNOWN")
     print(f"Result:\n    {to_yaml(result.result)}")
     print(f"Goal finished with status: {status}")
     return 0 if status == "SUCCEEDED" else 1
+
+
+def _cancel(node, handle, action_name: str) -> int:
+    """Cancel an accepted goal (Ctrl-C), as ``ros2 action send_goal`` does; exit status 1."""
+    print("Canceling goal...", flush=True)
+    if not _done(node, handle.cancel_goal_async(), what=f"{action_name}: ").goals_canceling:
+        raise CommandFailed(f"{action_name}: the goal was not canceled (it had ended)")
+    print("Goal canceled.")
+    return 1
 
 
 def interface_show(node, args) -> int:
