@@ -48,7 +48,7 @@ import grade  # noqa: E402
 pytestmark = pytest.mark.cross_process
 
 IN_MAKE_TEST = ["01_step1_tank_controller"]
-ALL = sorted(p.stem for p in (ROOT / "notebooks").glob("0[1-9]_*.ipynb"))
+ALL = sorted(p.stem for p in (ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb") if not p.stem.startswith("00"))
 DOMAINS = [int(os.environ["ROS_DOMAIN_ID"]), int(os.environ["ROS_DOMAIN_ID"]) + 101]  # this session's own
 # The endless answer is interrupted after this: notebook 01's cells take under 4 s here; all nine notebooks'
 # under 10 s alone, more with two graded at once.

@@ -237,6 +237,8 @@ def test_param_set_and_service_call_change_the_running_tank(ros):
         assert refused.returncode == 1, refused  # what could not be done
         assert refused.stderr == f"Set parameter failed: {limit} must be from 0.0 to 3.0 m/s, got -1.0\n", refused
         assert ros2("param", "get", "/rtt", limit).stdout == "Double value is: 0.5\n"
+        whole = ros2("param", "set", "/rtt", limit, "3")  # an integer, refused by rclpy before any callback
+        assert whole.stderr == "Set parameter failed: Wrong parameter type, expected 'Type.DOUBLE' got 'Type.INTEGER'\n"
     finally:
         stopped.set()
         spinner.join(timeout=5)
