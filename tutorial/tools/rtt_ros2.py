@@ -73,9 +73,15 @@ def _check_stop() -> None:
 
 
 def _pause(seconds: float) -> None:
-    _check_stop()
-    time.sleep(seconds)
-    _check_stop()
+    """``time.sleep(seconds)`` in slices of 0.1 s at most, each ended by :func:`_check_stop`: a Ctrl-C is
+    seen within 0.1 s (a sleep the signal interrupts goes on sleeping once its handler has run)."""
+    end = time.monotonic() + seconds
+    while True:
+        _check_stop()
+        left = end - time.monotonic()
+        if left <= 0:
+            return
+        time.sleep(min(0.1, left))
 
 
 class CommandFailed(Exception):
