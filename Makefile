@@ -10,7 +10,7 @@
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does two; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
-#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 2.5 min),
+#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 5 min),
 #       make test-hub (the hub with learners as Unix users: slow),
 #       make test-robots (the Step 3 monitor on every robot of example-robot-data; the UR5, SO-100 and Go2 in Chromium),
 #       make image (the learner image, podman), make hub-containers (the class on containers), make test-containers,
