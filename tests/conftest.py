@@ -201,6 +201,12 @@ def module_command(module: str, *args: str) -> list[str]:
     return [sys.executable, "-u", "-m", module, *args]
 
 
+def ros2(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
+    """``rtt-ros2 ARGS`` as a learner types it, to its end: its exit status, output and errors."""
+    command = [sys.executable, "-m", "tutorial.tools.rtt_ros2", *args]
+    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+
+
 class Proc:
     """A child process whose output lines are collected as they come; killed at the end of the test."""
 

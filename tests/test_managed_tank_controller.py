@@ -8,21 +8,14 @@ and status say what the turret did.
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 import threading
 import time
 
 import pytest
 
-from conftest import ROOT, Proc, module_command
+from conftest import Proc, module_command, ros2
 
 ACTION = "/Tank/turn_turret"
-
-
-def ros2(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "tutorial.tools.rtt_ros2", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
 class Client:

@@ -8,20 +8,12 @@ controllers' parameters on the node ``/rtt``).
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 import threading
 
 import pytest
 import yaml
 
-from conftest import ROOT, module_command
-
-
-def ros2(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    """``rtt-ros2 ARGS`` to its end: its exit status, output and errors."""
-    command = [sys.executable, "-m", "tutorial.tools.rtt_ros2", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+from conftest import module_command, ros2
 
 
 @pytest.fixture(scope="module")

@@ -11,8 +11,6 @@ publishes ``/Tank/odom`` meanwhile).
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import threading
 import time
 
@@ -27,7 +25,7 @@ from tutorial.core.body import Body
 from tutorial.core.controller import ControllerConfig, ControllerIO
 from tutorial.core.world import ModelEntry, build_world
 
-from conftest import MODEL, ROOT, module_command
+from conftest import MODEL, module_command, ros2
 
 LIMIT = "RttTunableTankController.max_track_speed"
 FORWARD = Joy(axes=[0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0], buttons=[0] * 8)
@@ -158,11 +156,6 @@ def test_unconfigure_gives_the_node_back_as_it_was(ros):
         assert not overridden.has_parameter(LIMIT)
     finally:
         overridden.destroy_node()
-
-
-def ros2(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "tutorial.tools.rtt_ros2", *args]
-    return subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
 
 
 @pytest.mark.more  # make test runs notebook 10 under nbval: the limit set live, rtt-ros2 param set, the reset
