@@ -8,7 +8,7 @@
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make mutate (mutation testing of the lessons, the library's core and the checks of assignments 01 to 04: hours),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
-#       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does two; and a live
+#       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does 01; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
 #       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 5 min),
 #       make test-hub (the hub with learners as Unix users: slow),
