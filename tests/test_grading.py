@@ -637,3 +637,44 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
 def test_every_cheat_gets_0_and_is_flagged(tmp_path, monkeypatch):
     monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))
     grade_cheats(tmp_path, sorted(CHEATS))
+
+
+def rebound_check(course: Path, name: str, number: str) -> str:
+    """The rebind-check cheat for exercise ``number`` of assignment ``name``: the code an answer cell adds to
+    rebind, in the check's own module, the check function its check cell imports, to one that always passes."""
+    gid = f"check_{number.replace('.', '_')}"
+    [check] = ["".join(c["source"]) for c in cells_of(course, name) if grade_id(c) == gid]
+    module, function = re.search(r"from (tutorial\.exercises\.\w+) import (check_\w+)", check).groups()
+    return (
+        f"{GRADER}import {module} as m\n"
+        f"m.{function} = lambda *a, **k: grader.Result('Exercise {number}', True, 'passed')\n"
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+@pytest.mark.parametrize("name", [n for n in ALL if n != IN_MAKE_TEST[0]])
+def test_a_rebound_check_gets_0_and_is_flagged_in_every_assignment(tmp_path, monkeypatch, name):
+    """Assignment 01 meets every cheat (test_every_cheat_gets_0_and_is_flagged); the seal knows no assignment
+    of its own, so each other assignment meets the cheat that needs no more than its statement: its first
+    exercise's check, rebound in its module, gets that exercise 0 and the flag; the other exercises keep the
+    worked solution's points and no flag."""
+    if os.geteuid() != 0:
+        pytest.skip("the grading sandbox needs root (a user per job, namespaces)")
+    monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_ALL_S))
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    numbers = exercises_of(name)
+    target = numbers[0]
+    gid = f"exercise_{target.replace('.', '_')}"
+    stubs = {grade_id(c): "".join(c["source"]) for c in cells_of(course, name) if grade_id(c)}
+    answers = dict(solution_of(course, name), **{gid: stubs[gid] + "\n\n" + rebound_check(course, name, target)})
+    folder = course / "submitted" / "cheat-rebind-check" / name
+    folder.mkdir(parents=True)
+    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, answers)))
+    csv_path = grade.grade(course, [name], collect=False, jobs=1, ids=DOMAINS[:1])
+    [row] = list(csv.DictReader(csv_path.open()))
+    flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
+    assert flags == {target: "tampering"}, row["flags"]
+    assert float(row["score"]) == sum(float(assignments.POINTS[n]) for n in numbers[1:]), row

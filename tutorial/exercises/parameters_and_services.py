@@ -40,8 +40,11 @@ def _show_list(params) -> str:
     return "[" + ", ".join(f"{p.name}={p.value!r}" for p in params) + "]"
 
 
-def _verdict(call: str, got, accept: bool, bad=None, hint: str = "") -> None:
-    """Raise CaseFailed unless ``got`` is a SetParametersResult that accepts (``accept``) or refuses, naming ``bad``."""
+def _verdict(call: str, got, accept: bool, bad=None) -> None:
+    """Raise CaseFailed unless ``got`` is a SetParametersResult that accepts (``accept``) or refuses, naming ``bad``.
+
+    A line without a hint of its own gets its case's (grader.CaseFailed).
+    """
     from rcl_interfaces.msg import SetParametersResult
 
     if not isinstance(got, SetParametersResult):
@@ -51,7 +54,7 @@ def _verdict(call: str, got, accept: bool, bad=None, hint: str = "") -> None:
         )
     if got.successful != accept:
         raise CaseFailed(
-            f"{call} {'refused' if accept else 'accepted'} it, expected it {'accepted' if accept else 'refused'}.", hint
+            f"{call} {'refused' if accept else 'accepted'} it, expected it {'accepted' if accept else 'refused'}."
         )
     if not accept and not (RATE in got.reason and repr(bad.value) in got.reason):
         raise CaseFailed(
@@ -80,7 +83,7 @@ def check_judge_rate(func) -> Result:
         call = label if hidden else f"judge_rate({_show_list(params)})"
 
         def run():
-            _verdict(call, func(list(params)), bad is None, bad, hint)
+            _verdict(call, func(list(params)), bad is None, bad)
 
         return Case(call, run, hint, hidden)
 
@@ -202,7 +205,7 @@ class TrackSwitch:
     Both threads use it under ``lock`` (a ``threading.Lock``).
     """
 
-    def __init__(self, enabled: bool = True):
+    def __init__(self, enabled: bool):
         self.lock = threading.Lock()
         self.enabled = enabled
 
@@ -238,7 +241,8 @@ def check_switch_tracks(func) -> Result:
     """
     from std_srvs.srv import SetBool
 
-    def ask(switch, data: bool, call: str, hint: str):
+    # A failing line without a hint of its own gets its case's (grader.CaseFailed).
+    def ask(switch, data: bool, call: str):
         response = SetBool.Response()
         got = func(switch, SetBool.Request(data=data), response)
         if switch.lock.locked():
@@ -247,17 +251,17 @@ def check_switch_tracks(func) -> Result:
                 "`with switch.lock:` lets the lock go however the block ends.",
             )
         if not isinstance(got, SetBool.Response):
-            raise CaseFailed(f"{call} returned {got!r}, expected the response (a service callback returns it).", hint)
+            raise CaseFailed(f"{call} returned {got!r}, expected the response (a service callback returns it).")
         return got
 
-    def expect(call: str, switch, got, was: bool, data: bool, hint: str) -> None:
+    def expect(call: str, switch, got, was: bool, data: bool) -> None:
         wanted = _said(data, was)
         if switch.enabled is not data:
-            raise CaseFailed(f"{call} left switch.enabled = {switch.enabled!r}, expected {data}.", hint)
+            raise CaseFailed(f"{call} left switch.enabled = {switch.enabled!r}, expected {data}.")
         if not got.success:
-            raise CaseFailed(f"{call} answered success=False, expected True: the switch did what was asked.", hint)
+            raise CaseFailed(f"{call} answered success=False, expected True: the switch did what was asked.")
         if got.message != wanted:
-            raise CaseFailed(f"{call} answered {got.message!r}, expected {wanted!r}.", hint)
+            raise CaseFailed(f"{call} answered {got.message!r}, expected {wanted!r}.")
         if switch.unlocked_writes:
             raise CaseFailed(
                 f"{call} set switch.enabled outside `with switch.lock:`.",
@@ -269,7 +273,7 @@ def check_switch_tracks(func) -> Result:
 
         def run():
             switch = _WatchedSwitch(was)
-            expect(call, switch, ask(switch, data, call, hint), was, data, hint)
+            expect(call, switch, ask(switch, data, call), was, data)
 
         return Case(call, run, hint)
 
@@ -294,7 +298,7 @@ def check_switch_tracks(func) -> Result:
                 raise CaseFailed(f"{call}: rclpy could not send the answer ({exc!r}).", "return the response.") from exc
             if not future.done():
                 raise CaseFailed(f"{call}: no answer within {ROUND_TRIP_TIMEOUT:.0f} s.", "return the response.")
-            expect(call, switch, future.result(), True, False, "")
+            expect(call, switch, future.result(), True, False)
         finally:
             executor.shutdown()
             node.destroy_node()
@@ -315,7 +319,7 @@ def check_switch_tracks(func) -> Result:
                     with switch.lock:
                         switch.enabled = not switch.enabled
                 was = switch.enabled
-                expect(call, switch, ask(switch, data, call, hint), was, data, hint)
+                expect(call, switch, ask(switch, data, call), was, data)
 
         return Case(call, run, hint, True)
 
