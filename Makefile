@@ -65,10 +65,11 @@ test-hub: $(VENV)/.installed course/node_modules/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_hub.py -m slow -q
 
-# Grading every assignment's fake submissions, and the cheats of assignment 01 (make test grades notebook 01's,
-# one cheat among them): several minutes; as root, in the grading sandbox.
+# Grading every assignment's fake submissions, the cheats of assignment 01 and a rebound check in each other
+# (make test grades notebook 01's, one cheat among them), and every mistake only hidden cases catch under five
+# learners' seeds: about 30 minutes; as root, in the grading sandbox.
 test-grade: $(VENV)/.installed
-	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_grading.py -m slow -q
+	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_grading.py tests/test_exercises.py -m slow -q
 
 # The learner image (course/containers/Containerfile) with podman, as root: the base image is made first if
 # missing (scripts/ensure-podman.sh); the host's uv cache and CA bundle are lent to the build.

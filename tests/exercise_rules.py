@@ -1191,7 +1191,6 @@ RULES_11 = {
             "every transition from active and finalized",
         ],
         "a name that is no state or no transition: None": ["a name that is no transition"],
-        "the state after a transition is where the next one starts": ["a walk along drawn transitions"],
     },
 }
 
@@ -1209,6 +1208,22 @@ HIDDEN_MISTAKES_11 = [
         "return machine.get(state, {}).get(transition)",
         "return machine.get(state.lower(), {}).get(transition.lower())",
         "a name that is no transition",
+    ),
+    # mutation testing: passed (no visible case shuts an inactive node down)
+    ("11.1", '            "shutdown": "finalized",\n', "", "every transition from unconfigured and inactive"),
+    # mutation testing: passed (activating an active node keeps it active, as a learner might think)
+    (
+        "11.1",
+        '"active": {"deactivate": "inactive", "shutdown": "finalized"},',
+        '"active": {"activate": "active", "deactivate": "inactive", "shutdown": "finalized"},',
+        "every transition from active and finalized",
+    ),
+    # mutation testing: passed (shutdown taken as a transition of every state, finalized too)
+    (
+        "11.1",
+        '"finalized": {},',
+        '"finalized": {"shutdown": "finalized"},',
+        "every transition from active and finalized",
     ),
 ]
 

@@ -1321,6 +1321,43 @@ def test_the_worked_solution_of_3_1_passes_the_hidden_cases_of_many_seeds(ros, m
         assert result.passed and "8 hidden ones" in result.message, str(result)
 
 
+# A learner's hidden cases are drawn from their own seed: a mistake must fail whatever the draw, not for most
+# learners (five seeds found three that passed: 3.1's all-NaN message and two cameras of 8.2 over the budget
+# where no drawn swing looked).  make test-grade; make test keeps 11.1's, below.
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", ["1", "2", "3", "4", "5"])
+@pytest.mark.parametrize(
+    "number, right, wrong, caught_by", HIDDEN_MISTAKES, ids=[mistake_id(m) for m in HIDDEN_MISTAKES]
+)
+def test_a_mistake_only_the_hidden_cases_catch_fails_for_other_learners_seeds_too(
+    ros, monkeypatch, seed, number, right, wrong, caught_by
+):
+    ex = exercise(number)
+    hidden_cases_on(monkeypatch, *HIDDEN_MODULES, seed=seed)
+    result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
+    assert not result.passed, f"seed {seed}: {number} passed {wrong!r}"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", ["1", "2", "3", "4", "5"])
+@pytest.mark.parametrize("number", sorted(VISIBLE_ONLY))
+def test_an_answer_for_the_visible_cases_alone_fails_for_other_learners_seeds_too(ros, monkeypatch, seed, number):
+    ex = exercise(number)
+    hidden_cases_on(monkeypatch, ex["checks"], seed=seed)
+    assert not grade(ex, ex["stub"], VISIBLE_ONLY[number]).passed, f"seed {seed}: {number}'s visible-only answer passed"
+
+
+def test_a_mistake_only_the_hidden_cases_of_11_1_catch_fails_whatever_the_learners_seed(monkeypatch):
+    """The hidden cases of 11.1 ask every pair and every strange name, so no learner's seed lets one of its
+    mistakes through (they once drew one strange name of several: a case-blind answer passed half the seeds)."""
+    ex = exercise("11.1")
+    for _, right, wrong, _ in [m for m in HIDDEN_MISTAKES if m[0] == "11.1"]:
+        for seed in range(20):
+            hidden_cases_on(monkeypatch, "managed_nodes_and_actions", seed=str(seed))
+            result = grade(ex, ex["stub"], ex["solution"].replace(right, wrong))
+            assert not result.passed, f"seed {seed}: 11.1 passed {wrong!r}"
+
+
 def test_the_hidden_cases_of_1_1_follow_the_statements_rules():
     """Each hidden case of 1.1 expects what the statement's rules give for its axes (a missing or non-finite D-pad
     axis counts as 0; the sticks never count), and together they draw every D-pad direction, every stick across
@@ -1411,6 +1448,28 @@ def test_the_hidden_runs_of_3_1_follow_the_statements_rules():
     assert -0.1 <= min(finite) < -0.09 and 0.69 < max(finite) <= 0.7, (min(finite), max(finite))
     assert set(names_seen) == set().union(*pools), names_seen
     assert 0.4 < nans / sum(names_seen.values()) < 0.6  # about half of the positions NaN
+
+
+def test_every_hidden_grading_of_3_1_has_a_tank_message_all_nan_and_one_with_the_gun_before_the_last():
+    """The first: 1 or 2 of the tank's names, each once, each position NaN (both sizes, both orders). The second:
+    the tank's two names and the gun's, the gun's never last, positions in -0.1 to 0.7."""
+    import math
+    import random
+
+    from tutorial.exercises.step3_viewer import _sure_messages
+
+    rng = random.Random("the sure messages of 3.1")
+    seen, orders = set(), set()
+    for _ in range(200):
+        (names, positions), (mixed, values) = _sure_messages(rng)
+        assert 1 <= len(set(names)) == len(names) == len(positions) <= 2 and set(names) <= {"TURRET_Y", "TURRET_P"}
+        assert all(math.isnan(q) for q in positions)
+        seen.add(tuple(names))
+        assert sorted(mixed) == ["GUN", "TURRET_P", "TURRET_Y"] and mixed[-1] != "GUN" and len(values) == 3
+        assert all(-0.1 <= q <= 0.7 for q in values)
+        orders.add(tuple(mixed))
+    assert seen == {("TURRET_Y",), ("TURRET_P",), ("TURRET_Y", "TURRET_P"), ("TURRET_P", "TURRET_Y")}
+    assert len(orders) == 2, orders
 
 
 def test_the_hidden_messages_of_3_2_follow_the_statements_rules():

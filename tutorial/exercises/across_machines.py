@@ -24,6 +24,10 @@ OVERHEAD_BYTES = 100  # RTPS, UDP and IP headers of one picture's message, about
 MIN_RATE, MAX_RATE = 10.0, 30.0  # pictures per second: watchable; the renderer's pace
 MIN_QUALITY = 30  # below it, edges and the crate smear into blocks
 PICTURES = 12  # rendered for the check, along the turret's swing
+SWING_HINT = (
+    "leave a margin: where the turret points elsewhere, pictures take more bytes; lower the quality or the rate."
+)
+SCAN, SCAN_WIDTH = 72, 6  # hidden: pictures all round (5 degrees apart) and a swing's (0.44 rad) of them
 
 
 def check_lossy_link_qos(func) -> Result:
@@ -283,14 +287,44 @@ def check_camera_settings(func) -> Result:
                 state["swings"] = [views[k : k + PICTURES] for k in range(0, len(views), PICTURES)]
             return state["swings"][n]
 
+        hint = (
+            "leave a margin: where the turret points elsewhere, pictures take more bytes; lower the quality or the rate"
+        )
+        hint += "."
         for n in range(len(drawn)):
             yield Case(
                 "camera_settings(): within the budget along another turret swing",
                 lambda n=n: fits(pictures(n)),
-                "leave a margin: where the turret points elsewhere, pictures take more bytes; lower the quality "
-                "or the rate.",
+                SWING_HINT,
                 True,
             )
+        # Drawn swings miss the busiest directions now and then (a setting over the budget on a fifth of them
+        # passed one learner in ten): every learner's grading also has the busiest swing round.
+        yield Case(
+            "camera_settings(): within the budget along the busiest turret swing round", busiest, SWING_HINT, True
+        )
+
+    def busiest():
+        """The swing of SCAN_WIDTH pictures, gun level or lowered, whose pictures take the most bytes at the
+        answer's quality, of a scan all round (SCAN pictures a pitch)."""
+        _, quality = settings()
+        if "scan" not in state:
+            state["scan"] = [
+                camera_views([(2 * math.pi * k / SCAN, pitch) for k in range(SCAN)]) for pitch in (0.0, -0.17)
+            ]
+        from sensor_msgs.msg import CompressedImage
+
+        from tutorial.interfaces.compressed_image import fill_compressed_image
+
+        msg, worst = CompressedImage(), None
+        for views in state["scan"]:
+            sizes = [fill_compressed_image(msg, p, 0.0, "jpeg", quality) for p in views]
+            for k in range(SCAN):
+                window = [(k + j) % SCAN for j in range(SCAN_WIDTH)]
+                total = sum(sizes[i] for i in window)
+                if worst is None or total > worst[0]:
+                    worst = (total, [views[i] for i in window])
+        fits(worst[1])
 
     rng = hidden_random("8.2")  # while grading: this learner's own turret swings
     return grade(

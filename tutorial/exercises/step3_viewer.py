@@ -147,6 +147,16 @@ def _random_run(rng) -> list[tuple[list[str], list[float]]]:
     return run
 
 
+def _sure_messages(rng) -> list[tuple[list[str], list[float]]]:
+    """Two messages every hidden grading of 3.1 has, so an answer that mishandles one fails for every learner,
+    not for a lucky draw's: 1 or 2 of the tank's names, every position NaN (not another model's: the matcher
+    rejects each entry); and the tank's names with the gun's before the last (another model's, whatever its
+    last name)."""
+    names = rng.sample(POOLS[0], rng.randrange(1, 3))
+    mixed = [*rng.sample(["GUN", "TURRET_Y"], 2), "TURRET_P"]
+    return [(names, [math.nan] * len(names)), (mixed, [rng.uniform(-0.1, 0.7) for _ in mixed])]
+
+
 def _random_message(rng, joints) -> tuple[list[str], list[float]]:
     """A message for ``joints`` by the statement's rules: any order, unknown and repeated names, values in
     range, within and past the tolerance, non-finite; sometimes a position or a name short."""
@@ -256,8 +266,11 @@ def check_wrong_model(cls) -> Result:
         (what it applies and counts) plus the statement's rule (another model's message is refused whole)."""
         from tutorial.controllers.joint_state_subscriber import RttJointStateSubscriber
 
-        for _ in range(8):
-            messages = [message(names, positions) for names, positions in _random_run(rng)]
+        for k in range(8):
+            run = _random_run(rng)
+            for sure in _sure_messages(rng) if k == 0 else ():
+                run.insert(rng.randrange(len(run) + 1), sure)
+            messages = [message(names, positions) for names, positions in run]
             ours = [m for m in messages if m.name and all(n in TANK for n in m.name)]
             refused = len(messages) - len(ours)
             body, summary = run_messages(ours, RttJointStateSubscriber)
