@@ -67,7 +67,7 @@ test-hub: $(VENV)/.installed course/node_modules/.installed
 
 # Grading every assignment's fake submissions, the cheats of assignment 01 and a rebound check in each other
 # (make test grades notebook 01's, one cheat among them), and every mistake only hidden cases catch under five
-# learners' seeds: about 30 minutes; as root, in the grading sandbox.
+# learners' seeds: about 33 minutes; as root, in the grading sandbox.
 test-grade: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(PY) -m pytest tests/test_grading.py tests/test_exercises.py -m slow -q
 

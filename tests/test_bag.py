@@ -610,7 +610,9 @@ def test_record_refuses_an_existing_file(tmp_path, capsys):
 
 
 # ------------------------------------------------------------ stopping a recording
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+@pytest.mark.parametrize(  # make test: Ctrl-C, as a learner stops it
+    "sig", [signal.SIGINT, pytest.param(signal.SIGTERM, marks=pytest.mark.more)], ids=["ctrl-c", "sigterm"]
+)
 def test_a_stopped_recording_is_a_whole_file(procs, node, tmp_path, sig):
     """Stopped while messages still arrive, the file is closed whole: summary, indexes, every message counted."""
     from sensor_msgs.msg import JointState

@@ -317,7 +317,11 @@ def step3_launch(procs):
                 os.kill(pid, signal.SIGKILL)
 
 
-@pytest.mark.parametrize("fault", ["sigterm-to-the-launch", "sigkill-to-a-node"])
+@pytest.mark.parametrize(
+    "fault",
+    # make test: a node killed; make test-more: the launch stopped
+    ["sigkill-to-a-node", pytest.param("sigterm-to-the-launch", marks=pytest.mark.more)],
+)
 def test_launch_leaves_no_process_and_no_shared_memory(step3_launch, fault):
     """SIGTERM to a launch, or SIGKILL to one of its nodes (the launch then stops, failed):
     no process is left, and no Fast DDS file in /dev/shm that its nodes used and nobody uses now."""
@@ -487,7 +491,10 @@ def limit_file_size(limit: int):
     return apply
 
 
-@pytest.mark.parametrize("fault", ["disk-full", "file-size-limit"])
+@pytest.mark.parametrize(
+    "fault",
+    ["disk-full", pytest.param("file-size-limit", marks=pytest.mark.more)],  # make test: the disk full
+)
 def test_recorder_stops_with_one_line_when_the_disk_is_full_and_its_file_stays_readable(
     nodes, node, request, tmp_path, fault
 ):

@@ -51,13 +51,13 @@ import json, os, subprocess, sys, time
 import rclpy
 venv = os.path.dirname(sys.executable)
 sim = subprocess.Popen([os.path.join(venv, "rtt-run"), "{root}/project/step2.yaml", "--headless", "--json",
-                        "--duration", "7"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "5"],
+                        "--duration", "5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "4"],
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if {with_joy} else None
 rclpy.init()
 node = rclpy.create_node("graph_look")
 seen = set()
-deadline = time.monotonic() + 5
+deadline = time.monotonic() + 4
 while time.monotonic() < deadline:
     rclpy.spin_once(node, timeout_sec=0.2)
     seen.update(n for n, _ in node.get_node_names_and_namespaces())

@@ -35,7 +35,11 @@ def processes_with_marker(marker: str) -> list[int]:
 
 @pytest.mark.parametrize(
     "sig, group",
-    [(signal.SIGINT, False), (signal.SIGINT, True), (signal.SIGTERM, False)],
+    [  # make test: Ctrl-C in a terminal, as a learner stops a launch; make test-more: the other two
+        pytest.param(signal.SIGINT, False, marks=pytest.mark.more),
+        (signal.SIGINT, True),
+        pytest.param(signal.SIGTERM, False, marks=pytest.mark.more),
+    ],
     ids=["ctrl-c", "ctrl-c-in-a-terminal", "sigterm"],
 )
 def test_step3_launch_stops_every_node_within_5_s(procs, sig, group):
