@@ -10,7 +10,7 @@
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does 01; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
-#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 5 min),
+#       make test-more (the cases make test leaves out, each of a kind it keeps one of: about 7 min),
 #       make test-hub (the hub with learners as Unix users: slow),
 #       make test-robots (the Step 3 monitor on every robot of example-robot-data; the UR5, SO-100 and Go2 in Chromium),
 #       make image (the learner image, podman), make hub-containers (the class on containers), make test-containers,
@@ -113,7 +113,7 @@ mutate: $(VENV)/.installed
 
 # The cases make test leaves out to stay under 10 minutes, each of a kind make test keeps one real case of
 # (marked "more": two more faults, two more network set-ups, one more robot across processes, and the mistakes
-# only the exercises' hidden cases catch past the first of each exercise, and more): about 3.5 minutes.
+# only the exercises' hidden cases catch past the first of each exercise, and more): about 7 minutes.
 test-more: $(VENV)/.installed
 	bash scripts/ensure-nftables.sh
 	RTT_TEST_MODE=1 $(PY) -m pytest tests -m more -q

@@ -14,7 +14,6 @@ from benchmarks.procs import finish, py, start
 pytestmark = pytest.mark.cross_process
 
 
-@pytest.mark.more  # a smoke test of one experiment's processes, as test_bench_tools': make bench runs it in full
 def test_bare_pair_with_the_hand_off_notes_every_state_on_its_main_thread(tmp_path):
     """The A/B's ``bare_hand_off`` variant: the states arrive through the SpinThread and the hand-off."""
     probe = tmp_path / "bare.json"

@@ -6,8 +6,9 @@ kernel starts (the Step 2 simulation, a joystick) lives in that domain: A's
 joystick drives A's tank and not B's, and neither sees the other's nodes.
 Both run as this machine's one Unix user (the trial's spawner), where Fast
 DDS's shared memory would carry data between them if their domains met.
-Then each logs in through the hub's form in a Chromium context of their
-own and runs a notebook with Step 2's live view: both views draw.
+Then a learner logs in through the hub's form in a Chromium context of
+their own and runs a notebook with Step 2's live view, which draws (both
+learners, each in a context of their own, in make test-more).
 """
 
 from __future__ import annotations
@@ -46,12 +47,13 @@ DOMAINS = (_FIRST, _FIRST + 1)
 
 # What a learner's kernel runs: the Step 2 simulation (and with a joystick, its demo) for a few seconds,
 # then the summary of where the tank ended and which nodes this learner's graph held meanwhile.
+DRIVE_S = 5  # s of simulated time a learner's drive lasts (the joystick 4 s of it), and the undriven run
 DRIVE = """
 import json, os, subprocess, sys, time
 import rclpy
 venv = os.path.dirname(sys.executable)
 sim = subprocess.Popen([os.path.join(venv, "rtt-run"), "{root}/project/step2.yaml", "--headless", "--json",
-                        "--duration", "5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                        "--duration", "{drive_s}"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 joy = subprocess.Popen([os.path.join(venv, "rtt-joy"), "--demo", "--duration", "4"],
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) if {with_joy} else None
 rclpy.init()
@@ -91,7 +93,7 @@ del held
 
 
 def run_drive(learner: Learner, with_joy: bool) -> dict:
-    out = learner.run(DRIVE.format(root=ROOT, with_joy=with_joy), timeout=180)
+    out = learner.run(DRIVE.format(root=ROOT, with_joy=with_joy, drive_s=DRIVE_S), timeout=180)
     return json.loads(out.strip().splitlines()[-1])
 
 
@@ -206,7 +208,7 @@ def test_each_learners_robots_are_their_own(hub, in_browsers):
         # A learner in a browser (each in one of their own, two-browsers): logged in through the hub's form, a
         # notebook that starts Step 2 with its live view; each view gets its scene over its own notebook's
         # connection and draws.
-        both_live_views_draw(hub, list(in_browsers), rtt_run_page=("learner-a", page.group(1)))
+        live_views_draw(hub, list(in_browsers), rtt_run_page=("learner-a", page.group(1)))
     finally:
         a.terminal(f"kill {pid.group(1)}; echo en''d.", "end.\r")
 
@@ -232,9 +234,10 @@ def both_submit_under_their_own_names(hub: Hub, learners: list[Learner]) -> None
     assert handed_in == sorted(learner.name for learner in learners), handed_in
 
 
-def both_live_views_draw(hub: Hub, names: list[str], rtt_run_page: tuple[str, str]) -> None:
-    """In one Chromium, a context (cookies) per learner: log in, run a live view, see it draw; and the page
-    of a learner's ``rtt-run`` (``(learner, path on the hub)``) draws for that learner, and for no other."""
+def live_views_draw(hub: Hub, names: list[str], rtt_run_page: tuple[str, str]) -> None:
+    """In one Chromium, a context (cookies) per learner of ``names``: log in, run a live view, see it draw; and
+    the page of a learner's ``rtt-run`` (``(learner, path on the hub)``) draws for that learner, and for no
+    other of ``names`` (with one name: the caller holds the others off by the hub's API)."""
     from playwright.sync_api import expect, sync_playwright
 
     from tests.jupyterlab import CHROMIUM, CHROMIUM_FLAGS
@@ -278,12 +281,12 @@ def hub_state(hub: Hub):
 
 
 def undriven_root() -> list[float]:
-    """Where the Step 2 tank's root ends after 7 s with no joystick (run here, in the test's own domain)."""
+    """Where the Step 2 tank's root ends after DRIVE_S s with no joystick (run here, in the test's own domain)."""
     import subprocess
 
     rtt_run = os.path.join(os.path.dirname(sys.executable), "rtt-run")
     out = subprocess.run(
-        [rtt_run, str(ROOT / "project" / "step2.yaml"), "--headless", "--json", "--fast", "--duration", "7"],
+        [rtt_run, str(ROOT / "project" / "step2.yaml"), "--headless", "--json", "--fast", "--duration", str(DRIVE_S)],
         capture_output=True,
         text=True,
         timeout=120,

@@ -15,7 +15,8 @@ What a learner does and sees, checked on the page itself:
   tank; turning the turret with the panel turns it in the viewer's view,
   another node's.  Kernel > Restart: the views say they are not live any
   more (a notice over their last frames, and the caption).
-* the notebooks of ``IN_MAKE_TEST`` (``test_run_all``): the two above;
+* the notebooks of ``IN_MAKE_TEST`` (``test_run_all``): the two above
+  (03's in ``make test-more``, marked by ``MORE``);
   every notebook ``notebooks/[0-9][0-9]_*.ipynb`` with
   ``RTT_LAB_ALL=1`` (``make test-lab``).  Run All
   runs every cell once, in order, with no error output and no stderr

@@ -287,10 +287,6 @@ def check_camera_settings(func) -> Result:
                 state["swings"] = [views[k : k + PICTURES] for k in range(0, len(views), PICTURES)]
             return state["swings"][n]
 
-        hint = (
-            "leave a margin: where the turret points elsewhere, pictures take more bytes; lower the quality or the rate"
-        )
-        hint += "."
         for n in range(len(drawn)):
             yield Case(
                 "camera_settings(): within the budget along another turret swing",
@@ -308,10 +304,9 @@ def check_camera_settings(func) -> Result:
         """The swing of SCAN_WIDTH pictures, gun level or lowered, whose pictures take the most bytes at the
         answer's quality, of a scan all round (SCAN pictures a pitch)."""
         _, quality = settings()
-        if "scan" not in state:
-            state["scan"] = [
-                camera_views([(2 * math.pi * k / SCAN, pitch) for k in range(SCAN)]) for pitch in (0.0, -0.17)
-            ]
+        if "scan" not in state:  # one renderer for both pitches: the gun level, then lowered
+            views = camera_views([(2 * math.pi * k / SCAN, pitch) for pitch in (0.0, -0.17) for k in range(SCAN)])
+            state["scan"] = [views[:SCAN], views[SCAN:]]
         from sensor_msgs.msg import CompressedImage
 
         from tutorial.interfaces.compressed_image import fill_compressed_image

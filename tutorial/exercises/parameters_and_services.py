@@ -205,7 +205,7 @@ class TrackSwitch:
     Both threads use it under ``lock`` (a ``threading.Lock``).
     """
 
-    def __init__(self, enabled: bool):
+    def __init__(self, enabled: bool = True):  # on, as the tracks start
         self.lock = threading.Lock()
         self.enabled = enabled
 

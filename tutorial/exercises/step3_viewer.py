@@ -263,7 +263,8 @@ def check_wrong_model(cls) -> Result:
 
     def hidden_cases(rng):
         """Random runs of messages, the tank's, the crane's and mixed ones, judged by the lesson's subscriber
-        (what it applies and counts) plus the statement's rule (another model's message is refused whole)."""
+        (what it applies and counts) plus the statement's rule (another model's message is refused whole).  The
+        first run also has the two messages of :func:`_sure_messages`, each at a drawn place."""
         from tutorial.controllers.joint_state_subscriber import RttJointStateSubscriber
 
         for k in range(8):
