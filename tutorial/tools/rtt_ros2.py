@@ -254,9 +254,7 @@ def _hidden(name: str) -> bool:
 
 
 def _discover(node, seconds: float) -> None:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        _pause(min(0.05, max(0.0, end - time.monotonic())))  # the graph is filled in by rmw's own thread
+    _pause(seconds)  # the graph is filled in by rmw's own thread: nothing to spin meanwhile
 
 
 def _split(full_name: str) -> tuple[str, str]:
