@@ -28,7 +28,6 @@ import numpy as np
 
 from benchmarks.experiments.speed import (
     SPEED_PAIRS,
-    TARGET_LEAVES_OUT,
     bare_steps_per_s,
     run_steps,
     simulation_speed,
@@ -87,7 +86,7 @@ def main(argv=None) -> int:
         for pairs in (60, SPEED_PAIRS):
             figures = []
             for _ in range(args.repeats):
-                s = simulation_speed(PROJECT, {"publisher_50Hz": 50.0}, pairs, 1000, leave_out=TARGET_LEAVES_OUT)
+                s = simulation_speed(PROJECT, {"publisher_50Hz": 50.0}, pairs, 1000)
                 lo, hi = s["publisher_50Hz_ratio_ci95"]
                 figures.append(s["publisher_50Hz_ratio"])
                 print(f"  {pairs} pairs: {s['publisher_50Hz_ratio']:.3f}x (95% CI {lo:.3f}-{hi:.3f})", flush=True)

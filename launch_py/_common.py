@@ -16,8 +16,13 @@ def joy_node(args, script: str = "drive") -> NodeProcess:
 
 
 def simulation_node(args, project: str) -> NodeProcess:
-    """The simulation (``rtt``), required: when it ends, the launch ends."""
+    """The simulation (``rtt``), required: when it ends, the launch ends.
+
+    With ``--tf`` it also publishes the robot's URDF and odometry (``rtt-run --describe``), which the
+    recorder computes TF from.
+    """
     extra = (["--headless"] if args.headless else []) + (["--duration", str(args.duration)] if args.duration else [])
+    extra += ["--describe"] if getattr(args, "tf", False) else []
     return NodeProcess("rtt", "tutorial.tools.rtt_run", [str(PROJECT / project), *extra], required=True)
 
 

@@ -64,7 +64,9 @@ class FoxgloveClient:
 
 @pytest.mark.cross_process
 def test_rtt_foxglove_serves_the_live_tank(procs):
-    sim = procs(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--duration", "60"))
+    sim = procs(
+        module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--duration", "60", "--describe")
+    )
     bridge = procs(module_command("tutorial.tools.rtt_foxglove", "--port", "0", "--duration", "60"))
     line = bridge.wait_for_line(lambda s: "serving ws://127.0.0.1:" in s, timeout=30)
     url = re.search(r"ws://127\.0\.0\.1:\d+", line).group(0)

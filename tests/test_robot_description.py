@@ -72,6 +72,44 @@ def test_the_description_project_loads():
 
 @pytest.mark.unit
 @pytest.mark.parametrize(
+    "model, topic",
+    [
+        ("    description: /Tank/robot_description", "/Tank/robot_description"),
+        (f"    file: {PROJECT.parent / 'model' / 'tank.xml'}\n    odometry: /Tank/odom", "/Tank/odom"),
+    ],
+)
+def test_the_lessons_app_refuses_a_model_only_rtt_run_draws(tmp_path, model, topic):
+    """The notebooks' App leaves robot descriptions and odometry to the tooling (DescribedApp, rtt-run): it says
+    so, naming the model and the topic, before it builds anything; DescribedApp takes the same project."""
+    from tutorial.app.app import App
+    from tutorial.app.descriptions import DescribedApp
+
+    (tmp_path / "v.yaml").write_text(VIEW.format(model=model, simulator=""))
+    project = load_project(tmp_path / "v.yaml")
+    with pytest.raises(ValueError, match=f"^model Tank takes {topic} from ROS: rtt-run draws it"):
+        App(project).prepare_project(project)
+    assert App(project).prepare_project(load_project(PROJECT / "step3.yaml")).models[0].file is not None
+    assert DescribedApp(project).description_timeout == 10.0
+
+
+@pytest.mark.unit
+def test_rtt_run_describe_adds_the_robot_model_publisher_to_each_robot_once():
+    """``rtt-run --describe``: notebook 09's frozen publisher on the tank (a model with controllers), not on the
+    room (scenery); a project that has one already (notebook 10's) keeps just that one."""
+    from tutorial.app.reference.robot_model_publisher import RttRobotModelPublisher
+    from tutorial.tools.rtt_run import build_parser, describe_robots
+
+    assert build_parser().parse_args(["p.yaml", "--describe"]).describe
+    for name, before in (("step2.yaml", 0), ("step10.yaml", 1)):
+        project = describe_robots(load_project(PROJECT / name))
+        room, tank = project.models
+        publishers = [c for c in tank.controllers if c.cls is RttRobotModelPublisher]
+        assert room.controllers == [] and len(publishers) == 1, name
+        assert [c.name for c in load_project(PROJECT / name).models[1].controllers].count(publishers[0].name) == before
+
+
+@pytest.mark.unit
+@pytest.mark.parametrize(
     "text, says",
     [
         ("", "empty"),
@@ -90,9 +128,9 @@ def test_a_received_description_is_checked(text, says):
 
 def description_error(node_name: str, timeout: float) -> DescriptionError:
     """The error a viewer of ``step3_description.yaml`` fails with when no description reaches it in ``timeout`` s."""
-    from tutorial.app.app import App
+    from tutorial.app.descriptions import DescribedApp
 
-    app = App(
+    app = DescribedApp(
         load_project(PROJECT / "step3_description.yaml"),
         node_name=node_name,
         headless=True,
@@ -135,7 +173,7 @@ def test_the_step3_monitor_draws_the_published_description(procs):
     """rtt-run step3_description.yaml beside a Step 2 simulation: the monitor takes its model from
     /Tank/robot_description, says so, mirrors the simulation's final joint state by name, and stands where
     /Tank/odom puts it."""
-    sim = procs(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json"))
+    sim = procs(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json", "--describe"))
     view = procs(
         module_command(
             "tutorial.tools.rtt_run",

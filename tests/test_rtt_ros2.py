@@ -1,7 +1,7 @@
 """``rtt-ros2``: the ``ros2`` commands of ROS 2's beginner tutorials, against a running Step 2 simulation.
 
 Each command runs as a learner types it, a process of its own; the
-simulation is ``rtt-run project/step2.yaml`` (50 Hz joint states, its
+simulation is ``rtt-run project/step2.yaml --describe`` (50 Hz joint states, its odometry, its
 controllers' parameters on the node ``/rtt``).
 """
 
@@ -23,7 +23,7 @@ def step2():
 
     from conftest import Proc
 
-    sim = Proc(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json"))
+    sim = Proc(module_command("tutorial.tools.rtt_run", "project/step2.yaml", "--headless", "--json", "--describe"))
     try:  # stopped also when it never came up: a simulation left running costs every later test
         deadline = time.monotonic() + 60
         while "Publisher count: 1" not in ros2("topic", "info", "/Tank/joint_state").stdout:

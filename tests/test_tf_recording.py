@@ -54,6 +54,7 @@ def test_tf_in_a_recording_is_the_simulation(ros, tmp_path):
     from rosbags.highlevel import AnyReader
 
     from tutorial.app.app import App
+    from tutorial.app.reference.robot_model_publisher import RttRobotModelPublisher
     from tutorial.bag.record import BagRecorder
     from tutorial.core.project import load_project
     from tutorial.joystick.scripted import ScriptedJoy
@@ -62,7 +63,7 @@ def test_tf_in_a_recording_is_the_simulation(ros, tmp_path):
     recorder = BagRecorder(path, [], tf=True, output=None, node_name="tf_test_bag").start()
     probe = Probe()
     app = App(
-        load_project(PROJECT / "step2.yaml"),
+        load_project(PROJECT / "step2.yaml").with_controller("Tank", "RttRobotModelPublisher", RttRobotModelPublisher),
         node_name="tf_test_sim",
         headless=True,
         realtime_sync=True,

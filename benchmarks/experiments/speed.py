@@ -19,13 +19,7 @@ MIN_RUN_S = 0.05  # s: the shortest bare run of a simulation-speed pair
 # next, as much as the target's margin; with 240 pairs (about 30 s per rate) three
 # figures in a row spread by 0.02 (python -m benchmarks.speed_noise).
 SPEED_PAIRS = 240
-SPEED_PAIRS_OTHER = 60  # the 24-joint arm's and the shipped Step 2 project's figures: reported, not targeted
-# The targeted figure times what its target names (issue #5): the tank with Step 1's
-# controller and Step 2's publisher, as the scale projects have them.  project/step2.yaml
-# later gained the odometry and robot-description publisher (for notebook 09's stock
-# tools); the project as shipped is timed beside it, so that publisher's cost is shown
-# and not folded into a target written before it existed.
-TARGET_LEAVES_OUT = ("RttRobotModelPublisher",)
+SPEED_PAIRS_OTHER = 60  # the 24-joint arm's figure: reported, not targeted
 
 
 def bare_steps_per_s(model, steps: int) -> float:
@@ -45,12 +39,9 @@ def run_steps(model, steps: int) -> int:
     return max(steps, int(np.ceil(MIN_RUN_S * fastest)))
 
 
-def simulation_speed(
-    project: str | Path, rates: dict[str, float], pairs: int, steps: int, leave_out: tuple[str, ...] = ()
-) -> dict:
-    """Steps/s of the project's simulation with its controllers (as fast as possible) vs bare mj_step.
-
-    ``leave_out``: names of the project's controllers not attached (``StepClock`` never is).
+def simulation_speed(project: str | Path, rates: dict[str, float], pairs: int, steps: int) -> dict:
+    """Steps/s of the project's simulation with its controllers (``StepClock`` never) as fast as possible vs
+    bare mj_step.
 
     This machine's CPU speed drifts by tens of percent within seconds, so
     single runs cannot be compared.  The two are measured in short
@@ -88,7 +79,7 @@ def simulation_speed(
             attachments = []
             for m in proj.models:
                 for c in m.controllers:
-                    if c.name == "StepClock" or c.name in leave_out:
+                    if c.name == "StepClock":
                         continue
                     params = dict(c.parameters)
                     if "rate" in params:

@@ -9,7 +9,8 @@ module              what
 ``app``             :class:`App`: the lifecycle of a running project (Choreonoid's
                     opening of a ``.cnoid`` project), its threads and its stop
 ``frame_clock``     :class:`FramePacer`: when the view draws a frame
-``descriptions``    a model taken from a robot description topic
+``descriptions``    :class:`DescribedApp` (what ``rtt-run`` runs): a model taken from a robot
+                    description topic (the lessons' :class:`App` refuses one)
 ``floating_base``   a viewer's floating base: the root link placed where odometry says
 ``summary``         the exit summary a run prints or returns
 ``reference``       the earlier steps' worked solutions, frozen, that later steps stand on

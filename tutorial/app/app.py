@@ -24,7 +24,6 @@ from collections.abc import Callable
 
 import mujoco
 
-from tutorial.app.descriptions import DESCRIPTION_TIMEOUT, receive_descriptions
 from tutorial.app.frame_clock import FRAME_RATE, FramePacer
 from tutorial.app.summary import app_summary
 from tutorial.core.body import Body
@@ -63,8 +62,10 @@ class App:
             to attach in code, before the project's own (as adding a
             controller item in Choreonoid's GUI).
         record_timing: keep each step's lateness in ``sim.lateness`` (benchmarks).
-        description_timeout: how long :meth:`open` waits for the robot
-            description of a model that names a topic instead of a file, s.
+
+    A model that names a robot description topic instead of a file, or an
+    odometry topic, is the tooling's: :class:`tutorial.app.descriptions.DescribedApp`
+    (what ``rtt-run`` runs) receives it; this class refuses it in :meth:`open`.
 
     Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
     becomes the owner of everything the main thread owns.
@@ -82,7 +83,6 @@ class App:
         vis=None,
         attach=(),
         record_timing: bool = False,
-        description_timeout: float = DESCRIPTION_TIMEOUT,
     ):
         self.project = project
         self.node = node
@@ -94,7 +94,6 @@ class App:
         self.vis = vis
         self.attach = list(attach)
         self.record_timing = record_timing
-        self.description_timeout = description_timeout
         self.loop = HandOverLoop()  # call_later's loop, and its spin thread steps aside for it
         self.log = logging.getLogger("rtt")
         self.server = None
@@ -119,8 +118,8 @@ class App:
         """Build the world, configure the controllers, start simulation and view.
 
         Raises:
-            ValueError: a model does not load, or a robot description it
-                takes its model from did not come (or is not a URDF).
+            ValueError: a model does not load, or names a robot description
+                or odometry topic (:meth:`prepare_project`).
             ControllerError: a controller refused to configure or to start.
         """
         settings = self.project.simulator
@@ -129,9 +128,7 @@ class App:
             from rclpy.node import Node
 
             self.node = Node(self.node_name)
-        self.project = receive_descriptions(
-            self.project, self.node, self.description_timeout, self.output, stopped=lambda: self.stop_requested
-        )
+        self.project = self.prepare_project(self.project)
         self.model = build_world(self.project.models, **kwargs)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_forward(self.model, self.data)
@@ -148,10 +145,6 @@ class App:
         for entry in self.project.models:
             for c in entry.controllers:
                 self._configure_instance(entry.name, c.name, c.cls(), self._ros_parameters(c))
-            if entry.odometry is not None:  # its root link placed where the robot's odometry says
-                from tutorial.app.floating_base import FloatingBase
-
-                self._configure_instance(entry.name, f"{entry.name}/floating_base", FloatingBase(entry.odometry), {})
         self.node_fqn = self.node.get_fully_qualified_name()
         # registered before the spin thread starts, which runs it (a parameter service's callback)
         self.node.add_on_set_parameters_callback(self._refuse_controller_parameters)
@@ -188,6 +181,23 @@ class App:
             if n == name:
                 return c
         raise KeyError(f"no controller named {name!r}")
+
+    def prepare_project(self, project: Project) -> Project:
+        """The project the world is built from: ``project`` itself (owner thread, in :meth:`open`).
+
+        A subclass may fill models in, and add to ``self.attach``, here: the
+        node exists, its spin thread has not started
+        (:class:`tutorial.app.descriptions.DescribedApp` takes models from robot descriptions).
+
+        Raises:
+            ValueError: a model takes a robot description or odometry from a topic.
+        """
+        for m in project.models:
+            unreceived = m.description is not None and m.text is None
+            if unreceived or m.odometry is not None:
+                topic = m.description if unreceived else m.odometry
+                raise ValueError(f"model {m.name} takes {topic} from ROS: rtt-run draws it (or DescribedApp)")
+        return project
 
     def _configure_instance(self, body_name: str, name: str, controller, params: dict) -> None:
         config = ControllerConfig(

@@ -1,7 +1,7 @@
 """``rtt-foxglove``: the running simulation, live in Foxglove (``foxglove_bridge``'s stand-in).
 
-    rtt-run project/step2.yaml &     # the simulation
-    rtt-foxglove                     # then, in Foxglove: Open connection, ws://127.0.0.1:8765
+    rtt-run project/step2.yaml --describe &   # the simulation, with its URDF and odometry
+    rtt-foxglove                              # then, in Foxglove: Open connection, ws://127.0.0.1:8765
 
 Serves every ROS 2 topic as it is (CDR with its ``ros2msg`` schema) and the
 robot in 3D: ``/robot_description`` and ``/tf``, ``/tf_static`` computed from

@@ -3,6 +3,7 @@
     rtt-run project/step1.yaml                 # simulate in real time, show in meshcat
     rtt-run project/step1.yaml --headless --duration 5 --json
     rtt-run project/step3.yaml --ros-args -r __node:=rtt_viewer
+    rtt-run project/step2.yaml --describe      # and the URDF and odometry, for Foxglove and RViz2
 
 A project with a simulator simulates (real time unless ``--fast``); one
 without only configures its controllers (Step 3's viewer).  The node is named
@@ -24,6 +25,7 @@ import signal
 import sys
 
 from tutorial.app.app import DEFAULT_NODE_NAME, App, ControllerError
+from tutorial.app.descriptions import DescribedApp
 from tutorial.core.project import ProjectError, load_project
 from tutorial.core.world import ModelError
 from tutorial.ros import env as ros_env
@@ -127,7 +129,26 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--headless", action="store_true", help="no meshcat viewer")
     p.add_argument("--json", action="store_true", help="status lines and summary as JSON, one object per line")
+    p.add_argument(
+        "--describe",
+        action="store_true",
+        help="also publish each robot's URDF (/<body>/robot_description) and odometry (/<body>/odom) for the "
+        "stock ROS 2 tools (notebook 09's RttRobotModelPublisher)",
+    )
     return p
+
+
+def describe_robots(project):
+    """``project`` with notebook 09's :class:`RttRobotModelPublisher` on each model that has controllers (a
+    robot, not scenery) and none of its own: what ``--describe`` runs (any thread).
+    """
+    from tutorial.app.reference.robot_model_publisher import RttRobotModelPublisher
+
+    for entry in project.models:
+        has_one = any(c.cls is RttRobotModelPublisher for c in entry.controllers)
+        if entry.controllers and not has_one:
+            project = project.with_controller(entry.name, "RttRobotModelPublisher", RttRobotModelPublisher)
+    return project
 
 
 def _stop_on_signal(app: App) -> None:
@@ -169,6 +190,8 @@ def main(argv: list[str] | None = None) -> int:
     output = make_output(args.json)
     try:
         project = load_project(args.project)
+        if args.describe:
+            project = describe_robots(project)
     except ProjectError as exc:
         return _fail(str(exc), 2)
     import rclpy
@@ -177,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
 
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    app = App(
+    app = DescribedApp(
         project,
         node_name=DEFAULT_NODE_NAME,
         headless=args.headless,
