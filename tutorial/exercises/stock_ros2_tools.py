@@ -36,6 +36,9 @@ def _pose(position, rotation_z: float = 0.0) -> np.ndarray:
 
 
 def _show(m) -> str:
+    """What a learner's answer was, in a line: a pose, an array of another shape, or its repr (None: no return)."""
+    if m is None or isinstance(m, str):
+        return repr(m)
     try:
         a = np.asarray(m, dtype=float)
     except (TypeError, ValueError):
