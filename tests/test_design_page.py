@@ -97,3 +97,34 @@ def test_the_layout_page_states_the_lessons_librarys_size_as_measured():
     rest = sum(len(p.read_text(encoding="utf-8").splitlines()) for p in (ROOT / "tutorial").rglob("*.py")) - m["lines"]
     said = int(re.search(r"The rest of\s+`tutorial/`, about ([\d,]+) lines", text).group(1).replace(",", ""))
     assert near(rest, said), f"the rest of tutorial/ is {rest} lines; the page says about {said}"
+
+
+# The tooling the lessons' library (notebooks 01 to 06, their checks and project files) never reaches: the URDF
+# tools, recording, Foxglove, the test hosts, the programs, and the App that receives robot descriptions.
+TOOLING = (
+    "tutorial.urdf",
+    "tutorial.bag",
+    "tutorial.foxglove",
+    "tutorial.network",
+    "tutorial.tools",
+    "tutorial.app.descriptions",
+    "tutorial.app.floating_base",
+    "tutorial.interfaces.robot_description",
+    "tutorial.interfaces.odometry",
+)
+
+
+def test_the_lessons_library_reaches_none_of_the_tooling():
+    """Followed as library_size follows it (imports at any depth, the project files' classes): a module of the
+    lessons that imports the URDF tools again, or a step's project that runs notebook 09's publisher, fails."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        import library_size
+    finally:
+        sys.path.remove(str(ROOT / "scripts"))
+    reached = [m for m in library_size.library() if m.startswith(TOOLING)]
+    assert reached == [], f"the lessons' library reaches the tooling: {reached}"
+    later = library_size.library(("01", "02", "03", "04", "05", "06", "09"))
+    assert "tutorial.urdf.export" in later, "the test can fail: notebook 09's lesson reaches the URDF tools"
