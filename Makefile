@@ -6,7 +6,7 @@
 #       make notebooks (JupyterLab on notebooks/), make hub (a class's JupyterHub on 127.0.0.1:8000, course/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
-#       make mutate (mutation testing of the lessons, the library's core and the checks of assignments 01 to 04: hours),
+#       make mutate (mutation testing of the lessons, the library's core and the checks of assignments 01 to 04 and 07 to 09: hours),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does 01; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
