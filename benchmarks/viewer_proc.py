@@ -27,7 +27,7 @@ import msgpack
 import rclpy
 from rclpy.signals import SignalHandlerOptions
 
-from tutorial.app.app import App
+from tutorial.app.standalone import StandaloneApp
 from tutorial.core.project import load_project
 from tutorial.ros import env as ros_env
 from tutorial.view.meshcat_batch import SET_TRANSFORMS
@@ -53,7 +53,7 @@ def main() -> int:
         tape = CommandTape()
         vis.window.zmq_socket = tape.tap(vis.window.zmq_socket)
         print(json.dumps({"event": "meshcat_url", "url": server.web_url}), flush=True)
-    app = App(
+    app = StandaloneApp(
         load_project(args.project),
         node_name=args.name,
         headless=args.headless,

@@ -115,7 +115,7 @@ def test_the_monitor_mirrors_every_robot_of_example_robot_data(ros, node, monkey
     from sensor_msgs.msg import JointState
     from std_msgs.msg import String
 
-    from tutorial.app.descriptions import DescribedApp
+    from tutorial.app.standalone import StandaloneApp
     from tutorial.interfaces.joint_state import joint_state_qos
     from tutorial.interfaces.robot_description import robot_description_qos
     from tutorial.urdf.mesh_files import MeshError, resolve_mesh
@@ -149,7 +149,7 @@ def test_the_monitor_mirrors_every_robot_of_example_robot_data(ros, node, monkey
             return False
 
     records = []
-    app = DescribedApp(project(name, tmp_path), node_name=f"monitor_{name}"[:60], headless=True, output=records.append)
+    app = StandaloneApp(project(name, tmp_path), node_name=f"monitor_{name}"[:60], headless=True, output=records.append)
     try:
         app.open()
         said = [r for r in records if r.get("event") == "description"]
@@ -404,7 +404,7 @@ def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, na
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from std_msgs.msg import String
 
-    from tutorial.app.descriptions import DescribedApp
+    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
 
     from browser import chromium, screenshot
@@ -421,7 +421,7 @@ def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, na
         node.create_publisher(String, topic, latched).publish(String(data=text))
         records = []
         (tmp_path / "p.yaml").write_text(f"name: p\nmodels:\n  - name: {name}\n    description: {topic}\n")
-        app = DescribedApp(load_project(tmp_path / "p.yaml"), node_name=f"page_{len(pictures)}", output=records.append)
+        app = StandaloneApp(load_project(tmp_path / "p.yaml"), node_name=f"page_{len(pictures)}", output=records.append)
         try:
             app.open()
             camera += [] if camera else [app.camera]  # the robot framed, then the same view without its meshes
@@ -456,7 +456,7 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
     from sensor_msgs.msg import JointState
     from std_msgs.msg import String
 
-    from tutorial.app.descriptions import DescribedApp
+    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
     from tutorial.interfaces.joint_state import joint_state_qos
 
@@ -485,7 +485,7 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
 
     odometry.publish(pose(-2.0, 1.0, 0.25, (1.0, 0.0, 0.0, 0.0)))  # kept (transient local) for a viewer to come
     records = []
-    app = DescribedApp(
+    app = StandaloneApp(
         load_project(tmp_path / "go2.yaml"), node_name="monitor_go2", headless=True, output=records.append
     )
     try:

@@ -100,7 +100,8 @@ def test_the_layout_page_states_the_lessons_librarys_size_as_measured():
 
 
 # The tooling the lessons' library (notebooks 01 to 06, their checks and project files) never reaches: the URDF
-# tools, recording, Foxglove, the test hosts, the programs, and the App that receives robot descriptions.
+# tools, recording, Foxglove, the test hosts, the programs, and the App rtt-run runs (its own meshcat server,
+# robot descriptions).
 TOOLING = (
     "tutorial.urdf",
     "tutorial.bag",
@@ -109,6 +110,8 @@ TOOLING = (
     "tutorial.tools",
     "tutorial.app.descriptions",
     "tutorial.app.floating_base",
+    "tutorial.app.standalone",
+    "tutorial.view.meshcat_server",
     "tutorial.interfaces.robot_description",
     "tutorial.interfaces.odometry",
 )

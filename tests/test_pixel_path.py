@@ -119,11 +119,12 @@ def path_of(viewer_class, node, server: bool = False) -> PathProfiler:
     from sensor_msgs.msg import JointState
 
     from tutorial.app.app import App
+    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
 
     project = load_project(ROOT / "project" / "tank_view.yaml").with_controller("Tank", "Viewer", viewer_class)
     vis = None if server else meshcat.Visualizer(window=KeepingWindow())
-    app = App(project, node=node, output=lambda record: None, vis=vis)
+    app = (StandaloneApp if server else App)(project, node=node, output=lambda record: None, vis=vis)
     errors, sent = [], threading.Event()
     msg = JointState(name=["TURRET_Y"], position=[0.4])
     profiler = PathProfiler(msg)

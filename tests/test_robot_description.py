@@ -79,17 +79,17 @@ def test_the_description_project_loads():
     ],
 )
 def test_the_lessons_app_refuses_a_model_only_rtt_run_draws(tmp_path, model, topic):
-    """The notebooks' App leaves robot descriptions and odometry to the tooling (DescribedApp, rtt-run): it says
-    so, naming the model and the topic, before it builds anything; DescribedApp takes the same project."""
+    """The notebooks' App leaves robot descriptions and odometry to the tooling (StandaloneApp, rtt-run): it says
+    so, naming the model and the topic, before it builds anything; StandaloneApp takes the same project."""
     from tutorial.app.app import App
-    from tutorial.app.descriptions import DescribedApp
+    from tutorial.app.standalone import StandaloneApp
 
     (tmp_path / "v.yaml").write_text(VIEW.format(model=model, simulator=""))
     project = load_project(tmp_path / "v.yaml")
     with pytest.raises(ValueError, match=f"^model Tank takes {topic} from ROS: rtt-run draws it"):
         App(project).prepare_project(project)
     assert App(project).prepare_project(load_project(PROJECT / "step3.yaml")).models[0].file is not None
-    assert DescribedApp(project).description_timeout == 10.0
+    assert StandaloneApp(project).description_timeout == 10.0
 
 
 @pytest.mark.unit
@@ -128,9 +128,9 @@ def test_a_received_description_is_checked(text, says):
 
 def description_error(node_name: str, timeout: float) -> DescriptionError:
     """The error a viewer of ``step3_description.yaml`` fails with when no description reaches it in ``timeout`` s."""
-    from tutorial.app.descriptions import DescribedApp
+    from tutorial.app.standalone import StandaloneApp
 
-    app = DescribedApp(
+    app = StandaloneApp(
         load_project(PROJECT / "step3_description.yaml"),
         node_name=node_name,
         headless=True,

@@ -46,7 +46,7 @@ def first_frame_s(project: Path) -> tuple[float, float]:
     ``receive_robot_description`` hands the URDF it received to the monitor.
     """
     import tutorial.interfaces.robot_description as descriptions
-    from tutorial.app.descriptions import DescribedApp
+    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
 
     arrived = []
@@ -62,7 +62,7 @@ def first_frame_s(project: Path) -> tuple[float, float]:
     records = []
     descriptions.receive_robot_description = timed  # the App imports it when it opens: it finds this one
     t0 = time.perf_counter()
-    app = DescribedApp(load_project(project), node_name="any_robot_monitor", output=records.append)
+    app = StandaloneApp(load_project(project), node_name="any_robot_monitor", output=records.append)
     try:
         app.open()
         app._draw()  # the first frame: the scene as built, drawn once

@@ -63,9 +63,11 @@ class App:
             controller item in Choreonoid's GUI).
         record_timing: keep each step's lateness in ``sim.lateness`` (benchmarks).
 
-    A model that names a robot description topic instead of a file, or an
-    odometry topic, is the tooling's: :class:`tutorial.app.descriptions.DescribedApp`
-    (what ``rtt-run`` runs) receives it; this class refuses it in :meth:`open`.
+    Two things are a program's, not the lessons': a model that names a robot
+    description topic instead of a file, or an odometry topic, and a meshcat
+    server of its own for the view.  :class:`tutorial.app.standalone.StandaloneApp`
+    (what ``rtt-run`` runs) does both; this class refuses such a model, and
+    draws only in a view it is given (``vis``) unless ``headless``.
 
     Create, :meth:`open`, :meth:`run` and :meth:`close` on the same thread: it
     becomes the owner of everything the main thread owns.
@@ -96,7 +98,7 @@ class App:
         self.record_timing = record_timing
         self.loop = HandOverLoop()  # call_later's loop, and its spin thread steps aside for it
         self.log = logging.getLogger("rtt")
-        self.server = None
+        self.server = None  # a meshcat server a subclass started for its view (StandaloneApp): closed with the App
         self.scene = None
         self.camera = None  # (position, target) of the view's camera, m, once the view is open
         self.overlays = Overlays()  # what controllers draw over the view (main thread)
@@ -187,7 +189,7 @@ class App:
 
         A subclass may fill models in, and add to ``self.attach``, here: the
         node exists, its spin thread has not started
-        (:class:`tutorial.app.descriptions.DescribedApp` takes models from robot descriptions).
+        (:class:`tutorial.app.standalone.StandaloneApp` takes models from robot descriptions).
 
         Raises:
             ValueError: a model takes a robot description or odometry from a topic.
@@ -196,8 +198,22 @@ class App:
             unreceived = m.description is not None and m.text is None
             if unreceived or m.odometry is not None:
                 topic = m.description if unreceived else m.odometry
-                raise ValueError(f"model {m.name} takes {topic} from ROS: rtt-run draws it (or DescribedApp)")
+                raise ValueError(f"model {m.name} takes {topic} from ROS: rtt-run draws it (or StandaloneApp)")
         return project
+
+    def open_visualizer(self):
+        """The ``meshcat.Visualizer`` to draw in when none was given (owner thread, in :meth:`open`).
+
+        :class:`tutorial.app.standalone.StandaloneApp` starts a meshcat server of its own here.
+
+        Raises:
+            ValueError: always, here: give ``vis``, or open it ``headless``.
+        """
+        raise ValueError("no view to draw in: give the App a vis (a notebook's widget), or headless=True")
+
+    def view_address(self) -> tuple[str, str | None]:
+        """``(url, url through Jupyter or None)`` of the view, for the ``meshcat`` record (owner thread)."""
+        return self.vis.url(), None
 
     def _configure_instance(self, body_name: str, name: str, controller, params: dict) -> None:
         config = ControllerConfig(
@@ -265,13 +281,11 @@ class App:
         )
 
     def _open_view(self) -> None:
-        from tutorial.view.meshcat_server import start_server, through_jupyter
         from tutorial.view.scene import Scene, look_at_geoms
         from tutorial.view.sinks import frame_sink
 
         if self.vis is None:
-            self.server = start_server()
-            self.vis = self.server.visualizer()
+            self.vis = self.open_visualizer()
         # A robot drawn from its description, with no world around it: meshcat's grid is its ground, and the
         # camera frames the robot whatever its size (the tank's close-up assumes the tank's).
         described = self.project.simulator is None and any(m.description for m in self.project.models)
@@ -288,10 +302,7 @@ class App:
         else:
             self.camera = (root + [-1.1, -1.2, 0.8], root)  # the robot, close up
         self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it
-        # Its own server's page is also offered through Jupyter's port when it runs under Jupyter; a view it
-        # was given (a notebook's widget, a test's) is not a page of a server.
-        url = self.vis.url() if self.server is None else self.server.web_url
-        via = None if self.server is None else through_jupyter(url)
+        url, via = self.view_address()
         self.output({"event": "meshcat", "node": self.node_fqn, "url": url, "through_jupyter": via})
 
     def step(self, timeout: float = 1.0 / FRAME_RATE) -> bool:

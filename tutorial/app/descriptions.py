@@ -2,11 +2,10 @@
 
 ``project/step3_description.yaml`` names ``/Tank/robot_description`` instead
 of a model file; :func:`receive_descriptions` fills such models in before
-the App builds its world, and a model that names an odometry topic gets a
-:class:`tutorial.app.floating_base.FloatingBase`.  :class:`DescribedApp` is
-the App that does both, and what ``rtt-run`` runs: the lessons' own
-:class:`tutorial.app.app.App` refuses such models, so the URDF tools stay
-out of the lessons' library (``scripts/library_size.py``).
+the App builds its world.  :class:`tutorial.app.standalone.StandaloneApp`
+(what ``rtt-run`` runs) calls it: the lessons' own :class:`tutorial.app.app.App`
+refuses such models, so the URDF tools stay out of the lessons' library
+(``scripts/library_size.py``).
 """
 
 from __future__ import annotations
@@ -14,44 +13,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 
-from tutorial.app.app import App
 from tutorial.core.project import Project
 
 DESCRIPTION_TIMEOUT = 10.0  # s a viewer waits for a robot description it takes its model from
-
-
-class DescribedApp(App):
-    """An :class:`App` that also runs models taken from robot descriptions, and robots placed by odometry.
-
-    Args:
-        description_timeout: how long :meth:`open` waits for each robot
-            description, s (:data:`DESCRIPTION_TIMEOUT`).
-        **kwargs: :class:`App`'s.
-
-    Same threads as :class:`App`.
-    """
-
-    def __init__(self, project: Project, *, description_timeout: float = DESCRIPTION_TIMEOUT, **kwargs):
-        super().__init__(project, **kwargs)
-        self.description_timeout = description_timeout
-
-    def prepare_project(self, project: Project) -> Project:
-        """``project`` with its description models received (:func:`receive_descriptions`), and a
-        floating base attached to each model that names an odometry topic (owner thread).
-
-        Raises:
-            tutorial.interfaces.robot_description.DescriptionError: a description did not come in time.
-            KeyboardInterrupt: the App was asked to stop while it waited.
-        """
-        project = receive_descriptions(
-            project, self.node, self.description_timeout, self.output, stopped=lambda: self.stop_requested
-        )
-        for entry in project.models:
-            if entry.odometry is not None:  # its root link placed where the robot's odometry says
-                from tutorial.app.floating_base import FloatingBase
-
-                self.attach.append((entry.name, f"{entry.name}/floating_base", FloatingBase(entry.odometry)))
-        return project
 
 
 def receive_descriptions(

@@ -25,7 +25,7 @@ import signal
 import sys
 
 from tutorial.app.app import DEFAULT_NODE_NAME, App, ControllerError
-from tutorial.app.descriptions import DescribedApp
+from tutorial.app.standalone import StandaloneApp
 from tutorial.core.project import ProjectError, load_project
 from tutorial.core.world import ModelError
 from tutorial.ros import env as ros_env
@@ -200,7 +200,7 @@ def main(argv: list[str] | None = None) -> int:
 
     ros_env.use_localhost_by_default()
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    app = DescribedApp(
+    app = StandaloneApp(
         project,
         node_name=DEFAULT_NODE_NAME,
         headless=args.headless,

@@ -1,0 +1,70 @@
+"""The App of a program on its own, ``rtt-run``: what the lessons' App leaves to the tooling.
+
+:class:`tutorial.app.app.App` is what the notebooks open: it draws in the
+view it is given and refuses a model it would need ROS to build.  A
+program in a terminal has no notebook around it, so :class:`StandaloneApp`
+adds the two things the lessons never import:
+
+- **a meshcat server of its own** for the view (:mod:`tutorial.view.meshcat_server`),
+  its page also offered through Jupyter's port when it runs under Jupyter;
+- **robots from ROS**: a model taken from a robot description topic
+  (:func:`tutorial.app.descriptions.receive_descriptions`, the URDF tools),
+  and a root link placed where an odometry topic says
+  (:class:`tutorial.app.floating_base.FloatingBase`).
+"""
+
+from __future__ import annotations
+
+from tutorial.app.app import App
+from tutorial.app.descriptions import DESCRIPTION_TIMEOUT, receive_descriptions
+from tutorial.core.project import Project
+
+
+class StandaloneApp(App):
+    """An :class:`App` with a meshcat server of its own, that also runs robots drawn from ROS.
+
+    Args:
+        description_timeout: how long :meth:`open` waits for each robot
+            description, s (:data:`tutorial.app.descriptions.DESCRIPTION_TIMEOUT`).
+        **kwargs: :class:`App`'s.
+
+    Same threads as :class:`App`.
+    """
+
+    def __init__(self, project: Project, *, description_timeout: float = DESCRIPTION_TIMEOUT, **kwargs):
+        super().__init__(project, **kwargs)
+        self.description_timeout = description_timeout
+
+    def prepare_project(self, project: Project) -> Project:
+        """``project`` with its description models received, and a floating base attached to each model that
+        names an odometry topic (owner thread, in :meth:`open`).
+
+        Raises:
+            tutorial.interfaces.robot_description.DescriptionError: a description did not come in time.
+            KeyboardInterrupt: the App was asked to stop while it waited.
+        """
+        project = receive_descriptions(
+            project, self.node, self.description_timeout, self.output, stopped=lambda: self.stop_requested
+        )
+        for entry in project.models:
+            if entry.odometry is not None:  # its root link placed where the robot's odometry says
+                from tutorial.app.floating_base import FloatingBase
+
+                self.attach.append((entry.name, f"{entry.name}/floating_base", FloatingBase(entry.odometry)))
+        return project
+
+    def open_visualizer(self):
+        """A meshcat server of this App's own (closed with it), and its ``Visualizer`` (owner thread)."""
+        from tutorial.view.meshcat_server import start_server
+
+        self.server = start_server()
+        return self.server.visualizer()
+
+    def view_address(self) -> tuple[str, str | None]:
+        """Its own server's page, and the same page through Jupyter's port when it runs under Jupyter; a view it
+        was given (a test's) is not a page of a server."""
+        if self.server is None:
+            return super().view_address()
+        from tutorial.view.meshcat_server import through_jupyter
+
+        return self.server.web_url, through_jupyter(self.server.web_url)
