@@ -468,3 +468,47 @@ def test_9_1_a_learners_answer_is_shown_as_a_pose_an_array_of_another_shape_or_w
     assert step9._show(np.zeros(3)) == "an array of shape (3,)"
     assert step9._show(None) == "None" and step9._show("a pose") == "'a pose'"
     assert step9._show([[1, 2], [3]]) == "[[1, 2], [3]]"
+
+
+def test_7_2_the_other_joint_moves_both_ways_at_up_to_3_rad_s_too():
+    speeds = []
+    for seed in SEEDS:
+        s, joint = step7._random_series(random.Random(seed), "late")
+        other = s.positions["TURRET_P" if joint == "TURRET_Y" else "TURRET_Y"]
+        speeds += list(np.diff(other) / np.diff(s.stamp))
+    assert -3.0 - 1e-9 <= min(speeds) < -2.5 and 2.5 < max(speeds) <= 3.0 + 1e-9
+
+
+def test_9_1_rotations_are_uniform_unit_quaternions_and_translations_go_either_way():
+    quaternions, translations = [], []
+    for seed in SEEDS:
+        transforms, _ = step9._random_tree(random.Random(seed), "any")
+        quaternions += [t.rotation for t in transforms]
+        translations += [t.translation for t in transforms]
+    q, t = np.array(quaternions), np.array(translations)
+    assert (np.abs(q.mean(axis=0)) < 0.06).all(), q.mean(axis=0)  # no axis favoured (a biased draw: about 0.4)
+    assert (t.min(axis=0) < -1.9).all() and (t.max(axis=0) > 1.9).all()
+
+
+def test_9_1_a_trees_first_stamps_reach_its_ends_and_the_first_frame_can_be_the_leaf_asked_for():
+    seconds = {step9._random_tree(random.Random(seed), "tilted")[0][0].stamp[0] for seed in MANY}
+    assert min(seconds) == 1 and max(seconds) == 999
+    nanos, leaves = [], set()
+    for seed in SEEDS:
+        transforms, frame = step9._random_tree(random.Random(seed), "root")
+        nanos += [t.stamp[1] for t in transforms]
+        leaves.add(frame)
+    assert min(nanos) < 5.2 * 10**8 and max(nanos) > 9.8 * 10**8 and "F0" in leaves
+
+
+def test_9_1_a_child_sent_again_is_sent_once_or_twice_more_each_time_a_second_later():
+    extra, nanos = set(), []
+    for seed in SEEDS:
+        transforms, _ = step9._random_tree(random.Random(seed), "newest")
+        base = min(t.stamp[0] for t in transforms)
+        resent = sorted(t.stamp[0] for t in transforms if t.stamp[1] < 10**8)
+        assert resent == list(range(base + 1, base + 1 + len(resent))), "one second later each time"
+        nanos += [t.stamp[1] for t in transforms if t.stamp[1] < 10**8]
+        sent = [t.child for t in transforms]
+        extra |= {sent.count(c) - 1 for c in set(sent) if sent.count(c) > 1}
+    assert extra == {1, 2} and max(nanos) > 9 * 10**7
