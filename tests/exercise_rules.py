@@ -974,6 +974,13 @@ HIDDEN_MISTAKES_07_08_09 = [
     ),
     # old: passed (fewer than two states counted before the NaN ones are skipped)
     ("7.2", "    if not moving.any():\n", "    if len(series.stamp) < 2:\n", "only one state carries the joint"),
+    # found by make mutate (a check tolerant to 1 rad/s passed it): the speeds rounded to the hundredth
+    (
+        "7.2",
+        "speeds = np.abs(dq[moving] / dt[moving])",
+        "speeds = np.round(np.abs(dq[moving] / dt[moving]), 2)",
+        "a second or more",
+    ),
     # old: passed (liveliness only warned: no publisher offers manual-by-topic)
     (
         "8.1",

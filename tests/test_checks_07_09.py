@@ -512,3 +512,91 @@ def test_9_1_a_child_sent_again_is_sent_once_or_twice_more_each_time_a_second_la
         sent = [t.child for t in transforms]
         extra |= {sent.count(c) - 1 for c in set(sent) if sent.count(c) > 1}
     assert extra == {1, 2} and max(nanos) > 9 * 10**7
+
+
+# ---- each hidden case draws what its label tells the learner it tests -------------------------------
+
+
+def hidden_draws(monkeypatch, module, check, generator: str, seed: int):
+    """``[(label, drawn)]`` of ``check``'s hidden cases for a learner's ``seed``: what ``generator`` returned for
+    each, in order (the check's cases are collected, not run)."""
+    drawn, cases = [], []
+    real = getattr(module, generator)
+    monkeypatch.setattr(module, "hidden_random", lambda exercise: random.Random(f"{seed}/{exercise}"))
+    monkeypatch.setattr(module, generator, lambda rng, kind: drawn.append(real(rng, kind)) or drawn[-1])
+    monkeypatch.setattr(module, "grade", lambda name, listed: cases.extend(listed))
+    check(None)
+    labels = [c.call for c in cases if c.hidden]
+    assert len(labels) == len(drawn)
+    return list(zip(labels, drawn))
+
+
+def pushes(messages):
+    return [nonzero(msg.axes) for topic, _, msg in messages if topic == step7.JOY and any(msg.axes)]
+
+
+RELEASE_LABELS = {
+    "a D-pad or trigger axis pushed alone": lambda m: all(len(p) == 1 and set(p) <= {4, 5, 6, 7} for p in pushes(m)),
+    "an axis barely off centre, which is not released": lambda m: all(
+        len(p) == 1 and abs(*p.values()) <= 0.04 for p in pushes(m)
+    ),
+    "two axes pushed opposite ways at once": lambda m: all(len(p) == 2 and sum(p.values()) == 0.0 for p in pushes(m)),
+    "another gamepad's Joys and joint states between the Joys": lambda m: (
+        {t for t, _, _ in m} == {step7.JOY, step7.OTHER_JOY, "/Tank/joint_state"}
+    ),
+    "a bag whose first Joy is released and comes after other topics": lambda m: (
+        not any(next(msg for t, _, msg in m if t == step7.JOY).axes) and m[0][0] != step7.JOY
+    ),
+    "a long drive of pushes, repeats and releases over several seconds": lambda m: (
+        len(runs(m)) >= 5 and max(s for _, s, _ in m) - min(s for _, s, _ in m) > 1.0
+    ),
+}
+
+PEAK_LABELS = {
+    "states stamped a second or more into the simulation, unevenly spaced": lambda s, q: (
+        s.stamp[0] >= 1.0 and np.isfinite(q).all() and len(set(np.round(np.diff(s.stamp), 9))) > 1
+    ),
+    "a drive of many states, stamped a second or more in": lambda s, q: s.stamp[0] >= 1.0 and np.isfinite(q).all(),
+    "several pairs tied at the top speed": lambda s, q: (
+        (np.abs(np.diff(q) / np.diff(s.stamp)) == step7._peak(s.stamp, q)[0]).sum() >= 2
+    ),
+    "states without the joint at the ends and in a row": lambda s, q: (
+        np.isnan(q[0]) and np.isnan(q[-1]) and any(np.isnan(q[1:-2]) & np.isnan(q[2:-1]))
+    ),
+    "several states sharing a stamp": lambda s, q: (np.diff(s.stamp) == 0).sum() >= 2,
+    "only one state carries the joint": lambda s, q: np.isfinite(q).sum() == 1,
+    "a joint that stood still, stamped a second or more in": lambda s, q: s.stamp[0] >= 1.0 and np.ptp(q) == 0.0,
+}
+
+
+def root_of(transforms) -> str:
+    parents = parents_of(transforms)
+    [root] = set(parents.values()) - set(parents)
+    return root
+
+
+LOOKUP_LABELS = {
+    "a chain of frames tilted about every axis": lambda ts, f: (
+        len(set(parents_of(ts).values())) == len(ts) and all(all(ts_.rotation) for ts_ in ts)
+    ),
+    "a tree whose root is not world": lambda ts, f: root_of(ts) != "world",
+    "a child sent several times, its stamps a second or more apart": lambda ts, f: len(ts) > len(parents_of(ts)),
+    "the root of a random tree": lambda ts, f: f == root_of(ts),
+    "a frame no transform names, in a random tree": lambda ts, f: f not in {root_of(ts), *parents_of(ts)},
+    "a random tree, listed in any order, tilted": lambda ts, f: (
+        f in parents_of(ts) and f not in parents_of(ts).values()
+    ),
+}
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_every_hidden_case_of_7_1_7_2_and_9_1_draws_what_its_label_says(monkeypatch, seed):
+    got = hidden_draws(monkeypatch, step7, step7.check_release_times, "_random_joy_bag", seed)
+    assert [label for label, _ in got] == list(RELEASE_LABELS)
+    assert [label for label, m in got if not RELEASE_LABELS[label](m)] == []
+    got = hidden_draws(monkeypatch, step7, step7.check_peak_speed, "_random_series", seed)
+    assert sorted({label for label, _ in got}) == sorted(PEAK_LABELS) and len(got) == 7
+    assert [label for label, (s, joint) in got if not PEAK_LABELS[label](s, s.positions[joint])] == []
+    got = hidden_draws(monkeypatch, step9, step9.check_lookup, "_random_tree", seed)
+    assert [label for label, _ in got] == list(LOOKUP_LABELS)
+    assert [label for label, (ts, f) in got if not LOOKUP_LABELS[label](ts, f)] == []

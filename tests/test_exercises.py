@@ -628,6 +628,15 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # states sharing a stamp dropped, the first kept, instead of the pair between them skipped
+    (
+        "7.2",
+        "    dt, dq = np.diff(t), np.diff(q)\n",
+        "    t, first = np.unique(t, return_index=True)\n    q = q[first]\n    dt, dq = np.diff(t), np.diff(q)\n",
+        "two states with one stamp",
+    ),
+    # the speed alone, not (speed, time)
+    ("7.2", "return float(speeds[k]), float(t[1:][moving][k])", "return float(speeds[k])", "steady at 1 rad/s"),
     # the statement's default rate not kept: the drive, with no rate parameter, publishes at 20 Hz
     ("2.2", '"rate": (float, 10.0,', '"rate": (float, 20.0,', "10 Hz from t = 0"),
     # the topic not named after the body
