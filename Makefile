@@ -104,7 +104,7 @@ grade: $(VENV)/.installed
 # Mutation testing (mutmut, configured in pyproject.toml) of the modules the notebooks build and the core they
 # stand on: each mutant is a small change to one function, run against the tests that call it; the report says
 # how many the tests caught and lists every survivor, with why it cannot be caught or that a test is missing.
-# Hours here (the checks of 01 to 04 with it).  mutmut keeps its results in mutants/ and re-tests only
+# Hours here (the checks of 01 to 04 and 07 to 09 with it).  mutmut keeps its results in mutants/ and re-tests only
 # functions whose code changed:
 # after adding tests, rm -rf mutants for a full run.
 mutate: $(VENV)/.installed

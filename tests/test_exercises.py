@@ -628,6 +628,15 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # a depth for a QoS, as create_subscription(..., 10) takes one
+    ("8.1", "    return QoSProfile(\n", "    return 10\n    return QoSProfile(\n", "lossy_link_qos()"),
+    # the system's default durability (a publisher's, whatever it is), not volatile
+    (
+        "8.1",
+        "durability=DurabilityPolicy.VOLATILE,",
+        "durability=DurabilityPolicy.SYSTEM_DEFAULT,",
+        "durability volatile",
+    ),
     # states sharing a stamp dropped, the first kept, instead of the pair between them skipped
     (
         "7.2",

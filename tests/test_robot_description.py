@@ -95,8 +95,10 @@ def test_the_lessons_app_refuses_a_model_only_rtt_run_draws(tmp_path, model, top
 @pytest.mark.unit
 def test_rtt_run_describe_adds_the_robot_model_publisher_to_each_robot_once():
     """``rtt-run --describe``: notebook 09's frozen publisher on the tank (a model with controllers), not on the
-    room (scenery); a project that has one already (notebook 10's) keeps just that one."""
+    room (scenery); a project that has one already (notebook 10's, or the notebook's own exported class) keeps
+    just that one; a viewer's project, which would publish what it listens to, is refused."""
     from tutorial.app.reference.robot_model_publisher import RttRobotModelPublisher
+    from tutorial.controllers.robot_model_publisher import RttRobotModelPublisher as Exported
     from tutorial.tools.rtt_run import build_parser, describe_robots
 
     assert build_parser().parse_args(["p.yaml", "--describe"]).describe
@@ -106,6 +108,10 @@ def test_rtt_run_describe_adds_the_robot_model_publisher_to_each_robot_once():
         publishers = [c for c in tank.controllers if c.cls is RttRobotModelPublisher]
         assert room.controllers == [] and len(publishers) == 1, name
         assert [c.name for c in load_project(PROJECT / name).models[1].controllers].count(publishers[0].name) == before
+    own = load_project(PROJECT / "step2.yaml").with_controller("Tank", "RttRobotModelPublisher", Exported)
+    assert describe_robots(own).models[1].controllers == own.models[1].controllers
+    with pytest.raises(ProjectError, match="step3_description.yaml: --describe publishes a simulation's robots"):
+        describe_robots(load_project(PROJECT / "step3_description.yaml"))
 
 
 @pytest.mark.unit

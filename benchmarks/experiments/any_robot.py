@@ -6,8 +6,8 @@ example-robot-data, cold and cached.
 
 A publisher keeps the Franka Panda's description (``example-robot-data``,
 ``package://`` URIs as shipped) on ``/Panda/robot_description``; a monitor
-(an :class:`tutorial.app.app.App` with a meshcat server, as ``rtt-run``
-runs it) opens on it and draws its first frame.  The figure is from the
+(a :class:`tutorial.app.standalone.StandaloneApp`, with its meshcat server,
+as ``rtt-run`` runs it) opens on it and draws its first frame.  The figure is from the
 description's arrival to the end of that frame: the meshes found, the
 Collada files converted to STL (cold: an empty cache) or read from the
 cache (warm), the MuJoCo model compiled, and the scene sent to meshcat;

@@ -1,7 +1,8 @@
 """A running project: the App that builds the world, attaches the controllers, simulates and draws.
 
-It sits above the core, the ROS plumbing, the 3D view and the URDF tools,
-and below the steps' notebooks and the programs, which open it.
+It sits above the core, the ROS plumbing, the 3D view and the URDF tools
+(which only ``standalone`` and ``descriptions`` reach), and below the steps'
+notebooks and the programs, which open it.
 
 ==================  ==============================================================
 module              what

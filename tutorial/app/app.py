@@ -51,13 +51,14 @@ class App:
         node: the ``rclpy`` node to use (its callbacks must be spun by the
             caller), or None to create ``node_name`` and spin it here.
         node_name: name of the node created when ``node`` is None.
-        headless: no meshcat server and scene.
+        headless: no scene, no view.
         realtime_sync: override the project's ``simulator.realtime_sync``.
         duration: stop after this many seconds: simulated time when the
             project simulates, wall-clock time otherwise (None: until stopped).
         output: called with one dict per status line or event (main thread).
-        vis: an existing ``meshcat.Visualizer`` to draw in (notebooks),
-            instead of starting a server; the owner thread must own it.
+        vis: the ``meshcat.Visualizer`` to draw in (a notebook's widget);
+            the owner thread must own it.  Without it, only a subclass that
+            opens a view of its own (:meth:`open_visualizer`) draws.
         attach: extra ``(body name, controller name, controller instance)``
             to attach in code, before the project's own (as adding a
             controller item in Choreonoid's GUI).

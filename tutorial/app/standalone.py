@@ -10,7 +10,8 @@ adds the two things the lessons never import:
 - **robots from ROS**: a model taken from a robot description topic
   (:func:`tutorial.app.descriptions.receive_descriptions`, the URDF tools),
   and a root link placed where an odometry topic says
-  (:class:`tutorial.app.floating_base.FloatingBase`).
+  (:class:`tutorial.app.floating_base.FloatingBase`, attached as ``attach``
+  entries are: configured before the project's own controllers).
 """
 
 from __future__ import annotations

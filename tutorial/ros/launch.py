@@ -274,8 +274,9 @@ def launch_parser(description: str) -> argparse.ArgumentParser:
     p.add_argument(
         "--tf",
         action="store_true",
-        help="with --record: also record the robot description and odometry, and write /tf, /tf_static and "
-        "/robot_description, so Foxglove and RViz2 replay the robot in 3D (rtt-bag record --tf)",
+        help="with --record: the simulation also publishes the robot description and odometry (rtt-run "
+        "--describe), and the recording holds them and /tf, /tf_static and /robot_description, so Foxglove and "
+        "RViz2 replay the robot in 3D (rtt-bag record --tf)",
     )
     return p
 

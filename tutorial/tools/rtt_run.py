@@ -132,20 +132,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--describe",
         action="store_true",
-        help="also publish each robot's URDF (/<body>/robot_description) and odometry (/<body>/odom) for the "
-        "stock ROS 2 tools (notebook 09's RttRobotModelPublisher)",
+        help="a simulation: also publish each robot's URDF (/<body>/robot_description) and odometry "
+        "(/<body>/odom) for the stock ROS 2 tools (notebook 09's RttRobotModelPublisher)",
     )
     return p
 
 
 def describe_robots(project):
     """``project`` with notebook 09's :class:`RttRobotModelPublisher` on each model that has controllers (a
-    robot, not scenery) and none of its own: what ``--describe`` runs (any thread).
+    robot, not scenery) and no robot model publisher yet (the frozen one or the notebook's own, by its class's
+    name): what ``--describe`` runs (any thread).
+
+    Raises:
+        ProjectError: the project does not simulate (a viewer: it would publish what it listens to).
     """
     from tutorial.app.reference.robot_model_publisher import RttRobotModelPublisher
 
+    if project.simulator is None:
+        raise ProjectError(
+            f"{project.path}: --describe publishes a simulation's robots; this project does not simulate"
+        )
     for entry in project.models:
-        has_one = any(c.cls is RttRobotModelPublisher for c in entry.controllers)
+        has_one = any(c.cls.__name__ == RttRobotModelPublisher.__name__ for c in entry.controllers)
         if entry.controllers and not has_one:
             project = project.with_controller(entry.name, "RttRobotModelPublisher", RttRobotModelPublisher)
     return project

@@ -21,6 +21,7 @@ module                      step      what the later steps use it for
 ``imu_state_publisher``     4         ``/Tank/imu`` (notebook 05's simulation)
 ``camera_image_publisher``  6         ``/Tank/camera/image`` (notebook 08's two hosts)
 ``robot_model_publisher``   9         ``/Tank/robot_description`` and ``/Tank/odom``
-                                      for the stock ROS 2 tools (Steps 2, 4, 6)
+                                      for the stock ROS 2 tools (rtt-run --describe,
+                                      notebooks 10 and 11)
 ==========================  ========  ===========================================
 """
