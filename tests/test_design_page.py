@@ -112,6 +112,8 @@ TOOLING = (
     "tutorial.app.floating_base",
     "tutorial.app.standalone",
     "tutorial.view.meshcat_server",
+    "tutorial.joystick.sources",
+    "tutorial.joystick.publisher",
     "tutorial.interfaces.robot_description",
     "tutorial.interfaces.odometry",
 )

@@ -99,8 +99,8 @@ def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: flo
     import rclpy
 
     from tutorial.app.reference.tank_controller import RttTankController
+    from tutorial.joystick.demo import SCRIPTS
     from tutorial.joystick.scripted import ScriptedJoy
-    from tutorial.joystick.sources import SCRIPTS
     from tutorial.notebook.runs import load, run_headless
 
     project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)

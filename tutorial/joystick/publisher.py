@@ -3,7 +3,7 @@
 Like ROS 2's ``joy_node``, :class:`JoyPublisher` publishes when the input
 changes (at most ``rate`` Hz) and repeats the current state at
 ``autorepeat`` Hz, so a subscriber that starts late, or missed a message,
-still gets the sticks' state.  Its sources are in :mod:`tutorial.joystick.sources`.
+still gets the sticks' state.  Its sources are in :mod:`tutorial.joystick.sources` and :mod:`tutorial.joystick.demo`.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Deterministic joystick input for notebooks, tests and snapshots.
 
-:class:`ScriptedJoy` is a controller that plays :data:`tutorial.joystick.sources.DEMO_SCRIPT`
+:class:`ScriptedJoy` is a controller that plays :data:`tutorial.joystick.demo.DEMO_SCRIPT`
 by *simulated* time and hands the stick state to the tank controller's
 ``on_joy``, the same callback the ``/joy`` subscription calls: when it
 changes, and again every 50 ms of simulated time, as ``rtt-joy`` repeats
@@ -15,7 +15,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 from tutorial.core.controller import SimpleController
-from tutorial.joystick.sources import DemoInput
+from tutorial.joystick.demo import DemoInput
 
 AUTOREPEAT = 0.05  # s of simulated time between repeats of an unchanged state (20 Hz)
 
@@ -28,7 +28,7 @@ class ScriptedJoy(SimpleController):
             function returning it (called in ``initialize``, when every
             controller of the project has been configured).
         cycles: how many times to play the script (None: forever).
-        script: the script, :data:`tutorial.joystick.sources.DEMO_SCRIPT` unless given
+        script: the script, :data:`tutorial.joystick.demo.DEMO_SCRIPT` unless given
             (e.g. ``SCRIPTS["wall"]``, Step 5's).
 
     Attach it before the target, so both see the same step.  Runs on the simulation thread.

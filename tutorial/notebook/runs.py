@@ -121,7 +121,7 @@ def run_project(
             project's ``RttTankController`` by simulated time, repeated at 20 Hz.
         fps: frame rate of the recorded states.
         realtime: keep simulated time with wall time (False: as fast as possible).
-        script: which demo script, a key of :data:`tutorial.joystick.sources.SCRIPTS`
+        script: which demo script, a key of :data:`tutorial.joystick.demo.SCRIPTS`
             (``"drive"``, or ``"wall"``: Step 5's wall ramming).
 
     Returns:
@@ -131,8 +131,8 @@ def run_project(
     Deaf to the network, as :func:`run_headless`; what it publishes still goes out.
     """
     from tutorial.core.trajectory import TrajectoryLog
+    from tutorial.joystick.demo import SCRIPTS
     from tutorial.joystick.scripted import ScriptedJoy
-    from tutorial.joystick.sources import SCRIPTS
 
     proj = load(project)
     body = next(m.name for m in proj.models if m.controllers)

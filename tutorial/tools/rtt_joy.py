@@ -29,7 +29,8 @@ NODE_NAME = "rtt_joy"
 
 def choose_source(args, stack: contextlib.ExitStack):
     """The input source the command line asks for, and a line saying which it is."""
-    from tutorial.joystick.sources import KEYBOARD_HELP, SCRIPTS, DemoInput, GamepadInput, KeyboardInput
+    from tutorial.joystick.demo import SCRIPTS, DemoInput
+    from tutorial.joystick.sources import KEYBOARD_HELP, GamepadInput, KeyboardInput
 
     if args.demo:
         return (
