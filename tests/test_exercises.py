@@ -630,6 +630,8 @@ MISTAKES = [
 MUTANT_MISTAKES = [
     # a depth for a QoS, as create_subscription(..., 10) takes one
     ("8.1", "    return QoSProfile(\n", "    return 10\n    return QoSProfile(\n", "lossy_link_qos()"),
+    # the system's default history, not keep last
+    ("8.1", "history=HistoryPolicy.KEEP_LAST,", "history=HistoryPolicy.SYSTEM_DEFAULT,", "keep last 1"),
     # the system's default durability (a publisher's, whatever it is), not volatile
     (
         "8.1",
