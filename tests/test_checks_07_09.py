@@ -467,7 +467,9 @@ def test_9_1_a_learners_answer_is_shown_as_a_pose_an_array_of_another_shape_or_w
     assert step9._show(step9._pose((1, -2, 0.25), math.pi / 2)) == "a pose at (1.000, -2.000, 0.250) m, yaw 1.571 rad"
     assert step9._show(np.zeros(3)) == "an array of shape (3,)"
     assert step9._show(None) == "None" and step9._show("a pose") == "'a pose'"
-    assert step9._show([[1, 2], [3]]) == "[[1, 2], [3]]"
+    assert step9._show([[1, 2], [3]]) == "a list of 2 (an array of shape (2,), an array of shape (1,))"
+    assert step9._show((np.zeros(3), np.eye(3))) == "a tuple of 2 (an array of shape (3,), an array of shape (3, 3))"
+    assert step9._show(object).startswith("<class")
 
 
 def test_7_2_the_other_joint_moves_both_ways_at_up_to_3_rad_s_too():

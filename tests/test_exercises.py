@@ -628,6 +628,8 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # the position and the rotation apart, as a TransformStamped holds them, not one 4x4 pose
+    ("9.1", "    return pose\n", "    return pose[:3, 3], pose[:3, :3]\n", "world -> CHASSIS, moved only"),
     # a depth for a QoS, as create_subscription(..., 10) takes one
     ("8.1", "    return QoSProfile(\n", "    return 10\n    return QoSProfile(\n", "lossy_link_qos()"),
     # the system's default history, not keep last

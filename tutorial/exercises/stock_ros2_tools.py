@@ -36,12 +36,15 @@ def _pose(position, rotation_z: float = 0.0) -> np.ndarray:
 
 
 def _show(m) -> str:
-    """What a learner's answer was, in a line: a pose, an array of another shape, or its repr (None: no return)."""
+    """What a learner's answer was, in a line: a pose, an array of another shape, a tuple or list of such, or
+    its repr (None: no return)."""
     if m is None or isinstance(m, str):
         return repr(m)
     try:
         a = np.asarray(m, dtype=float)
     except (TypeError, ValueError):
+        if isinstance(m, (tuple, list)):
+            return f"a {type(m).__name__} of {len(m)} ({', '.join(_show(x) for x in m)})"
         return repr(m)
     if a.shape != (4, 4):
         return f"an array of shape {a.shape}"
