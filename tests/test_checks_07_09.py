@@ -63,6 +63,7 @@ def test_7_1_any_push_is_one_to_three_axes_each_at_least_0_01_off_centre():
     pushed = [nonzero(step7._pushed_axes(random.Random(seed), "any")) for seed in SEEDS]
     assert {len(p) for p in pushed} == {1, 2, 3}
     assert all(0.01 <= abs(v) <= 1.0 for p in pushed for v in p.values())
+    assert {v > 0 for p in pushed for v in p.values()} == {True, False}
     assert {i for p in pushed for i in p} == set(range(8))
 
 
@@ -133,15 +134,16 @@ def test_7_1_every_push_of_a_hidden_bag_of_one_kind_is_of_that_kind(kind):
 
 
 def test_7_1_released_joys_come_as_zeros_negative_zeros_fewer_axes_or_none():
-    shapes = set()
+    shapes, lengths = set(), set()
     for seed in SEEDS:
         for pushed, _, joys in runs(step7._random_joy_bag(random.Random(seed), "long")):
             for j in joys if not pushed else ():
                 axes = list(j.axes)
+                lengths.add(len(axes))
                 assert all(a == 0.0 for a in axes) and len(axes) <= 8
                 negative = any(math.copysign(1.0, a) < 0 for a in axes)
                 shapes.add("none" if not axes else "negative" if negative else "eight" if len(axes) == 8 else "fewer")
-    assert shapes == {"none", "negative", "eight", "fewer"}
+    assert shapes == {"none", "negative", "eight", "fewer"} and lengths == set(range(9))
 
 
 @pytest.mark.parametrize("kind", KINDS)
