@@ -839,6 +839,9 @@ RULES_07_08_09 = {
             "two axes pushed opposite ways at once",
         ],
         "a Joy with no axes is released": ["a Joy with no axes"],
+        "only the axes count: a Joy with every axis 0 is released, whatever buttons it holds": [
+            "a long drive of pushes, repeats and releases over several seconds",
+        ],
         "a release is a released Joy right after one that was not (repeats are one release)": [
             "let go, then repeated at 20 Hz",
             "two pushes",
@@ -926,6 +929,13 @@ RULES_07_08_09 = {
 HIDDEN_MISTAKES_07_08_09 = [
     # old: passed (only the sticks: "every stick came back to the centre")
     ("7.1", "released = all(a == 0.0 for a in msg.axes)", "released = all(a == 0.0 for a in msg.axes[:4])", "a D-pad"),
+    # found by make mutate (no Joy of any case held a button): a button held counted as a push
+    (
+        "7.1",
+        "released = all(a == 0.0 for a in msg.axes)",
+        "released = all(a == 0.0 for a in msg.axes) and not any(msg.buttons)",
+        "a long drive",
+    ),
     # old: passed (a dead zone at a threshold the statement does not have)
     (
         "7.1",

@@ -604,3 +604,38 @@ def test_every_hidden_case_of_7_1_7_2_and_9_1_draws_what_its_label_says(monkeypa
     got = hidden_draws(monkeypatch, step9, step9.check_lookup, "_random_tree", seed)
     assert [label for label, _ in got] == list(LOOKUP_LABELS)
     assert [label for label, (ts, f) in got if not LOOKUP_LABELS[label](ts, f)] == []
+
+
+@pytest.mark.parametrize("kind", ("topics", "late", "long"))
+def test_7_1_the_other_topics_of_a_bag_are_4_to_11_drawn_anywhere_and_one_pushed_joy_before_the_first(kind):
+    counts, early, positions, others, ratio = set(), [], [], [], []
+    for seed in SEEDS:
+        messages = step7._random_joy_bag(random.Random(seed), kind)
+        first = min(t for topic, t, _ in messages if topic == step7.JOY)
+        extra = [m for m in messages if m[0] != step7.JOY]
+        counts.add(len(extra))
+        positions += [msg.position[0] for topic, _, msg in extra if topic == "/Tank/joint_state"]
+        early += [t for topic, t, _ in extra if topic == "/Tank/joint_state"]
+        joys = [msg for topic, _, msg in extra if topic == step7.OTHER_JOY]
+        others.append((sum(any(j.axes) for j in joys), sum(not any(j.axes) for j in joys)))
+        assert all(len(j.axes) == 8 for j in joys)
+        if first > 0:
+            ratio.append(min(t for topic, t, msg in extra if topic == step7.OTHER_JOY and any(msg.axes)) / first)
+    assert counts == set(range(5, 13))  # 4 to 11 drawn, and the one before the first /joy
+    assert min(early) < 0.3 and -1.0 <= min(positions) < -0.9 and 0.9 < max(positions) <= 1.0
+    assert max(p for p, _ in others) >= 3 and max(r for _, r in others) >= 2, "pushed and released Joys of its own"
+    assert min(ratio) < 0.1 and max(ratio) < 0.9 + 1e-9
+
+
+def test_7_1_a_long_drive_holds_buttons_now_and_then_which_release_nothing():
+    held = 0
+    for seed in SEEDS:
+        for topic, _, msg in step7._random_joy_bag(random.Random(seed), "long"):
+            held += topic == step7.JOY and not any(msg.axes) and any(msg.buttons)
+        for kind in ("dpad", "topics"):
+            assert not any(
+                any(m.buttons) for t, _, m in step7._random_joy_bag(random.Random(seed), kind) if t == "/joy"
+            )
+    assert held > 100
+    joy = step7._joy
+    assert step7._releases([("/joy", 0.0, joy(lv=1.0)), ("/joy", 0.5, joy(buttons=[1] * 8))]) == [0.5]

@@ -628,6 +628,8 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # how many releases, not when
+    ("7.1", "    return times\n", "    return len(times)\n", "forward for 1 s, then let go"),
     # the position and the rotation apart, as a TransformStamped holds them, not one 4x4 pose
     ("9.1", "    return pose\n", "    return pose[:3, 3], pose[:3, :3]\n", "world -> CHASSIS, moved only"),
     # a depth for a QoS, as create_subscription(..., 10) takes one

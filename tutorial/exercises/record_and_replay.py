@@ -46,10 +46,13 @@ def write_bag(path: Path, messages: list[tuple[str, float, object]]) -> Path:
     return path
 
 
-def _joy(lv: float = 0.0, rh: float = 0.0, axes=None, stamp: float = 0.0):
+def _joy(lv: float = 0.0, rh: float = 0.0, axes=None, stamp: float = 0.0, buttons=None):
     from sensor_msgs.msg import Joy
 
-    msg = Joy(axes=list(axes) if axes is not None else [0.0, lv, rh, 0.0, 0.0, 0.0, 0.0, 0.0], buttons=[0] * 8)
+    msg = Joy(
+        axes=list(axes) if axes is not None else [0.0, lv, rh, 0.0, 0.0, 0.0, 0.0, 0.0],
+        buttons=list(buttons) if buttons is not None else [0] * 8,
+    )
     msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(round(stamp * 1e9), 1_000_000_000)
     return msg
 
@@ -72,8 +75,9 @@ def check_release_times(func) -> Result:
 
     While grading, hidden bags drawn by the same rules (a D-pad or trigger
     pushed alone, an axis barely off centre, two axes pushed opposite ways,
-    another gamepad's Joys, a first Joy that is released, the Joys stamped by
-    the gamepad's own clock) are judged by :func:`_releases`.
+    another gamepad's Joys, a first Joy that is released, buttons held in a
+    long drive, the Joys stamped by the gamepad's own clock) are judged by
+    :func:`_releases`.
     """
 
     def bag(label, messages, expected, hint, hidden=False):
@@ -205,7 +209,8 @@ def _pushed_axes(rng, kind: str) -> list[float]:
 def _random_joy_bag(rng, kind: str) -> list[tuple[str, float, object]]:
     """A bag's ``(topic, s, message)``: pushes (by :func:`_pushed_axes`) and releases on /joy, each state repeated
     at 20 Hz a few times, the Joys stamped by the gamepad's clock (not the recorder's); for ``topics``, ``late``
-    and ``long``, joint states and another gamepad's Joys between them, sometimes before the first /joy."""
+    and ``long``, joint states and another gamepad's Joys between them, sometimes before the first /joy; for
+    ``long``, buttons held now and then (a button is no axis: a Joy with every axis 0 is released)."""
     clock = rng.uniform(1.0, 500.0)  # s: the gamepad's clock when the bag starts
     released = (lambda: [0.0] * 8, lambda: [-0.0] * 8, lambda: [], lambda: [0.0] * rng.randrange(1, 8))
     t = rng.uniform(0.5, 3.0) if kind in ("topics", "late") else rng.choice((0.0, rng.uniform(0.0, 2.0)))
@@ -215,7 +220,8 @@ def _random_joy_bag(rng, kind: str) -> list[tuple[str, float, object]]:
         axes = _pushed_axes(rng, kind if kind in ("dpad", "tiny", "opposite") else "any") if pushing else None
         for _ in range(rng.randrange(1, 5)):
             state = axes if pushing else rng.choice(released)()
-            messages.append((JOY, t, _joy(axes=state, stamp=clock + t - rng.uniform(0.001, 0.03))))
+            buttons = [int(rng.random() < 0.3) for _ in range(8)] if kind == "long" else None
+            messages.append((JOY, t, _joy(axes=state, stamp=clock + t - rng.uniform(0.001, 0.03), buttons=buttons)))
             t += 0.05
         t += rng.uniform(0.0, 0.6)
         pushing = not pushing
