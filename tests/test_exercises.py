@@ -628,6 +628,30 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # a stick taken as pushed before the first Joy: a bag that starts released gets a release at once
+    (
+        "7.1",
+        "times, first, pushed = [], None, False",
+        "times, first, pushed = [], None, True",
+        "still pushed at the end",
+    ),
+    # times counted from the bag's first message of any topic, not its first Joy
+    (
+        "7.1",
+        'for _topic, log_time, msg in read_messages(path, topics=["/joy"]):\n'
+        "        first = log_time if first is None else first\n",
+        "for _topic, log_time, msg in read_messages(path):\n"
+        "        first = log_time if first is None else first\n"
+        '        if _topic != "/joy":\n            continue\n',
+        "joint states around the Joys",
+    ),
+    # a Joy with no axes taken for a push
+    (
+        "7.1",
+        "released = all(a == 0.0 for a in msg.axes)",
+        "released = bool(msg.axes) and all(a == 0.0 for a in msg.axes)",
+        "a Joy with no axes",
+    ),
     # how many releases, not when
     ("7.1", "    return times\n", "    return len(times)\n", "forward for 1 s, then let go"),
     # the position and the rotation apart, as a TransformStamped holds them, not one 4x4 pose
