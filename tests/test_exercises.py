@@ -1001,8 +1001,9 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
             '        self.debug = config.node.create_publisher(PoseStamped, "/debug/pose", 1)\n'
             "        return True\n\n    def unconfigure",
         ),
+        ("8.2", "return 15.0, 70", "return 10.0, 70"),  # the slowest watchable rate, 10 pictures/s, is watchable
     ],
-    ids=["2.2-another-publisher"],
+    ids=["2.2-another-publisher", "8.2-the-slowest-rate"],
 )
 def test_a_right_answer_written_otherwise_passes(ros, number, right, other):
     """What a statement leaves free is left free by its check (found by make mutate: a mutant failed it)."""
