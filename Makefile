@@ -6,7 +6,7 @@
 #       make notebooks (JupyterLab on notebooks/), make hub (a class's JupyterHub on 127.0.0.1:8000, course/), make book (the Jupyter Book, warnings are errors),
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
-#       make mutate (mutation testing of the lessons, the library's core and the checks of assignments 01 to 04 and 07 to 09: hours),
+#       make mutate (mutation testing of the lessons, the library's core and every exercise's check: hours),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does 01; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
@@ -104,7 +104,7 @@ grade: $(VENV)/.installed
 # Mutation testing (mutmut, configured in pyproject.toml) of the modules the notebooks build and the core they
 # stand on: each mutant is a small change to one function, run against the tests that call it; the report says
 # how many the tests caught and lists every survivor, with why it cannot be caught or that a test is missing.
-# Hours here (the checks of 01 to 04 and 07 to 09 with it).  mutmut keeps its results in mutants/ and re-tests only
+# Hours here (every exercise's check with it).  mutmut keeps its results in mutants/ and re-tests only
 # functions whose code changed:
 # after adding tests, rm -rf mutants for a full run.
 mutate: $(VENV)/.installed

@@ -54,6 +54,29 @@ PROJECT = ROOT / "project"
 MODEL = ROOT / "model"
 
 
+class ViewerNode:
+    """A stand-in for a viewer's rclpy node, for its controllers' tests without ROS: it keeps the subscriptions
+    made (each a namespace of what ``create_subscription`` was given) and those destroyed, in order."""
+
+    def __init__(self):
+        self.subscriptions, self.destroyed = [], []
+
+    def get_fully_qualified_name(self):
+        return "/rtt_viewer"
+
+    def create_subscription(self, msg_type, topic, callback, qos, event_callbacks=None):
+        from types import SimpleNamespace
+
+        made = SimpleNamespace(
+            msg_type=msg_type, topic=topic, topic_name=topic, callback=callback, qos=qos, events=event_callbacks
+        )
+        self.subscriptions.append(made)
+        return made
+
+    def destroy_subscription(self, subscription):
+        self.destroyed.append(subscription)
+
+
 TIERS = ("unit", "ros", "cross_process", "launch", "browser", "notebooks", "network")
 
 # The session's clean-up of Fast DDS's files in /dev/shm: entered when the session starts, left when it ends.

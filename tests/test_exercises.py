@@ -445,6 +445,23 @@ MISTAKES = [
         'names = config.parameters["joints"].split(",")',
         "joints=' TURRET_P , TURRET_Y '",
     ),
+    # a publish() of one's own that names the joints as asked but reads their values in the tank's order
+    (
+        "2.1",
+        "        self.joints = [io.body.joint(name).info for name in self.selected]\n        return True\n",
+        "        self.joints = [io.body.joint(name).info for name in self.selected]\n        return True\n\n"
+        "    def publish(self):\n"
+        "        d, msg = self.data, self.msg_type()\n"
+        "        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(d.time)\n"
+        "        msg.name = [j.name for j in self.joints]\n"
+        "        ours = sorted(self.joints, key=lambda j: j.qpos_adr)  # the tank's order\n"
+        "        msg.position = [float(d.qpos[j.qpos_adr]) for j in ours]\n"
+        "        msg.velocity = [float(d.qvel[j.dof_adr]) for j in ours]\n"
+        "        msg.effort = [float(d.qfrc_actuator[j.dof_adr]) for j in ours]\n"
+        "        self.publisher.publish(msg)\n"
+        "        self.published += 1\n",
+        "joints='TURRET_P,TURRET_Y'",
+    ),
     ("3.1", 'self.rejected["wrong_model"] += 1', 'self.rejected["unknown_name"] += 1', "(the crane's message)"),
     ("3.1", "if not names or not names <= ours:", "if not names or names != ours:", "(only one of the tank's joints)"),
     ("4.1", "self.peak = max(self.peak, math.hypot(a[0], a[1]))", "self.peak = math.hypot(a[0], a[1])", "(at rest"),
@@ -628,6 +645,50 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # the CameraInfo beside the camera, not under it: no publisher of the camera_info topic a subscriber asks for
+    (
+        "6.2",
+        'topic = f"/{config.body_name}/camera/camera_info"',
+        'topic = f"/{config.body_name}/camera_info"',
+        "one CameraInfo on /Tank/camera/camera_info",
+    ),
+    # an unconfigure() of one's own that gives nothing back: neither the CameraInfo's publisher nor, without
+    # super().unconfigure(), the Image's
+    (
+        "6.2",
+        "        super().unconfigure()  # the render thread has ended: nothing publishes now\n"
+        "        self.node.destroy_publisher(self.info_publisher)\n",
+        "        pass\n",
+        "unconfigure() removes the CameraInfo publisher",
+    ),
+    # the CameraInfo published once, when configured, as if it were latched: not one with each Image
+    (
+        "6.2",
+        ("        self.info_publisher.publish(self.info)\n", "        return True\n\n    def unconfigure"),
+        ("", "        self.info_publisher.publish(self.info)\n        return True\n\n    def unconfigure"),
+        "one CameraInfo on /Tank/camera/camera_info",
+    ),
+    # the focal length rounded to the thousandth of a pixel, for tidy printing: k and p off by up to 0.0005
+    (
+        "6.2",
+        "fy = (self.height / 2) / math.tan(fovy / 2)  # pixels",
+        "fy = round((self.height / 2) / math.tan(fovy / 2), 3)  # pixels",
+        "k, from the vertical field of view",
+    ),
+    # the distortion left at CameraInfo's defaults (no model, no coefficients): a lens no calibration tool reads
+    (
+        "6.2",
+        '            distortion_model="plumb_bob",\n            d=[0.0] * 5,\n',
+        "",
+        "size and distortion",
+    ),
+    # the Image's publisher and message copied for the CameraInfo's: the picture again, on camera_info
+    (
+        "6.2",
+        ("            CameraInfo, topic, camera_image_qos()\n", "        self.info_publisher.publish(self.info)\n"),
+        ("            type(self.msg), topic, camera_image_qos()\n", "        self.info_publisher.publish(self.msg)\n"),
+        "one CameraInfo on /Tank/camera/camera_info",
+    ),
     # a stick taken as pushed before the first Joy: a bag that starts released gets a release at once
     (
         "7.1",
@@ -1001,9 +1062,16 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
             '        self.debug = config.node.create_publisher(PoseStamped, "/debug/pose", 1)\n'
             "        return True\n\n    def unconfigure",
         ),
+        (  # the same in 2.1, made before the joint state's
+            "2.1",
+            "        return super().configure(config)\n",
+            "        from std_msgs.msg import String\n"
+            '        self.debug = config.node.create_publisher(String, "/debug/said", 1)\n'
+            "        return super().configure(config)\n",
+        ),
         ("8.2", "return 15.0, 70", "return 10.0, 70"),  # the slowest watchable rate, 10 pictures/s, is watchable
     ],
-    ids=["2.2-another-publisher", "8.2-the-slowest-rate"],
+    ids=["2.2-another-publisher", "2.1-another-publisher", "8.2-the-slowest-rate"],
 )
 def test_a_right_answer_written_otherwise_passes(ros, number, right, other):
     """What a statement leaves free is left free by its check (found by make mutate: a mutant failed it)."""

@@ -19,24 +19,9 @@ from tutorial.core.controller import ControllerConfig
 from tutorial.core.world import ModelEntry, build_world
 
 from conftest import MODEL
+from conftest import ViewerNode as Node
 
 pytestmark = pytest.mark.unit
-
-
-class Node:
-    def __init__(self):
-        self.subscriptions, self.destroyed = [], []
-
-    def get_fully_qualified_name(self):
-        return "/rtt_viewer"
-
-    def create_subscription(self, msg_type, topic, callback, qos, event_callbacks=None):
-        sub = SimpleNamespace(topic=topic, topic_name=topic, callback=callback, qos=qos, events=event_callbacks)
-        self.subscriptions.append(sub)
-        return sub
-
-    def destroy_subscription(self, sub):
-        self.destroyed.append(sub)
 
 
 def state(t, names, positions):

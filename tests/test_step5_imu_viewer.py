@@ -22,24 +22,9 @@ from tutorial.core.controller import ControllerConfig
 from tutorial.core.world import ModelEntry, build_world
 
 from conftest import MODEL
+from conftest import ViewerNode as Node
 
 pytestmark = pytest.mark.unit
-
-
-class Node:
-    def __init__(self):
-        self.subscriptions, self.destroyed = [], []
-
-    def get_fully_qualified_name(self):
-        return "/rtt_viewer"
-
-    def create_subscription(self, msg_type, topic, callback, qos, event_callbacks=None):
-        sub_ = SimpleNamespace(msg_type=msg_type, topic=topic, callback=callback, qos=qos, events=event_callbacks)
-        self.subscriptions.append(sub_)
-        return sub_
-
-    def destroy_subscription(self, subscription):
-        self.destroyed.append(subscription)
 
 
 class Clock:

@@ -352,7 +352,13 @@ class Body:
     def root_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """Root link position (3,) in m and orientation quaternion (4,) w,x,y,z.
 
-        Valid after ``mj_step`` or ``mj_kinematics`` on the data.
+        MuJoCo's link poses (``MjData.xpos``, ``xquat``) are those of the last
+        kinematics: after ``mj_forward`` or ``mj_kinematics``, of the current
+        ``qpos``; after ``mj_step``, of the ``qpos`` the step started from.  So
+        in a controller's ``control()``, which runs before each step, the pose
+        is one time step (1 ms in the tank's world) older than ``qpos`` and
+        ``io.current_time`` from the second call on, as the sensors' readings
+        are (the first call follows the simulator's ``mj_forward``).
         """
         return self.data.xpos[self.root_id].copy(), self.data.xquat[self.root_id].copy()
 

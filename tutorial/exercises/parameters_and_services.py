@@ -69,6 +69,57 @@ def _rate_ok(value) -> bool:
     return isinstance(value, float) and not math.isnan(value) and 0.0 <= value <= MAX_RATE
 
 
+# Other controllers' parameters, and ROS's own, which a hidden case of 10.1 sets beside (or instead of) RATE.
+OTHERS = ("RttRobotModelPublisher.rate", "RttImuStatePublisher.rate", "use_sim_time", "camera.rate")
+
+
+def _among(rng, value, last: bool = False) -> list:
+    """A hidden case of 10.1: RATE set to ``value`` with 1 to 3 of :data:`OTHERS`, each far out of any range,
+    RATE anywhere among them (after 2 or 3 of them, if ``last``)."""
+    count = rng.randrange(2, 4) if last else rng.randrange(1, 4)
+    params = [_param(rng.choice(OTHERS), rng.choice((-1.0, 5000.0, math.nan))) for _ in range(count)]
+    params.insert(len(params) if last else rng.randrange(len(params) + 1), _param(RATE, value))
+    return params
+
+
+def _hidden_10_1(rng) -> list[tuple[str, list, str]]:
+    """The hidden cases of 10.1, each ``(label, parameters, hint)``: a rate a hair past either end, any rate inside,
+    another controller's rate far out, RATE among others (good, bad, and bad after several)."""
+    return [
+        (
+            "a rate a hair above the highest",
+            [_param(RATE, math.nextafter(MAX_RATE, math.inf))],  # the next float: any tolerance lets it in
+            "both ends are included, nothing past them.",
+        ),
+        ("a rate a hair below zero", [_param(RATE, -math.ulp(0.0))], "a rate below 0 Hz cannot be kept."),
+        (
+            "a rate anywhere inside the range",
+            [_param(RATE, rng.uniform(0.0, MAX_RATE))],
+            "every rate from 0 to the highest is a rate.",
+        ),
+        (
+            "another controller's rate far out of range",
+            [_param(rng.choice(OTHERS[:2]), MAX_RATE * rng.uniform(2, 9))],
+            "only RATE is this callback's to judge.",
+        ),
+        (
+            "a good rate among other parameters set together",
+            _among(rng, rng.uniform(1.0, MAX_RATE)),
+            "other parameters are not this callback's to refuse.",
+        ),
+        (
+            "a bad rate among other parameters set together",
+            _among(rng, rng.choice((-rng.uniform(1, 99), math.inf, math.nan))),
+            "judge every parameter of the list, wherever RATE is in it.",
+        ),
+        (
+            "a bad rate after several other parameters",
+            _among(rng, MAX_RATE * rng.uniform(1.5, 9), last=True),
+            "judge every parameter of the list, to its end.",
+        ),
+    ]
+
+
 def check_judge_rate(func) -> Result:
     """Check ``func(parameters) -> SetParametersResult``; see the module text.
 
@@ -77,15 +128,15 @@ def check_judge_rate(func) -> Result:
     among several in any position) are judged by :func:`_rate_ok`.
     """
 
-    def case(label: str, params: list, hint: str, hidden: bool = False) -> Case:
+    def case(params: list, hint: str, label: str | None = None) -> Case:  # a hidden case has a label
         ours = [p for p in params if p.name == RATE]
         bad = next((p for p in ours if not _rate_ok(p.value)), None)
-        call = label if hidden else f"judge_rate({_show_list(params)})"
+        call = label or f"judge_rate({_show_list(params)})"
 
         def run():
             _verdict(call, func(list(params)), bad is None, bad)
 
-        return Case(call, run, hint, hidden)
+        return Case(call, run, hint, label is not None)
 
     def on_a_node() -> None:
         """Through a real node: the parameter keeps its value when the callback refuses, takes it when it accepts."""
@@ -107,84 +158,29 @@ def check_judge_rate(func) -> Result:
             node.destroy_node()
 
     rng = hidden_random("10.1")
-    hidden = []
-    if rng:
-        others = ("RttRobotModelPublisher.rate", "RttImuStatePublisher.rate", "use_sim_time", "camera.rate")
-
-        def among(value, last: bool = False) -> list:
-            """RATE set to ``value`` with 1 to 3 other parameters (2 or 3 before it, if ``last``)."""
-            count = rng.randrange(2, 4) if last else rng.randrange(1, 4)
-            params = [_param(rng.choice(others), rng.choice((-1.0, 5000.0, math.nan))) for _ in range(count)]
-            params.insert(len(params) if last else rng.randrange(len(params) + 1), _param(RATE, value))
-            return params
-
-        hidden = [
-            case(
-                "a rate a hair above the highest",
-                [_param(RATE, math.nextafter(MAX_RATE, math.inf))],  # the next float: any tolerance lets it in
-                "both ends are included, nothing past them.",
-                True,
-            ),
-            case("a rate a hair below zero", [_param(RATE, -math.ulp(0.0))], "a rate below 0 Hz cannot be kept.", True),
-            case(
-                "a rate anywhere inside the range",
-                [_param(RATE, rng.uniform(0.0, MAX_RATE))],
-                "every rate from 0 to the highest is a rate.",
-                True,
-            ),
-            case(
-                "another controller's rate far out of range",
-                [_param(rng.choice(others[:2]), MAX_RATE * rng.uniform(2, 9))],
-                "only RATE is this callback's to judge.",
-                True,
-            ),
-            case(
-                "a good rate among other parameters set together",
-                among(rng.uniform(1.0, MAX_RATE)),
-                "other parameters are not this callback's to refuse.",
-                True,
-            ),
-            case(
-                "a bad rate among other parameters set together",
-                among(rng.choice((-rng.uniform(1, 99), math.inf, math.nan))),
-                "judge every parameter of the list, wherever RATE is in it.",
-                True,
-            ),
-            case(
-                "a bad rate after several other parameters",
-                among(MAX_RATE * rng.uniform(1.5, 9), last=True),
-                "judge every parameter of the list, to its end.",
-                True,
-            ),
-        ]
+    hidden = [case(params, hint, label) for label, params, hint in _hidden_10_1(rng)] if rng else []
     return grade(
         "Exercise 10.1, judge a rate before it is set",
         [
+            case([_param(RATE, 100.0)], "a rate from 0 to 1000 Hz is accepted: SetParametersResult(successful=True)."),
+            case([_param(RATE, 0.0)], "0 Hz is accepted: it publishes every step."),
+            case([_param(RATE, MAX_RATE)], "1000 Hz itself is accepted: both ends are included."),
             case(
-                "", [_param(RATE, 100.0)], "a rate from 0 to 1000 Hz is accepted: SetParametersResult(successful=True)."
-            ),
-            case("", [_param(RATE, 0.0)], "0 Hz is accepted: it publishes every step."),
-            case("", [_param(RATE, MAX_RATE)], "1000 Hz itself is accepted: both ends are included."),
-            case(
-                "",
                 [_param(RATE, -5.0)],
                 "a negative rate is refused, with a reason naming the parameter and its value.",
             ),
-            case("", [_param(RATE, 1000.5)], "past 1000 Hz the simulation cannot keep up: refused."),
-            case("", [_param(RATE, math.nan)], "NaN is no rate; every comparison with NaN is False."),
-            case("", [_param(RATE, math.inf)], "infinity is past 1000 Hz."),
+            case([_param(RATE, 1000.5)], "past 1000 Hz the simulation cannot keep up: refused."),
+            case([_param(RATE, math.nan)], "NaN is no rate; every comparison with NaN is False."),
+            case([_param(RATE, math.inf)], "infinity is past 1000 Hz."),
             case(
-                "",
                 [_param("RttRobotModelPublisher.rate", 5000.0)],
                 "another controller's rate is not this callback's to judge: accept it.",
             ),
             case(
-                "",
                 [_param("use_sim_time", True), _param(RATE, -1.0)],
                 "judge every parameter of the list, not just the first.",
             ),
             case(
-                "",
                 [_param(RATE, 50.0), _param("RttTankController.joy_timeout", -3.0)],
                 "a parameter that is not RATE is accepted, whatever its value.",
             ),
@@ -204,7 +200,7 @@ class TrackSwitch:
     Both threads use it under ``lock`` (a ``threading.Lock``).
     """
 
-    def __init__(self, enabled: bool = True):  # on, as the tracks start
+    def __init__(self, enabled: bool):
         self.lock = threading.Lock()
         self.enabled = enabled
 
@@ -230,6 +226,20 @@ class _WatchedSwitch(TrackSwitch):
 def _said(state: bool, was: bool) -> str:
     word = "on" if state else "off"
     return f"tracks already {word}" if state == was else f"tracks {word}"
+
+
+def _hidden_sequence(rng, meddled: bool) -> tuple[bool, list[tuple[bool, bool]]]:
+    """A hidden case of 10.2: a drawn start (on or off) and 4 to 8 requests, each ``(data, turned)``.
+
+    ``turned``: the check turns the switch over, from another thread with the lock held, just before that
+    request; only with ``meddled``, and then before at least one request.
+    """
+    start = rng.random() < 0.5
+    steps = [(rng.random() < 0.5, meddled and rng.random() < 0.5) for _ in range(rng.randrange(4, 9))]
+    if meddled:
+        k = rng.randrange(len(steps))
+        steps[k] = (steps[k][0], True)
+    return start, steps
 
 
 def check_switch_tracks(func) -> Result:
@@ -303,12 +313,7 @@ def check_switch_tracks(func) -> Result:
             node.destroy_node()
 
     def sequence(rng, call: str, meddled: bool) -> Case:
-        """Drawn requests to one switch from a drawn start; with ``meddled``, the switch is also turned by
-        another thread (the check, with the lock held) before some of them."""
-        start = rng.random() < 0.5
-        steps = [(rng.random() < 0.5, meddled and rng.random() < 0.5) for _ in range(rng.randrange(4, 9))]
-        if meddled:
-            steps[rng.randrange(len(steps))] = (steps[0][0], True)
+        start, steps = _hidden_sequence(rng, meddled)
         hint = "each answer says what this request did to the switch as it was, whoever turned it last."
 
         def run():

@@ -272,7 +272,11 @@ def check_camera_info(cls) -> Result:
 
     fovy_hint = "fy = (height / 2) / tan(fovy / 2), fovy in radians; fx = fy (square pixels); "
     cases = [
-        case(f"one CameraInfo on {KINECT.topic('camera_info')} with each Image", one_with_each),
+        case(
+            f"one CameraInfo on {KINECT.topic('camera_info')} with each Image",
+            one_with_each,
+            "a publisher of CameraInfo (rclpy refuses any other message on it), one message in publish_image.",
+        ),
         case("each CameraInfo has its Image's stamp and frame", stamps),
         case("size and distortion", size),
         case(
