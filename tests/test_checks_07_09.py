@@ -349,6 +349,25 @@ def test_7_2_a_series_starts_between_1_and_500_s_moves_both_ways_and_repeats_a_s
 
 # ---- 9.1: the trees ---------------------------------------------------------------------------------
 
+from tutorial.exercises import across_machines as step8  # noqa: E402
+
+
+def test_8_2_the_hidden_swings_are_a_third_to_half_a_radian_either_way_from_anywhere_the_gun_level_to_lowest():
+    swings = [swing for drawn in draws(step8._hidden_swings) for swing in drawn]
+    assert len(swings) == 8 * len(SEEDS) and all(len(swing) == step8.PICTURES for swing in swings)
+    widths = [swing[-1][0] - swing[0][0] for swing in swings]
+    assert all(0.3 - 1e-12 <= abs(w) <= 0.6 + 1e-12 for w in widths)
+    assert min(abs(w) for w in widths) < 0.31 and max(abs(w) for w in widths) > 0.59  # both ends of the range
+    assert any(w < 0 for w in widths) and any(w > 0 for w in widths)  # either way
+    for swing, w in zip(swings, widths):  # evenly along the swing, the gun at one pitch
+        steps = np.diff([yaw for yaw, _ in swing])
+        assert np.allclose(steps, w / (step8.PICTURES - 1), atol=1e-12)
+        assert len({pitch for _, pitch in swing}) == 1
+    starts, pitches = [swing[0][0] for swing in swings], [swing[0][1] for swing in swings]
+    assert all(-math.pi <= s <= math.pi for s in starts) and min(starts) < -3.0 and max(starts) > 3.0
+    assert all(-0.17 <= p <= 0.0 for p in pitches) and min(pitches) < -0.165 and max(pitches) > -0.005
+
+
 from tutorial.exercises import stock_ros2_tools as step9  # noqa: E402
 
 TREES = ("tilted", "root", "newest", "the root", "missing", "any")

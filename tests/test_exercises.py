@@ -1070,8 +1070,9 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
             "        return super().configure(config)\n",
         ),
         ("8.2", "return 15.0, 70", "return 10.0, 70"),  # the slowest watchable rate, 10 pictures/s, is watchable
+        ("8.2", "return 15.0, 70", "return 15.0, 30"),  # the lowest recognisable quality, 30, is recognisable
     ],
-    ids=["2.2-another-publisher", "2.1-another-publisher", "8.2-the-slowest-rate"],
+    ids=["2.2-another-publisher", "2.1-another-publisher", "8.2-the-slowest-rate", "8.2-the-lowest-quality"],
 )
 def test_a_right_answer_written_otherwise_passes(ros, number, right, other):
     """What a statement leaves free is left free by its check (found by make mutate: a mutant failed it)."""

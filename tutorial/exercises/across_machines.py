@@ -215,6 +215,17 @@ def camera_bit_rate(rate: float, quality: int, pictures) -> float:
     return rate * 8 * sum(sizes) / len(sizes)
 
 
+def _hidden_swings(rng) -> list[list[tuple[float, float]]]:
+    """8.2's hidden turret swings: 8 of them, each :data:`PICTURES` poses ``(yaw, pitch)`` in rad, a third to half
+    a radian either way from anywhere round, the gun at one pitch from its lowest to level."""
+    drawn = []
+    for _ in range(8):
+        start, width = rng.uniform(-math.pi, math.pi), rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 0.6)
+        pitch = rng.uniform(-0.17, 0.0)  # rad: the gun's lowest to level
+        drawn.append([(start + width * k / (PICTURES - 1), pitch) for k in range(PICTURES)])
+    return drawn
+
+
 def check_camera_settings(func) -> Result:
     """Check ``func() -> (rate, jpeg_quality)``: watchable, recognisable, within :data:`BUDGET_BIT_S`.
 
@@ -273,13 +284,9 @@ def check_camera_settings(func) -> Result:
             )
 
     def swings(rng):
-        """Hidden cases: the same budget along other turret swings, a third to half a radian anywhere round, the
-        gun level or lowered (all rendered at once, when the first is checked)."""
-        drawn = []
-        for _ in range(8):
-            start, width = rng.uniform(-math.pi, math.pi), rng.choice((-1.0, 1.0)) * rng.uniform(0.3, 0.6)
-            pitch = rng.uniform(-0.17, 0.0)  # rad: the gun's lowest to level
-            drawn.append([(start + width * k / (PICTURES - 1), pitch) for k in range(PICTURES)])
+        """Hidden cases: the same budget along other turret swings (all rendered at once, when the first is
+        checked)."""
+        drawn = _hidden_swings(rng)
 
         def pictures(n):
             if "swings" not in state:
