@@ -1228,6 +1228,20 @@ HIDDEN_MISTAKES_11 = [
         "return machine.get(state.lower(), {}).get(transition.lower())",
         "a name that is no transition",
     ),
+    # mutation testing: passed (a transition's name taken whatever its case, a state's as it is)
+    (
+        "11.1",
+        "return machine.get(state, {}).get(transition)",
+        "return machine.get(state, {}).get(transition.lower())",
+        "a name that is no transition",
+    ),
+    # mutation testing: passed (a callback's name taken for its transition's: on_activate for activate)
+    (
+        "11.1",
+        "return machine.get(state, {}).get(transition)",
+        'return machine.get(state, {}).get(transition.removeprefix("on_"))',
+        "a name that is no transition",
+    ),
     # mutation testing: passed (no visible case shuts an inactive node down)
     ("11.1", '            "shutdown": "finalized",\n', "", "every transition from unconfigured and inactive"),
     # mutation testing: passed (activating an active node keeps it active, as a learner might think)
