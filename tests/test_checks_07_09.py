@@ -347,7 +347,7 @@ def test_7_2_a_series_starts_between_1_and_500_s_moves_both_ways_and_repeats_a_s
     assert min(firsts) < -0.9 and max(firsts) > 0.9  # the grid's ends (-1 and 63/64) are each drawn once in 128
 
 
-# ---- 9.1: the trees ---------------------------------------------------------------------------------
+# ---- 8.2: the turret's swings ----------------------------------------------------------------------
 
 from tutorial.exercises import across_machines as step8  # noqa: E402
 
@@ -367,6 +367,8 @@ def test_8_2_the_hidden_swings_are_a_third_to_half_a_radian_either_way_from_anyw
     assert all(-math.pi <= s <= math.pi for s in starts) and min(starts) < -3.0 and max(starts) > 3.0
     assert all(-0.17 <= p <= 0.0 for p in pitches) and min(pitches) < -0.165 and max(pitches) > -0.005
 
+
+# ---- 9.1: the trees ---------------------------------------------------------------------------------
 
 from tutorial.exercises import stock_ros2_tools as step9  # noqa: E402
 

@@ -8,6 +8,7 @@ the whole answers, which fail on some step of a sequence however it is drawn).
 
 from __future__ import annotations
 
+import math
 import random
 
 import pytest
@@ -42,8 +43,6 @@ def test_10_2_a_hidden_sequence_is_4_to_8_requests_either_way_from_either_start(
 
 @pytest.mark.parametrize("last", [False, True], ids=["anywhere", "last"])
 def test_10_1_a_rate_among_others_has_1_to_3_of_them_far_out_and_the_rate_once_anywhere(last):
-    import math
-
     # the hidden cases leave last at its default unless they put the rate last
     lists = [step10._among(random.Random(seed), 25.0, **({"last": True} if last else {})) for seed in SEEDS]
     assert all([p.name for p in params].count(step10.RATE) == 1 for params in lists)
@@ -58,8 +57,6 @@ def test_10_1_a_rate_among_others_has_1_to_3_of_them_far_out_and_the_rate_once_a
 
 
 def test_10_1_the_hidden_cases_are_hairs_past_either_end_a_rate_inside_and_anothers_rate_far_out():
-    import math
-
     drawn = [step10._hidden_10_1(random.Random(seed)) for seed in SEEDS]
     assert all([label for label, _, _ in cases] == [label for label, _, _ in drawn[0]] for cases in drawn)
     by_label = {label: [cases[i][1] for cases in drawn] for i, (label, _, _) in enumerate(drawn[0])}
