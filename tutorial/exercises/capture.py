@@ -1,4 +1,4 @@
-"""What a controller publishes, captured in-process, for the exercises' checks.
+"""What a controller publishes, captured in-process, for the exercises' checks, and the scripted run it is captured in.
 
 :class:`CapturingNode` stands in for the ``rclpy`` node a controller gets in
 ``configure``: everything goes to the real node, except that each publisher
@@ -6,6 +6,10 @@ it creates also keeps a copy of every message published through it (a
 serialized copy: a controller may refill and reuse its message object).
 Nothing depends on the network or on timing, so a check sees exactly what
 was published, in order.  Used by one thread at a time, as a node is.
+
+:func:`scripted_drive` is the run the checks of notebooks 02 and 04 capture
+in: the tank in its room, driven by a script by simulated time (deaf to the
+network, so always the same run), on the calling thread.
 """
 
 from __future__ import annotations
@@ -92,3 +96,34 @@ class CapturingNode:
 
     def __getattr__(self, name):
         return getattr(self.node, name)
+
+
+def scripted_drive(name: str, cls, parameters: dict, node: CapturingNode, script, duration: float, probe, first=None):
+    """Run the tank world for ``duration`` s of simulated time with the learner's ``cls`` attached as ``name``.
+
+    Args:
+        parameters: the learner's controller's parameters.
+        node: the capturing node the run's controllers get.
+        script: ``ScriptedJoy``'s script (None: the demo drive), through the frozen Step 1 tank controller.
+        probe: the check's own controller, attached after the drive (it reads each step's state).
+        first: a controller attached before everything else (a start of the check's own), or None.
+
+    Returns:
+        The ``App`` that ran (:func:`tutorial.notebook.runs.run_headless`).
+
+    Raises:
+        tutorial.app.app.ControllerError: the learner's controller refused to configure (or raised there).
+        tutorial.exercises.grader.CaseFailed: the simulation failed.
+    """
+    from tutorial.app.reference.tank_controller import RttTankController
+    from tutorial.exercises.grader import raise_run_error
+    from tutorial.joystick.scripted import ScriptedJoy
+    from tutorial.notebook.runs import load, run_headless
+
+    project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
+    tank = RttTankController()
+    attach = [("Tank", "ScriptedJoy", ScriptedJoy(tank, script=script)), ("Tank", "RttTankController", tank)]
+    attach = ([("Tank", "First", first)] if first is not None else []) + attach + [("Tank", "Probe", probe)]
+    summary, app = run_headless(project, duration, node=node, attach=attach)
+    raise_run_error(summary)
+    return app

@@ -28,7 +28,7 @@ import contextlib
 import logging
 import math
 
-from tutorial.exercises.capture import CapturingNode
+from tutorial.exercises.capture import CapturingNode, scripted_drive
 from tutorial.exercises.grader import (
     Case,
     CaseFailed,
@@ -37,7 +37,6 @@ from tutorial.exercises.grader import (
     grade,
     hidden_random,
     not_done,
-    raise_run_error,
     show,
 )
 
@@ -81,32 +80,14 @@ TURN_SCRIPT = ((0.2, (0.0, 0.0, 0.0, 0.0)), (10.0, (0.8, 0.0, 0.0, 0.0)))
 
 
 def _drive(name: str, cls, parameters: dict, script=None, duration: float = DURATION, tumble=None):
-    """Run the scripted drive with ``cls`` attached as ``name``; ``(capturing node, probe, app)``.
+    """:func:`~tutorial.exercises.capture.scripted_drive` with the probe; ``(capturing node, probe, app)``.
 
     ``tumble``: a controller attached first (:func:`_tumbling`).
-
-    Raises:
-        tutorial.app.app.ControllerError: the learner's controller refused to configure (or raised there).
     """
     import rclpy
 
-    from tutorial.app.reference.tank_controller import RttTankController
-    from tutorial.joystick.scripted import ScriptedJoy
-    from tutorial.notebook.runs import load, run_headless
-
-    project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
-    node = CapturingNode(rclpy.create_node("exercise_check"))
-    probe = _Probe()
-    tank = RttTankController()
-    attach = [
-        ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=script)),
-        ("Tank", "RttTankController", tank),
-        ("Tank", "Probe", probe.controller),
-    ]
-    if tumble is not None:
-        attach.insert(0, ("Tank", "Tumble", tumble))
-    summary, app = run_headless(project, duration, node=node, attach=attach)
-    raise_run_error(summary)
+    node, probe = CapturingNode(rclpy.create_node("exercise_check")), _Probe()
+    app = scripted_drive(name, cls, parameters, node, script, duration, probe.controller, first=tumble)
     return node, probe, app
 
 

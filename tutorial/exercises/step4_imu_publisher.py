@@ -34,8 +34,8 @@ import math
 
 import numpy as np
 
-from tutorial.exercises.capture import CapturingNode
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, raise_run_error, show
+from tutorial.exercises.capture import CapturingNode, scripted_drive
+from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, show
 
 DURATION = 3.0  # s of simulated time per checked run: the tank hits the wall at about 2.05 s
 TIME_STEP_NS = 1_000_000  # the tank world's 1 ms step
@@ -86,38 +86,14 @@ class _NotingNode(CapturingNode):
 
 
 def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: float = DURATION):
-    """Run the tank world with ``cls`` attached as ``name``, driven by ``script``.
-
-    Returns:
-        ``(capturing node, probe)``.
-
-    Raises:
-        NotImplementedError: the learner's code is not written yet.
-        CaseFailed: the simulation failed.
-        tutorial.app.app.ControllerError: the controller refused to configure (or raised there).
-    """
+    """:func:`~tutorial.exercises.capture.scripted_drive` by the demo script ``script``, with the probe;
+    ``(capturing node, probe)``."""
     import rclpy
 
-    from tutorial.app.reference.tank_controller import RttTankController
     from tutorial.joystick.demo import SCRIPTS
-    from tutorial.joystick.scripted import ScriptedJoy
-    from tutorial.notebook.runs import load, run_headless
 
-    project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
-    node = _NotingNode(rclpy.create_node("exercise_check_imu"))
-    probe = _Probe()
-    tank = RttTankController()
-    summary, _ = run_headless(
-        project,
-        duration,
-        node=node,
-        attach=[
-            ("Tank", "ScriptedJoy", ScriptedJoy(tank, script=SCRIPTS[script])),
-            ("Tank", "RttTankController", tank),
-            ("Tank", "ImuProbe", probe.controller),
-        ],
-    )
-    raise_run_error(summary)
+    node, probe = _NotingNode(rclpy.create_node("exercise_check_imu")), _Probe()
+    scripted_drive(name, cls, parameters, node, SCRIPTS[script], duration, probe.controller)
     return node, probe
 
 
