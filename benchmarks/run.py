@@ -257,7 +257,7 @@ def _suite(args) -> int:
         measure("widget_remote", lambda: widget_remote(5.0))
     learners = (1, 2) if args.quick else LEARNERS
     measure("learners", lambda: learners_per_server(learners, 8.0 if args.quick else 20.0, warmup + 1.0))
-    if not args.quick:  # one learner before the slice and lone-wait cuts: the cores per learner's baseline
+    if not args.quick:  # one learner before the cuts of 2026-11-27 and 28: the cores per learner's baseline
         measure("learners_before", lambda: learners_per_server([1], 20.0, warmup + 1.0, before=True))
     r["load_average_at_end"] = [round(x, 2) for x in os.getloadavg()]
     r["machine_at_end"] = machine_probe()

@@ -342,7 +342,7 @@ LEARNERS_TARGETS = (
         "{:.3f} cores",
         # for reference only (held against the limit): a before-run that failed reads n/a, never a crash
         baseline=lambda r: ((r.get("learners_before") or {}).get("1") or {}).get("cores_per_learner"),
-        baseline_fmt="before the slice and lone-wait cuts {:.3f} cores",
+        baseline_fmt="before the cuts of 2026-11-27 and 28 {:.3f} cores",
         needs="learners",
     ),
 )

@@ -2,7 +2,11 @@
 
 A genuine check signs a verdict that passes; the same check after the grader
 was patched, or a Result made by hand, does not; a patched function's code is
-refused; the signature holds only with the key.  The sandbox around it
+refused; the signature holds only with the key.  Then each rule of the hook
+that a mutation round found untested (benchmarks/RESULTS.md, *The seal*):
+what an answer opens, links to a process's memory, frames during a check,
+code claiming the library's files, processes and connections, and the ways
+a verdict is not the teacher's.  The sandbox around it
 (users, namespaces, limits) is tested by grading: tests/test_grading.py.
 """
 
@@ -74,10 +78,17 @@ def signed_lines(out: str) -> list[list[str]]:
     return lines
 
 
-def sealed(script: str) -> subprocess.CompletedProcess:
-    """``script`` run in a Python of its own (it seals itself), on this machine's ROS graph; it must succeed."""
+def sealed(script: str, cwd=None) -> subprocess.CompletedProcess:
+    """``script`` run in a Python of its own (it seals itself), on this machine's ROS graph; it must succeed.
+
+    ``cwd``: its working folder (default this one's); it imports the ``tutorial`` this process imported.
+    """
+    import tutorial
+
     env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, env=env)
+    paths = [os.path.dirname(os.path.dirname(tutorial.__file__)), env.get("PYTHONPATH", "")]
+    env["PYTHONPATH"] = os.pathsep.join(p for p in paths if p)
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, env=env, cwd=cwd)
     assert done.returncode == 0, done.stderr
     return done
 
@@ -100,6 +111,321 @@ def test_the_seal_signs_only_the_teachers_untouched_check():
     # the same lines under another key are not the seal's
     with pytest.raises(AssertionError):
         signed_lines(done.stdout.replace("\t1.1\t", "\t1.2\t", 1))
+
+
+def test_the_seal_trusts_the_modules_a_check_imports_only_when_it_runs():
+    """2.1's check imports the scripted run's modules inside its functions: they are imported, and so snapshot,
+    before any answer runs (an answer could otherwise import one first and replace what is in it, unseen)."""
+    done = sealed(
+        "from tutorial.exercises import seal\n"
+        "print(*(m.__name__ for m in seal.trusted_modules(['tutorial.exercises.step2_joint_state_publisher'])))"
+    )
+    trusted = set(done.stdout.split())
+    lazily = {"tutorial.notebook.runs", "tutorial.app.reference.tank_controller", "tutorial.joystick.scripted"}
+    assert lazily <= trusted, lazily - trusted
+    assert "tutorial.exercises.step1_tank_controller" not in trusted  # only the checks named, and the grader
+
+
+def test_an_answer_reading_the_projects_and_models_is_not_noted_and_one_reading_elsewhere_is(tmp_path):
+    """The answer works in a folder of its own: opening the system's files, the project files and models the
+    library reads, or its own files, is quiet; opening a file elsewhere or in a hidden folder (were it there or
+    not, named by an absolute or a relative path) is noted, and named."""
+    (tmp_path / "hidden").mkdir()
+    done = sealed(
+        textwrap.dedent(
+            f"""
+            import os, tutorial
+            from tutorial.exercises import seal
+            seal.install(b"k" * 32, 1, [], hidden=[{str(tmp_path / "hidden")!r}])
+            repository = os.path.dirname(os.path.dirname(tutorial.__file__))
+            with open("mine.txt", "w") as f:
+                f.write("my own")
+            for path in (
+                "/dev/null",
+                "/proc/self/status",
+                "/sys/rtt-not-there",
+                "/etc/hostname",
+                "/usr/rtt-not-there",
+                "/lib/rtt-not-there",
+                "/run/rtt-not-there",
+                os.path.join(repository, "project/step1.yaml"),
+                os.path.join(repository, "model/tank.xml"),
+                "mine.txt",
+                os.path.join(repository, "course/source/secret"),
+                "/var/rtt\tnot-there",
+                os.path.relpath("/var/rtt-relative"),
+                os.path.join({str(tmp_path)!r}, "hidden", "secret"),
+            ):
+                try:
+                    open(path).close()
+                except OSError:
+                    pass
+            """
+        ),
+        cwd=tmp_path,
+    )
+    import tutorial
+
+    repository = os.path.dirname(os.path.dirname(os.path.realpath(tutorial.__file__)))
+    notes = [line for line in signed_lines(done.stdout) if line[0] == "note"]
+    assert {n[1] for n in notes} == {"outside"}, notes
+    assert [n[2] for n in notes] == [
+        *([f"opened {repository}/course/source/secret"] if not repository.startswith("/tmp/") else []),  # else allowed
+        "opened /var/rtt not-there",  # a tab in a field is a space: the line's fields stay apart
+        "opened /var/rtt-relative",
+        f"opened {tmp_path / 'hidden' / 'secret'}",
+    ], notes
+
+
+def test_an_answer_cannot_open_a_process_s_memory_directly_or_through_a_chain_of_relative_links(tmp_path):
+    """Opening /proc/self/mem (where the seal's key lives) is refused, and so is a link to a link to it, made
+    before the seal; making a link to /proc is refused after; a link to a file of the answer's own opens."""
+    done = sealed(
+        textwrap.dedent(
+            """
+            import os, sys
+            os.symlink("b", "a")  # a -> b -> /proc/self/mem, each link relative to its folder
+            os.symlink("/proc/self/mem", "b")
+            os.mkdir("links")
+            os.symlink("y", "links/x")  # the same in a folder that is not the working one (which has no y)
+            os.symlink("/proc/self/mem", "links/y")
+            with open("real.txt", "w") as f:
+                f.write("plain")
+            os.symlink("real.txt", "c")
+            from tutorial.exercises import seal
+            seal.install(b"k" * 32, 1, [])
+            for path in ("/proc/self/mem", os.path.abspath("a"), "a", "links/x", "c"):
+                try:
+                    with open(path, "rb") as f:
+                        print("read", path, f.read(5), file=sys.stderr)
+                except RuntimeError as e:
+                    print("refused", path, e, file=sys.stderr)
+            links = ((os.symlink, "/proc/self/mem"), (os.symlink, "../../proc/1/mem"), (os.link, "/proc/self/mem"))
+            for make, source in links:
+                try:
+                    make(source, "d")
+                except RuntimeError as e:
+                    print("refused", e, file=sys.stderr)
+            os.symlink("real.txt", "e")  # a link elsewhere: made
+            """
+        ),
+        cwd=tmp_path,
+    )
+    said = done.stderr.splitlines()
+    assert said[:4] == [
+        "refused /proc/self/mem the grader's sandbox refused: opening /proc/self/mem",
+        f"refused {tmp_path / 'a'} the grader's sandbox refused: opening {tmp_path / 'a'}",
+        f"refused a the grader's sandbox refused: opening {tmp_path / 'a'}",
+        f"refused links/x the grader's sandbox refused: opening {tmp_path / 'links' / 'x'}",
+    ], done.stderr
+    assert said[4] == "read c b'plain'", done.stderr
+    assert said[5:] == [
+        "refused the grader's sandbox refused: a link to /proc/self/mem",
+        "refused the grader's sandbox refused: a link to ../../proc/1/mem",
+        "refused the grader's sandbox refused: a link to /proc/self/mem",  # a hard link
+    ], done.stderr
+    assert (tmp_path / "e").is_symlink() and not (tmp_path / "d").exists()
+
+
+def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_method_is_not_the_teachers():
+    """require() from a statement other than the test cell's is no verdict of the cell; a Result made by hand
+    under any name is noted as tampering; a check's function replaced before the check and put back during it
+    is found, and so is a check of the answer's own under the check's name; a note names the check it came
+    during, and no check after it; a class method's code of the library cannot be changed; a number of the
+    answer's own class that equals everything is told to the teacher; another thread's frames, and a thread
+    started with the answer's tracer, are refused."""
+    done = sealed(
+        textwrap.dedent(
+            """
+            import os, sys
+            from tutorial.exercises import seal
+            seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+            from tutorial.exercises.step1_tank_controller import check_dpad_steering
+            from tutorial.exercises.sandbox import Job
+            from tutorial.interfaces import joy
+            import tutorial.exercises.grader as grader
+
+            def cell(text):
+                exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
+
+            def dpad_track_velocities(axes):
+                forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+                return forward - turn, forward + turn
+
+            cell("r = check_dpad_steering(dpad_track_velocities).require()")  # not the test cell's statement
+            cell("grader.Result('steer', True, 'ok').require()")  # made by hand, under a name of no exercise
+            real, calls = grader.same_numbers, []
+            grader.same_numbers = lambda *a, **k: True  # replaced before the check, put back during it
+
+            def dpad_track_velocities(axes):
+                if not calls:
+                    grader.same_numbers = real
+                    try:
+                        open("/var/rtt-during").close()
+                    except OSError:
+                        pass
+                calls.append(axes)
+                forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+                return forward - turn, forward + turn
+
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            try:
+                open("/var/rtt-after").close()
+            except OSError:
+                pass
+            try:
+                Job.from_env.__func__.__code__ = (lambda cls: None).__code__
+            except RuntimeError as e:
+                print("refused:", e, file=sys.stderr)
+            real_axis = joy.axis
+            joy.axis = lambda axes, index: real_axis(axes, index)  # a library function the check uses, wrapped
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            joy.axis = real_axis
+            cells = grader.CaseFailed.__init__.__closure__
+            cells[0].cell_contents = AssertionError  # a closure of the grader's (super()'s class) changed
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            cells[0].cell_contents = grader.CaseFailed
+            teachers = check_dpad_steering
+
+            def check_dpad_steering(func):  # shadowed: a check of the answer's own
+                return grader.grade("Exercise 1.1, steer", [grader.Case("anything", lambda: None)])
+
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            check_dpad_steering = teachers
+
+            class Same(float):  # a number equal to every other
+                def __eq__(self, other):
+                    return True
+
+                __hash__ = float.__hash__
+
+            def dpad_track_velocities(axes):
+                return Same(0.0), Same(0.0)
+
+            try:
+                cell("check_dpad_steering(dpad_track_velocities).require()")
+            except AssertionError:
+                pass
+            try:
+                sys._current_frames()
+            except RuntimeError as e:
+                print("refused:", e, file=sys.stderr)
+            import threading
+
+            threading.settrace(lambda *a: None)  # a thread started with the answer's tracer
+            thread = threading.Thread(target=lambda: None)
+            thread.start()
+            thread.join()
+            """
+        )
+    )
+    lines = signed_lines(done.stdout)
+    verdicts = [line for line in lines if line[0] == "verdict"]
+    assert [v[1:] for v in verdicts] == [
+        ["1.1", "1", "0", "require() was not called by the test cell's statement"],
+        ["1.1", "1", "0", "tutorial.exercises.grader.same_numbers was replaced"],  # when the check began
+        ["1.1", "1", "0", "tutorial.interfaces.joy.axis was replaced"],
+        ["1.1", "1", "0", "tutorial.exercises.grader.CaseFailed.__init__'s closure was changed"],
+        ["1.1", "1", "0", "grade() was not called by one of the teacher's checks"],  # the shadowed check
+        ["1.1", "0", "1", ""],  # the numbers equal to every other: failed, by the teacher's check
+    ], verdicts
+    notes = [line[1:] for line in lines if line[0] == "note"]
+    assert notes == [
+        ["tampering", "a verdict not made by the teacher's check and require()", "?"],
+        ["outside", "opened /var/rtt-during", "1.1"],  # during the check: the check's
+        ["outside", "opened /var/rtt-after", ""],  # after it: the next check's
+        ["refused", "changing Job.from_env.__code__", ""],
+        ["tampering", "an answer returned a Same, a class of its own that compares as it likes", "1.1"],
+        ["refused", "sys._current_frames", ""],
+        ["refused", "sys.settrace", ""],  # in the thread, which its tracer would have watched
+    ], notes
+    assert "refused: the grader's sandbox refused: changing Job.from_env.__code__" in done.stderr, done.stderr
+    assert "refused: the grader's sandbox refused: sys._current_frames" in done.stderr, done.stderr
+
+
+def test_frames_code_processes_and_connections_of_an_answer_are_refused_or_noted_as_the_seal_says():
+    """Outside a check an answer may read its own frames; during one it may not.  Code claiming a file of the
+    library is refused; a process started and a connection tried are noted (the network tier has none)."""
+    done = sealed(
+        textwrap.dedent(
+            """
+            import inspect, os, socket, subprocess, sys, threading, types
+            import tutorial
+            import tutorial.exercises.grader as grader
+            from tutorial.exercises import seal
+            seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+            from tutorial.exercises.step1_tank_controller import check_dpad_steering
+            from tutorial.interfaces import joy
+
+            def said(what, attack):
+                try:
+                    print(what, "gave", attack(), file=sys.stderr)
+                except RuntimeError as e:
+                    print(what, e, file=sys.stderr)
+
+            def own_traceback_frame():
+                try:
+                    1 / 0
+                except ZeroDivisionError as e:
+                    return e.__traceback__.tb_frame.f_code.co_name
+
+            said("frame", lambda: sys._getframe().f_code.co_name)
+            said("traceback", own_traceback_frame)
+            calls = []
+
+            def dpad_track_velocities(axes):
+                if not calls:  # during the check
+                    said("frame during", lambda: sys._getframe().f_code.co_name)
+                    said("traceback during", own_traceback_frame)
+                    said("currentframe during", lambda: inspect.currentframe().f_code.co_name)
+                    # a function of the answer's with the grader's globals, saying the check ended: not the grader
+                    types.FunctionType(compile("sys.audit('rtt.check_end')", "answer", "exec"), vars(grader))()
+                    said("frame after its end", lambda: sys._getframe().f_code.co_name)
+                calls.append(axes)
+                forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+                return forward - turn, forward + turn
+
+            check_dpad_steering(dpad_track_velocities)
+            said("compile", lambda: compile("1", tutorial.__file__, "eval"))
+            said("replace", lambda: (lambda: 0).__code__.replace(co_filename=tutorial.__file__))
+            said("process", lambda: subprocess.run(["true"]).returncode)
+            with socket.socket() as s:
+                said("connect", lambda: s.connect_ex(("127.0.0.1", 9)) != 0)
+            threading.setprofile(lambda *a: None)  # a thread started with the answer's profiler
+            thread = threading.Thread(target=lambda: None)
+            thread.start()
+            thread.join()
+            """
+        )
+    )
+    asked = ("frame", "traceback", "currentframe", "compile", "replace", "process", "connect")
+    said = [line for line in done.stderr.splitlines() if line.split(" ")[0] in asked]
+    refused = "the grader's sandbox refused:"
+    assert said == [
+        "frame gave <lambda>",
+        "traceback gave own_traceback_frame",
+        f"frame during {refused} reading frames during a check",
+        f"traceback during {refused} reading tb_frame during a check",
+        f"currentframe during {refused} reading frames during a check",
+        f"frame after its end {refused} reading frames during a check",
+        f"compile {refused} code claiming to be the library's ({tutorial_file()})",
+        f"replace {refused} code claiming to be the library's ({tutorial_file()})",
+        "process gave 0",
+        "connect gave True",
+    ], done.stderr
+    notes = [line[1:] for line in signed_lines(done.stdout) if line[0] == "note"]
+    assert notes[-3:] == [
+        ["processes", "subprocess.Popen", ""],
+        ["network", "socket.connect", ""],
+        ["refused", "sys.setprofile", ""],  # in the thread
+    ], notes
+
+
+def tutorial_file() -> str:
+    """The file of the ``tutorial`` package this process imported (the one the sealed Python imports)."""
+    import tutorial
+
+    return tutorial.__file__
 
 
 def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():

@@ -96,7 +96,7 @@ def test_at_most_window_frames_in_flight_and_each_answer_lets_one_more_go():
     out = f.take(100.0)
     assert out is not None and unpack(out)[0]["matrix"][12] == 99.0, "the answer did not let the newest state go"
     assert f.take(100.0) is None
-    for _ in range(5):  # answers never add up past the window
+    for _ in range(WINDOW + 1):  # answers never add up past the window
         f.drawn()
     burst = 0
     for i in range(10):

@@ -11,7 +11,7 @@ viewer probe (``benchmarks/probes.py``) ride along.  A learner's browser is
 on their laptop, so here each learner's views are a client that does not
 draw: it opens the kernel's WebSocket through the hub's proxy, says hello
 to each view as widget.js does, and answers the frames with ``drawn`` as
-widget.js does (two at a time) as they arrive.  Its CPU is this machine's
+widget.js does (four at a time) as they arrive.  Its CPU is this machine's
 too, and is stated apart.
 
 Measured in a window common to every learner (after each has applied its
@@ -53,11 +53,13 @@ LEARNERS = (1, 2, 4, 8, 16)
 # ROS domains for the hub to give out: one upper block (215-232) and 101, clear of the 1-100 that test
 # sessions and the other benchmarks pick from.
 DOMAINS = (101, *range(215, 233))
-LONE_WAIT_MS = 100  # how long a lone frame waits for its answer: widget.js's LONE_WAIT_MS
-# The code path before the slice and lone-wait cuts of 2026-11-27, kept for a same-run baseline (--before;
-# rtt-joy's own cut is not undone): a view answered a lone frame two animation frames later, and a class's
-# simulation slept before every step (the hub's RTT_HUB_REALTIME_SLICE_MS).
-BEFORE = {"lone_wait_ms": 2000 / 60, "hub_env": {"RTT_HUB_REALTIME_SLICE_MS": "0.2"}}
+ANSWER_EVERY = 4  # frames answered at once: widget.js's ANSWER_EVERY
+LONE_WAIT_MS = 250  # how long the first frame owed waits for the others: widget.js's LONE_WAIT_MS
+# The code path before the cuts of 2026-11-27 and 28, kept for a same-run baseline (--before; rtt-joy's own cut
+# is not undone, and the kernel keeps today's window of eight frames): a view answered two frames at a time and
+# a lone frame two animation frames later, and a class's simulation slept before every step (the hub's
+# RTT_HUB_REALTIME_SLICE_MS).
+BEFORE = {"answer_every": 2, "lone_wait_ms": 2000 / 60, "hub_env": {"RTT_HUB_REALTIME_SLICE_MS": "0.2"}}
 
 # A learner's first cell: what notebook 03's set-up cell imports, and ROS 2 initialised.
 PREPARE = """\
@@ -125,13 +127,13 @@ class ViewClient:
     """One learner's kernel WebSocket, through the hub's proxy: runs cells, and answers its live views.
 
     It acts as widget.js does without drawing: a view's ``hello`` on its
-    comm's opening, then ``drawn`` for the frames as they arrive, two at a
-    time, a lone frame 0.1 s later.  Frames are counted with their
+    comm's opening, then ``drawn`` for the frames as they arrive,
+    ``answer_every`` at a time, or what is owed ``lone_wait_ms`` after the first.  Frames are counted with their
     arrival times (monotonic ns).  One asyncio task.
     """
 
-    def __init__(self, url: str, token: str, lone_wait_ms: float = LONE_WAIT_MS):
-        self.url, self.token, self.lone_wait_ms = url, token, lone_wait_ms
+    def __init__(self, url: str, token: str, lone_wait_ms: float = LONE_WAIT_MS, answer_every: int = ANSWER_EVERY):
+        self.url, self.token, self.lone_wait_ms, self.answer_every = url, token, lone_wait_ms, answer_every
         self.frames: list[tuple[int, int]] = []  # (arrival, ns; its buffers' bytes)
         self.scenes = 0
         self.views: list[str] = []
@@ -140,6 +142,7 @@ class ViewClient:
         self._errors: dict[str, str] = {}
         self._owed: dict[str, int] = {}  # comm id -> frames arrived and not answered yet
         self._settling: set[asyncio.Task] = set()  # the late answers' tasks, each kept until it is done
+        self._answered: dict[str, int] = {}  # comm id -> answers sent: a late answer overtaken by one ends
         self._ws = None
 
     async def connect(self) -> None:
@@ -190,9 +193,9 @@ class ViewClient:
                     self.frames.append((time.monotonic_ns(), size))
                     comm = content["comm_id"]
                     self._owed[comm] = self._owed.get(comm, 0) + 1
-                    if self._owed[comm] >= 2:
+                    if self._owed[comm] >= self.answer_every:
                         await self._settle(comm)
-                    else:
+                    elif self._owed[comm] == 1:
                         self._settle_later(comm)
                 elif body.get("type") == "scene":
                     self.scenes += 1
@@ -206,11 +209,13 @@ class ViewClient:
                     future.set_result(None)
 
     def _settle_later(self, comm: str) -> None:
-        """Answer a lone frame as widget.js does: 0.1 s later, unless a second came."""
+        """Answer what is owed as widget.js does: ``lone_wait_ms`` after the first, unless an answer came first."""
+        answered = self._answered.get(comm, 0)
 
         async def settle() -> None:
             await asyncio.sleep(self.lone_wait_ms / 1000)
-            await self._settle(comm)
+            if self._answered.get(comm, 0) == answered:
+                await self._settle(comm)
 
         task = asyncio.get_running_loop().create_task(settle())
         self._settling.add(task)
@@ -220,6 +225,7 @@ class ViewClient:
         from websockets.exceptions import ConnectionClosed
 
         owed, self._owed[comm] = self._owed.get(comm, 0), 0
+        self._answered[comm] = self._answered.get(comm, 0) + 1
         if owed:
             try:
                 await self._send(_custom(comm, {"type": "drawn", "frames": owed}))
@@ -303,11 +309,18 @@ def _pss_mb(procs: list[psutil.Process]) -> float:
 
 
 def one_class(
-    n: int, seconds: float, warmup: float, directory: Path, frame_rate: float | None = None, before: bool = False
+    n: int,
+    seconds: float,
+    warmup: float,
+    directory: Path,
+    frame_rate: float | None = None,
+    before: bool = False,
+    answers: tuple[int, float] | None = None,
 ) -> dict:
     """N learners at once: each one's figures, and the machine's (``frame_rate``: the hub's, else its default).
 
-    ``before``: the code path before the slice and lone-wait cuts (:data:`BEFORE`).
+    ``before``: the code path before the cuts of 2026-11-27 and 28 (:data:`BEFORE`).  ``answers``: the views'
+    ``(answer_every, lone_wait_ms)`` (default widget.js's; an A/B of them).
     """
     from tests.hub import Hub, Learner
 
@@ -330,8 +343,9 @@ def one_class(
             r = learner.api("POST", "api/kernels", json={"name": "python3"})
             r.raise_for_status()
             learner.kernel_id = r.json()["id"]
-        lone_wait_ms = BEFORE["lone_wait_ms"] if before else LONE_WAIT_MS
-        return asyncio.run(_measure(hub, learners, seconds, warmup, directory, lone_wait_ms))
+        if answers is None:
+            answers = (BEFORE["answer_every"], BEFORE["lone_wait_ms"]) if before else (ANSWER_EVERY, LONE_WAIT_MS)
+        return asyncio.run(_measure(hub, learners, seconds, warmup, directory, answers))
     except BaseException:
         print(f"the hub's log, its end:\n{hub.log()[-3000:]}", file=sys.stderr)
         raise
@@ -339,12 +353,12 @@ def one_class(
         hub.close()
 
 
-async def _measure(hub, learners, seconds: float, warmup: float, directory: Path, lone_wait_ms: float) -> dict:
+async def _measure(hub, learners, seconds: float, warmup: float, directory: Path, answers: tuple[int, float]) -> dict:
     n = len(learners)
     clients = []
     for learner in learners:
         url = f"ws://127.0.0.1:{hub.port}/user/{learner.name}/api/kernels/{learner.kernel_id}/channels"
-        client = ViewClient(url, learner.token, lone_wait_ms)
+        client = ViewClient(url, learner.token, answers[1], answers[0])
         await client.connect()
         clients.append(client)
     probes = [directory / f"{learner.name}.json" for learner in learners]
@@ -457,7 +471,12 @@ def _in_window(p: dict, window: tuple[int, int]) -> dict:
 
 
 def learners_per_server(
-    counts, seconds: float, warmup: float, frame_rate: float | None = None, before: bool = False
+    counts,
+    seconds: float,
+    warmup: float,
+    frame_rate: float | None = None,
+    before: bool = False,
+    answers: tuple[int, float] | None = None,
 ) -> dict:
     """The class sizes in turn; each one's figures.
 
@@ -470,7 +489,7 @@ def learners_per_server(
     for n in counts:
         try:
             with tempfile.TemporaryDirectory() as d:
-                out[str(n)] = one_class(n, seconds, warmup, Path(d), frame_rate, before)
+                out[str(n)] = one_class(n, seconds, warmup, Path(d), frame_rate, before, answers)
         except Exception as error:  # noqa: BLE001 - kept as this size's result, with what went wrong
             out[str(n)] = {"learners": n, "failed": f"{type(error).__name__}: {error}"[:500]}
             print(f"{n:3d} learners: the class failed ({out[str(n)]['failed']}); no larger class tried", flush=True)
@@ -487,7 +506,7 @@ def learners_per_server(
             + f"frames/s min {r['frames_per_s_min']:.1f}, "
             f"{r['memory_mb_per_learner_mean']:.0f} MB/learner, {r['cores_per_learner']:.3f} cores/learner, "
             f"{r['cores_busy']:.2f} cores busy (client {r['client_cores']:.2f})"
-            + (" [before the slice and lone-wait cuts]" if before else ""),
+            + (" [before the cuts of 2026-11-27 and 28]" if before else ""),
             flush=True,
         )
     return out
@@ -501,9 +520,17 @@ def main(argv=None) -> int:
     p.add_argument("--frame-rate", type=float, default=None, help="the live views' frames/s (default: the hub's)")
     p.add_argument("--output", default=None, help="a folder: learners.json and its plot, bench_learners.png")
     p.add_argument(
-        "--before", action="store_true", help="also one learner before the slice and lone-wait cuts (BEFORE)"
+        "--before", action="store_true", help="also one learner before the cuts of 2026-11-27 and 28 (BEFORE)"
+    )
+    p.add_argument(
+        "--answers",
+        type=float,
+        nargs=2,
+        metavar=("EVERY", "WAIT_MS"),
+        help="the views answer EVERY frames at once, or what they owe WAIT_MS after the first (default widget.js's)",
     )
     args = p.parse_args(argv)
+    answers = None if args.answers is None else (int(args.answers[0]), args.answers[1])
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))  # the hub gives each learner theirs
     from benchmarks.plots import plot_learners
@@ -515,7 +542,8 @@ def main(argv=None) -> int:
         "when": time.strftime("%Y-%m-%d %H:%M"),
         "commit": _commit(),
         "frame_rate": args.frame_rate,
-        "learners": learners_per_server(args.learners, args.seconds, args.warmup, args.frame_rate),
+        "answers": answers,
+        "learners": learners_per_server(args.learners, args.seconds, args.warmup, args.frame_rate, answers=answers),
     }
     if args.before:
         r["learners_before"] = learners_per_server([1], args.seconds, args.warmup, args.frame_rate, before=True)

@@ -76,7 +76,7 @@ def trusted_modules(checks: list[str] | None = None) -> list[types.ModuleType]:
     wanted, done = ["tutorial.exercises.grader", *checks], set()
     while wanted:  # each module, and the tutorial modules it imports anywhere (inside a check, lazily) too
         name = wanted.pop()
-        if name in done or name.rsplit(".", 1)[-1] in ("seal", "sealed_kernel"):
+        if name in done:
             continue
         done.add(name)
         module = importlib.import_module(name)

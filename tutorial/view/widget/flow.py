@@ -13,14 +13,15 @@ animation frame of its own, and less on a slow machine or a slow link.
   away, and what goes out is always the newest state, never a queue of
   old ones.
 - **it sends only what the browser can draw.**  A view answers the frames
-  it has drawn with ``drawn`` (two at a time, or a lone one 0.1 s later:
-  each message to the kernel costs it a busy and an idle status on its
-  connection).  The flow keeps at most :data:`WINDOW` frames
-  in flight: two drawn and not answered yet, and two more on their way, so
-  that neither the answer's trip back to the kernel cuts the frame rate nor
-  a state waits here for it (with room for one on its way, not two, one
-  tank's view had a p99 1.23x to 1.31x the meshcat page's, against 1.12x
-  to 1.22x: the Benchmarks page, *Live views in the notebook*).  A
+  it has drawn with ``drawn`` (four at a time, or what it owes 0.25 s after
+  the first: each message to the kernel costs it a busy and an idle status
+  on its connection, each relayed by the Jupyter server).  The flow keeps
+  at most :data:`WINDOW` frames in flight: four drawn and not answered yet,
+  and four more on their way, so that neither the answer's trip back to
+  the kernel cuts the frame rate nor a state waits here for it (with room
+  for one on its way, not two, one tank's view had a p99 1.23x to 1.31x the
+  meshcat page's, against 1.12x to 1.22x, when a view answered two at a
+  time: the Benchmarks page, *Live views in the notebook*).  A
   slow browser or link therefore gets fewer frames, each the newest
   state; a tab that closed, or hid, gets nothing more until a view says
   ``hello`` again.
@@ -50,7 +51,7 @@ import umsgpack
 
 from tutorial.view.meshcat_batch import pack_batch
 
-WINDOW = 4  # frames sent and not yet answered, at most (a view answers two frames at a time)
+WINDOW = 8  # frames sent and not yet answered, at most (a view answers four frames at a time: widget.js)
 BUSY_RATE = 10.0  # frames/s sent while the kernel runs a cell (no answers can arrive then)
 BUSY_UNANSWERED = 600  # frames sent in a row with no answer, while busy, before the flow stops (a minute)
 KINDS = ("set_transform", "set_object", "set_property", "delete", "set_animation")

@@ -5,11 +5,12 @@
 // lighter drawing without a GPU).  The kernel sends meshcat's own commands, packed with msgpack, as the
 // buffers of one widget message a frame.  The view answers the frames it has drawn with "drawn" (how
 // many), which is what lets the kernel send the next: a slow browser gets fewer frames, never a queue.
-// It answers two frames at a time, or a lone frame 0.1 s after it was drawn (LONE_WAIT_MS): the
-// kernel publishes a busy and an idle status for every message it is sent, so an answer per frame would
-// double the traffic on the kernel's connection and slow the frames themselves (the Benchmarks page, "Live
-// views in the notebook").  At a class server's 20 frames/s the next frame comes first, so a view answers
-// ten times a second, not twenty; the kernel keeps four frames in flight, so waiting holds no frame back.
+// It answers four frames at a time (ANSWER_EVERY), or what it owes 0.25 s after the first of them was
+// drawn (LONE_WAIT_MS): the kernel publishes a busy and an idle status for every message it is sent, and
+// the Jupyter server relays each of them, so an answer per frame would double the traffic on the kernel's
+// connection and slow the frames themselves (the Benchmarks page, "Live views in the notebook").  At a
+// class server's 20 frames/s a view answers five times a second, not twenty; the kernel keeps eight
+// frames in flight, so waiting holds no frame back.
 // A view that opens (a page reload, a second tab) says "hello" and is sent the whole scene.
 //
 // A message the view cannot take (not a meshcat command, a buffer over the limit, a set_transforms to a
@@ -19,7 +20,8 @@ const PAGE_SCRIPT = __PAGE_SCRIPT__;
 const LIMITS = __LIMITS__;
 const KNOWN = ["set_transform", "set_transforms", "set_object", "set_property", "delete", "set_animation"];
 const SCRIPT_KEY = "__rttMeshcatViewerScript";
-const LONE_WAIT_MS = 100;  // how long a lone drawn frame waits for a second one before it is answered, ms
+const ANSWER_EVERY = 4;  // frames drawn that are answered at once: half the kernel's window (flow.py's WINDOW)
+const LONE_WAIT_MS = 250;  // how long the first frame owed waits for the others before what is owed is answered, ms
 
 // meshcat's viewer script as a blob: URL, asked of the kernel once per browser page and shared by every view.
 function viewerScript(model) {
@@ -202,7 +204,8 @@ function render({ model, el }) {
   // A benchmark's probe (benchmarks/experiments/widget.py sets window.rttProbe to an array): for each
   // frame, [its number, when it arrived, when it was drawn], on this page's clock, ms.
   const now = () => performance.timeOrigin + performance.now();
-  let owed = 0;  // frames drawn and not answered yet: at most one, for about LONE_WAIT_MS
+  let owed = 0;  // frames drawn and not answered yet: fewer than ANSWER_EVERY, for about LONE_WAIT_MS at most
+  let answered = 0;  // answers sent: a wait for owed frames that an answer overtook ends without answering
   const settle = () => {
     try {
       if (!gone && owed > 0) model.send({ type: "drawn", frames: owed });
@@ -210,6 +213,7 @@ function render({ model, el }) {
       // cut off its kernel (restarted): nothing to answer; the comm_live_update watch says so
     }
     owed = 0;
+    answered += 1;
   };
   const answer = (n) => {
     const probe = Array.isArray(window.rttProbe) && n !== undefined ? [n, now(), null] : null;
@@ -220,12 +224,17 @@ function render({ model, el }) {
     view.requestAnimationFrame(() => {
       if (probe) probe[2] = now();
       owed += 1;
-      if (owed >= 2) {
+      if (owed >= ANSWER_EVERY) {
         settle();
-      } else {  // a lone frame: answered with the next one, or LONE_WAIT_MS from now (in an animation frame,
-        // so a hidden tab answers nothing, whatever its display's refresh rate)
+      } else if (owed === 1) {  // the first owed: answered with the others, or LONE_WAIT_MS from now (in an
+        // animation frame, so a hidden tab answers nothing, whatever its display's refresh rate)
         const drawnAt = performance.now();
-        const wait = () => (performance.now() - drawnAt >= LONE_WAIT_MS ? settle() : view.requestAnimationFrame(wait));
+        const answer = answered;
+        const wait = () => {
+          if (answered !== answer) return;  // answered meanwhile, with the others
+          if (performance.now() - drawnAt >= LONE_WAIT_MS) settle();
+          else view.requestAnimationFrame(wait);
+        };
         view.requestAnimationFrame(wait);
       }
     });

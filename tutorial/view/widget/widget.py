@@ -18,7 +18,7 @@ page, drawn by meshcat's own three.js viewer taken from the meshcat wheel
 What travels: each frame is one widget message whose binary buffers are
 meshcat's commands, packed as meshcat packs them (a frame's transforms as
 one ``set_transforms``: :mod:`tutorial.view.meshcat_batch`).  Coalescing,
-at most four frames in flight and the scene kept for a page that opens later are
+at most eight frames in flight and the scene kept for a page that opens later are
 :class:`tutorial.view.widget.flow.FrameFlow`'s.  meshcat's viewer script
 (850 kB) goes once per browser page, when its first view asks.
 
