@@ -7,6 +7,7 @@
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make mutate (mutation testing of the lessons, the library's core and every exercise's check: hours),
+#       make mutate-seal (the same for the grading kernel's seal, in a worktree of its own: two hours, SAMPLE=N),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does 01; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
@@ -25,7 +26,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: image hub-containers test-containers demo test test-fast test-more test-lab test-hub test-robots test-grade mutate assignments grade test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
+.PHONY: image hub-containers test-containers demo test test-fast test-more test-lab test-hub test-robots test-grade mutate mutate-seal assignments grade test-latest fuzz lint lock hub notebooks book bench bench-figures export run-notebooks venv clean
 
 UV_VERSION := 0.13.9
 
@@ -110,6 +111,12 @@ grade: $(VENV)/.installed
 mutate: $(VENV)/.installed
 	RTT_TEST_MODE=1 $(VENV)/bin/mutmut run
 	$(PY) scripts/mutation_report.py
+
+# The grading kernel's seal, which make mutate cannot reach (its tests run it in a Python of its own), in a git
+# worktree beside this one (scripts/mutate_seal.py says how): about two hours for its 1,025 mutants; SAMPLE=N runs
+# N of them drawn at random.
+mutate-seal: $(VENV)/.installed
+	$(PY) scripts/mutate_seal.py $(if $(SAMPLE),--sample $(SAMPLE))
 
 # The cases make test leaves out to stay under 10 minutes, each of a kind make test keeps one real case of
 # (marked "more": two more faults, two more network set-ups, one more robot across processes, and the mistakes

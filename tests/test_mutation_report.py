@@ -60,3 +60,20 @@ def test_every_listed_equivalent_mutant_names_a_function_that_exists_and_says_wh
             target = getattr(module, function.removeprefix("x_"))
         assert inspect.isfunction(target), name
         assert len(why) > 20, name
+
+
+def test_a_sample_counts_only_the_mutants_it_ran_and_a_list_of_another_runs_modules_is_not_stale(
+    tmp_path, monkeypatch, capsys
+):
+    """scripts/mutate_seal.py runs a sample of the seal's mutants: the rest are not counted, and the listed
+    equivalents of make mutate's modules are not called stale there (nor the seal's in make mutate)."""
+    report = load_report()
+    status = {"pkg.mod.x_f__mutmut_1": "killed", "pkg.mod.x_f__mutmut_2": "not checked"}
+    monkeypatch.setattr(report, "results", lambda: status)
+    listed = tmp_path / "equivalent.toml"
+    listed.write_text('"other.mod.x_g__mutmut_1" = "of another run"\n"pkg.mod.x_f__mutmut_9" = "gone"\n')
+    monkeypatch.setattr(report, "EQUIVALENT", listed)
+    assert report.main([]) == 0
+    out = capsys.readouterr().out
+    assert "1 mutants: 1 caught (100.0%)" in out and "1 more not run (not counted)" in out
+    assert "(stale): pkg.mod.x_f__mutmut_9" in out and "other.mod" not in out

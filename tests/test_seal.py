@@ -124,6 +124,13 @@ def test_the_seal_trusts_the_modules_a_check_imports_only_when_it_runs():
     lazily = {"tutorial.notebook.runs", "tutorial.app.reference.tank_controller", "tutorial.joystick.scripted"}
     assert lazily <= trusted, lazily - trusted
     assert "tutorial.exercises.step1_tank_controller" not in trusted  # only the checks named, and the grader
+    done = sealed(
+        "import sys\n"
+        "from tutorial.exercises import seal\n"
+        "seal.install(b'k' * 32, 1, [], checks=['tutorial.exercises.step1_tank_controller'])\n"
+        "print(*sorted(n for n in sys.modules if n.startswith('tutorial.exercises.step')))"
+    )
+    assert done.stdout.split() == ["tutorial.exercises.step1_tank_controller"]  # install imports only those named
 
 
 def test_an_answer_reading_the_projects_and_models_is_not_noted_and_one_reading_elsewhere_is(tmp_path):

@@ -1,0 +1,121 @@
+"""``make mutate-seal``: mutation testing of the grading kernel's seal, which ``make mutate`` cannot reach.
+
+    python scripts/mutate_seal.py [--dir DIR] [--sample N] [--seed S]
+
+The seal (``tutorial/exercises/seal.py``) is tested in a Python of its own
+(``tests/test_seal.py``: a sealed process stays sealed), where mutmut sees
+neither which test reaches which function nor, as it runs, the function it
+wraps.  This makes a git worktree of HEAD in ``DIR`` (default: beside this
+repository; not under ``/tmp/``, which the seal lets an answer read, so the
+tests of what it notes hold there), whose ``[tool.mutmut]`` mutates only the
+seal with ``tests/test_seal.py`` as the tests, and there:
+
+1. lets mutmut write its mutants (that first run stops: ``install`` rebuilds
+   ``_make_hook`` from its code with private globals, and mutmut's wrapper
+   around it is a closure);
+2. makes ``install``, in mutmut's copy, rebuild the ``_make_hook`` of the
+   mutant under test (``MUTANT_UNDER_TEST``, which the sealed Python inherits;
+   its working folder, mutmut's copy, is the first place it imports from);
+3. tells mutmut, in its copy of ``tests/test_seal.py``, that the seal's tests
+   reach every function of the seal (mutmut counts calls in its own process,
+   and the sealed Python of that count runs the original);
+4. runs mutmut on every mutant, or on a seeded sample of ``N``, then
+   ``scripts/mutation_report.py`` there.
+
+About 7 s a mutant on two cores: the seal's 1,025 take about two hours.
+Remove the worktree with ``git worktree remove --force DIR``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import random
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SEAL = "tutorial/exercises/seal.py"
+HOOK = """
+
+def _rtt_make_hook_code():  # scripts/mutate_seal.py: the code of the mutant under test's _make_hook
+    name = os.environ.get("MUTANT_UNDER_TEST", "")
+    prefix = "tutorial.exercises.seal.x__make_hook__mutmut_"
+    if name.startswith(prefix):
+        return globals()["x__make_hook__mutmut_" + name[len(prefix):]].__code__
+    return x__make_hook__mutmut_orig.__code__
+"""
+REACHED = """    if os.environ.get("MUTANT_UNDER_TEST") == "stats":  # scripts/mutate_seal.py: the child is not seen
+        env["MUTANT_UNDER_TEST"] = ""  # the child runs the original: mutmut counts calls in this process only
+        from mutmut.stats import record_trampoline_hit
+
+        for name in {names!r}:
+            record_trampoline_hit("tutorial.exercises.seal." + name)
+"""
+
+
+def configure(tree: Path) -> None:
+    """The worktree's ``[tool.mutmut]``: only the seal, only its tests."""
+    path = tree / "pyproject.toml"
+    text = path.read_text()
+    text = re.sub(r"only_mutate = \[.*?\]\n", f'only_mutate = ["{SEAL}"]\n', text, count=1, flags=re.S)
+    text = re.sub(
+        r"pytest_add_cli_args_test_selection = \[.*?\]\n",
+        'pytest_add_cli_args_test_selection = ["-m", "", "tests/test_seal.py"]\n',
+        text,
+        count=1,
+        flags=re.S,
+    )
+    path.write_text(text)
+
+
+def patch_mutants(tree: Path) -> None:
+    """Steps 2 and 3 of the module text, on mutmut's copy (each once)."""
+    seal = tree / "mutants" / SEAL
+    text = seal.read_text()
+    if "_rtt_make_hook_code" not in text:
+        if "_make_hook.__code__" not in text:
+            raise SystemExit(f"{seal}: no _make_hook.__code__ to replace: has install() changed?")
+        seal.write_text(text.replace("_make_hook.__code__", "_rtt_make_hook_code()") + HOOK)
+    names = sorted(set(re.findall(r"^def (x_\w+?)__mutmut_orig\(", seal.read_text(), flags=re.M)))
+    for tests in (tree / "tests" / "test_seal.py", tree / "mutants" / "tests" / "test_seal.py"):  # mutmut copies
+        text = tests.read_text()
+        if "record_trampoline_hit" not in text:
+            anchor = "    done = subprocess.run("
+            if text.count(anchor) != 1:
+                raise SystemExit(f"{tests}: sealed() no longer runs {anchor.strip()!r} once")
+            tests.write_text(text.replace(anchor, REACHED.format(names=tuple(names)) + anchor))
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--dir", type=Path, default=ROOT.parent / f"{ROOT.name}-mutate-seal")
+    p.add_argument("--sample", type=int, default=None, help="run only N mutants, drawn at random (default all)")
+    p.add_argument("--seed", type=int, default=20261128, help="the sample's seed")
+    args = p.parse_args(argv)
+    tree = args.dir.resolve()
+    if str(tree).startswith("/tmp/"):
+        raise SystemExit("--dir under /tmp/: the seal allows an answer to read there, and its tests need it not to")
+    env = dict(os.environ, ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST", RTT_TEST_MODE="1")
+    env.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 100)))
+    if not tree.exists():
+        subprocess.run(["git", "worktree", "add", "--detach", str(tree), "HEAD"], cwd=ROOT, check=True)
+        (tree / ".venv").symlink_to(ROOT / ".venv")
+        configure(tree)
+    mutmut = [str(tree / ".venv" / "bin" / "mutmut")]
+    if not (tree / "mutants" / SEAL).exists():
+        subprocess.run([*mutmut, "run"], cwd=tree, env=env, check=False)  # stops at its clean tests: step 1
+    patch_mutants(tree)
+    names = []
+    if args.sample is not None:
+        listed = subprocess.run([*mutmut, "results", "--all", "true"], cwd=tree, capture_output=True, text=True)
+        every = sorted(line.split(":")[0].strip() for line in listed.stdout.splitlines() if "__mutmut_" in line)
+        names = sorted(random.Random(args.seed).sample(every, min(args.sample, len(every))))
+    subprocess.run([*mutmut, "run", "--max-children", str(os.cpu_count() or 1), *names], cwd=tree, env=env)
+    return subprocess.run([sys.executable, str(tree / "scripts" / "mutation_report.py")], cwd=tree).returncode
+
+
+if __name__ == "__main__":
+    sys.exit(main())
