@@ -104,6 +104,11 @@ def main(argv=None) -> int:
         subprocess.run(["git", "worktree", "add", "--detach", str(tree), "HEAD"], cwd=ROOT, check=True)
         (tree / ".venv").symlink_to(ROOT / ".venv")
         configure(tree)
+    heads = [
+        subprocess.run(["git", "rev-parse", "HEAD"], cwd=d, capture_output=True, text=True).stdout for d in (ROOT, tree)
+    ]
+    if heads[0] != heads[1]:
+        raise SystemExit(f"{tree} is not at this repository's HEAD: remove it (git worktree remove --force {tree})")
     mutmut = [str(tree / ".venv" / "bin" / "mutmut")]
     if not (tree / "mutants" / SEAL).exists():
         subprocess.run([*mutmut, "run"], cwd=tree, env=env, check=False)  # stops at its clean tests: step 1

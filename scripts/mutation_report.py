@@ -57,11 +57,11 @@ def main(argv=None) -> int:
     p.add_argument("--write", help="also write the figures as JSON here")
     args = p.parse_args(argv)
     status = results()
-    unchecked = [n for n, s in status.items() if s == "not checked"]  # a run stopped, or a sample's (mutate_seal.py)
-    status = {n: s for n, s in status.items() if s != "not checked"}
     equivalent = tomllib.loads(EQUIVALENT.read_text()) if EQUIVALENT.exists() else {}
     mutated = {module(n) for n in status}
     unknown = sorted(n for n in set(equivalent) - set(status) if module(n) in mutated)  # of another run: not stale
+    unchecked = [n for n, s in status.items() if s == "not checked"]  # a run stopped, or a sample's (mutate_seal.py)
+    status = {n: s for n, s in status.items() if s != "not checked"}
     by_module: dict[str, Counter] = defaultdict(Counter)
     for name, s in status.items():
         by_module[module(name)][s] += 1
@@ -75,7 +75,8 @@ def main(argv=None) -> int:
     left = {n: s for n, s in status.items() if s not in CAUGHT}
     excused = {n for n in left if n in equivalent}
     score = caught / max(1, total - len(excused))
-    print(f"\n{total} mutants: {caught} caught ({caught / total:.1%}); {len(excused)} equivalent (listed with why)")
+    share = caught / max(1, total)
+    print(f"\n{total} mutants: {caught} caught ({share:.1%}); {len(excused)} equivalent (listed with why)")
     if unchecked:
         print(f"{len(unchecked)} more not run (not counted)")
     print(f"score, equivalent ones left out: {score:.1%} (target {TARGET:.0%})")

@@ -145,7 +145,7 @@ def test_scene_and_frames_draw_and_each_is_answered(view):
 def test_two_frames_drawn_together_are_answered_once_and_a_lone_frame_on_its_own(view):
     page, errors = view
     frame(page, [pack_batch([move(0.5)])])  # whatever was owed before is answered
-    page.wait_for_timeout(300)  # six animation frames at 60 Hz (0.1 s) and more: no answer left owed
+    page.wait_for_timeout(600)  # the wait for owed frames (0.25 s) and more: no answer left owed
     before = page.evaluate("window.sent.length")
     page.evaluate(  # two frames in one task: drawn in the same animation frame
         "([a, b]) => { for (const m of [a, b]) window.deliver({type: 'frame'}, "

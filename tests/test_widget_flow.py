@@ -106,7 +106,7 @@ def test_at_most_window_frames_in_flight_and_each_answer_lets_one_more_go():
 
 
 def test_an_answer_for_two_frames_lets_two_go_and_a_bad_count_counts_as_one(widget):
-    """A view answers two drawn frames at once ({"type": "drawn", "frames": 2}); its count is never trusted."""
+    """A view answers several drawn frames at once ({"type": "drawn", "frames": 2}); its count is never trusted."""
     vis = widget.visualizer()
     vis["box"].set_object(g.Box([0.1, 0.2, 0.3]))
     widget._on_message(widget, {"type": "hello", "id": "v1"}, [])

@@ -189,16 +189,17 @@ class ViewClient:
                     await self._send(_custom(content["comm_id"], {"type": "hello", "id": "bench"}))
             elif kind == "comm_msg" and content.get("data", {}).get("method") == "custom":
                 body = content["data"].get("content", {})
-                if body.get("type") == "frame":
-                    self.frames.append((time.monotonic_ns(), size))
+                if body.get("type") in ("frame", "scene"):  # widget.js answers a scene as a frame drawn
+                    if body.get("type") == "frame":
+                        self.frames.append((time.monotonic_ns(), size))
+                    else:
+                        self.scenes += 1
                     comm = content["comm_id"]
                     self._owed[comm] = self._owed.get(comm, 0) + 1
                     if self._owed[comm] >= self.answer_every:
                         await self._settle(comm)
                     elif self._owed[comm] == 1:
                         self._settle_later(comm)
-                elif body.get("type") == "scene":
-                    self.scenes += 1
             elif parent in self._out and kind == "stream":
                 self._out[parent].append(content["text"])
             elif parent in self._waiting and kind == "error":

@@ -112,6 +112,7 @@ def scripted_drive(name: str, cls, parameters: dict, node: CapturingNode, script
         The ``App`` that ran (:func:`tutorial.notebook.runs.run_headless`).
 
     Raises:
+        tutorial.core.project.ProjectError: the project refuses ``cls`` or ``parameters`` (``node`` destroyed).
         tutorial.app.app.ControllerError: the learner's controller refused to configure (or raised there).
         tutorial.exercises.grader.CaseFailed: the simulation failed.
     """
@@ -120,7 +121,11 @@ def scripted_drive(name: str, cls, parameters: dict, node: CapturingNode, script
     from tutorial.joystick.scripted import ScriptedJoy
     from tutorial.notebook.runs import load, run_headless
 
-    project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
+    try:
+        project = load("tank_world.yaml").with_controller("Tank", name, cls, parameters)
+    except BaseException:  # a parameter or class the project refuses: the run that would destroy the node never starts
+        node.destroy_node()
+        raise
     tank = RttTankController()
     attach = [("Tank", "ScriptedJoy", ScriptedJoy(tank, script=script)), ("Tank", "RttTankController", tank)]
     attach = ([("Tank", "First", first)] if first is not None else []) + attach + [("Tank", "Probe", probe)]

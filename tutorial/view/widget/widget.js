@@ -229,9 +229,9 @@ function render({ model, el }) {
       } else if (owed === 1) {  // the first owed: answered with the others, or LONE_WAIT_MS from now (in an
         // animation frame, so a hidden tab answers nothing, whatever its display's refresh rate)
         const drawnAt = performance.now();
-        const answer = answered;
+        const since = answered;
         const wait = () => {
-          if (answered !== answer) return;  // answered meanwhile, with the others
+          if (answered !== since) return;  // answered meanwhile, with the others
           if (performance.now() - drawnAt >= LONE_WAIT_MS) settle();
           else view.requestAnimationFrame(wait);
         };
@@ -313,6 +313,8 @@ function render({ model, el }) {
     if (!win || typeof win.viewer === "undefined") return;  // the empty page before srcdoc
     viewer = win.viewer;
     stats.page = win.rttPage;
+    owed = 0;  // what the old page drew: its wait died with it, and the hello's scene starts the window afresh
+    answered += 1;
     model.send({ type: "hello", id });
   });
   // While this view is on a page someone can see, it says so now and then: a run that no page shows
