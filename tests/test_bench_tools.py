@@ -72,7 +72,7 @@ def test_learners_targets_and_plot(tmp_path):
            "learners_before": {"1": one(1, 1.0, 0.9, 277, cores=0.49)}}  # fmt: skip
     rtf, age, memory, cores = (t.row(run) for t in LEARNERS_TARGETS)
     assert rtf["pass"] and age["pass"] and memory["pass"] and cores["pass"] and age["measured"] == "32.9 ms"
-    assert cores["measured"] == "0.190 cores" and "lone-wait cuts 0.490 cores" in cores["baseline"]
+    assert cores["measured"] == "0.190 cores" and "cuts of 2026-11-27 and 28 0.490 cores" in cores["baseline"]
     failed_before = dict(run, learners_before={"1": {"learners": 1, "failed": "TimeoutError: ..."}})
     assert (
         LEARNERS_TARGETS[3].row(failed_before)["pass"] and LEARNERS_TARGETS[3].row(failed_before)["baseline"] == "n/a"
