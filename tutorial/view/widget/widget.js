@@ -20,7 +20,7 @@ const PAGE_SCRIPT = __PAGE_SCRIPT__;
 const LIMITS = __LIMITS__;
 const KNOWN = ["set_transform", "set_transforms", "set_object", "set_property", "delete", "set_animation"];
 const SCRIPT_KEY = "__rttMeshcatViewerScript";
-const ANSWER_EVERY = 4;  // frames drawn that are answered at once: half the kernel's window (flow.py's WINDOW)
+const ANSWER_EVERY = __ANSWER_EVERY__;  // frames drawn that are answered at once: half flow.py's WINDOW (widget.py)
 const LONE_WAIT_MS = 250;  // how long the first frame owed waits for the others before what is owed is answered, ms
 
 // meshcat's viewer script as a blob: URL, asked of the kernel once per browser page and shared by every view.

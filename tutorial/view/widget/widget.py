@@ -44,7 +44,7 @@ import traitlets
 
 from tutorial.view import meshcat_batch
 from tutorial.view.meshcat_page import PAGE_SCRIPT, viewer_script_gzip
-from tutorial.view.widget.flow import FrameFlow
+from tutorial.view.widget.flow import WINDOW, FrameFlow
 from tutorial.view.widget.subshell import ViewSubshell, current_kernel
 
 # What a view takes in one command (widget.js refuses more and says so): a mesh of a few hundred
@@ -60,8 +60,10 @@ LIMITS = {
 
 
 def _esm() -> str:
-    """widget.js with the page script and the limits written in (JavaScript literals)."""
+    """widget.js with the page script, the limits and how many frames a view answers at once written in (half the
+    flow's window: as many more are on their way meanwhile), as JavaScript literals."""
     source = (Path(__file__).with_name("widget.js")).read_text(encoding="utf-8")
+    source = source.replace("__ANSWER_EVERY__", str(WINDOW // 2))
     return source.replace("__PAGE_SCRIPT__", json.dumps(PAGE_SCRIPT)).replace("__LIMITS__", json.dumps(LIMITS))
 
 
