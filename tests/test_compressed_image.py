@@ -17,7 +17,8 @@ from tutorial.interfaces.compressed_image import (
     fill_compressed_image,
 )
 from tutorial.interfaces.image import ImageError
-from tutorial.view.images import ImageReceiver, format_image_status, transport_topic
+from tutorial.view.image_files import format_image_status
+from tutorial.view.images import ImageReceiver, transport_topic
 
 
 def picture(h: int = 48, w: int = 64) -> np.ndarray:

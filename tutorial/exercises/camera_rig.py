@@ -155,8 +155,6 @@ class Rig:
 
     def close(self) -> None:
         """Stop the controller as the simulation would, end its render thread, remove the node."""
-        from tutorial.controllers.camera_image_publisher import RttCameraImagePublisher
-
         c = self.controller
         try:
             if getattr(self, "steps", 0):
@@ -165,7 +163,9 @@ class Rig:
                 c.unconfigure()
         finally:
             if getattr(c, "thread", None) is not None and c.thread.is_alive():
-                RttCameraImagePublisher.finish_rendering(c)  # a broken unconfigure must not leave it running
+                c.finishing = True  # a broken unconfigure must not leave it running: as finish_rendering() does,
+                if getattr(c, "loop", None) is not None:  # the answer's own override left out
+                    c.loop.wake()
                 c.thread.join(5.0)
             self.node.destroy_node()
 
@@ -185,12 +185,17 @@ def references(rig: Rig) -> list[np.ndarray]:
     """``(H, W, 3)`` uint8 pictures of the rig's camera at each of its poses, rendered on this thread."""
     import mujoco
 
-    from tutorial.controllers.camera_image_publisher import render_snapshot
-    from tutorial.core.simulator import Snapshot
-
     renderer = mujoco.Renderer(rig.model, rig.camera.height, rig.camera.width)
     try:
         data = mujoco.MjData(rig.model)
-        return [render_snapshot(renderer, data, Snapshot(t, q, 0), rig.camera_id).copy() for t, q in rig.poses]
+        pictures = []
+        for t, qpos in rig.poses:  # posed from qpos alone, as the lesson's render_snapshot() does: no physics
+            data.qpos[:], data.time = qpos, t
+            mujoco.mj_kinematics(rig.model, data)
+            mujoco.mj_comPos(rig.model, data)  # centres of mass, for tracking cameras
+            mujoco.mj_camlight(rig.model, data)
+            renderer.update_scene(data, camera=rig.camera_id)
+            pictures.append(renderer.render().copy())
+        return pictures
     finally:
         renderer.close()

@@ -263,9 +263,10 @@ def check_wrong_model(cls) -> Result:
 
     def hidden_cases(rng):
         """Random runs of messages, the tank's, the crane's and mixed ones, judged by the lesson's subscriber
-        (what it applies and counts) plus the statement's rule (another model's message is refused whole).  The
-        first run also has the two messages of :func:`_sure_messages`, each at a drawn place."""
-        from tutorial.controllers.joint_state_subscriber import RttJointStateSubscriber
+        (what it applies and counts: its frozen copy, ``app/reference``) plus the statement's rule (another model's
+        message is refused whole).  The first run also has the two messages of :func:`_sure_messages`, each at a
+        drawn place."""
+        from tutorial.app.reference.joint_state_subscriber import RttJointStateSubscriber
 
         for k in range(8):
             run = _random_run(rng)

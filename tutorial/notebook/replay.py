@@ -43,6 +43,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from tutorial.view.meshcat_overlays import key_frames
 from tutorial.view.meshcat_page import LIGHTEN_SCRIPT, UNHOOK_SCRIPT, viewer_script_gzip
 
 DECIMALS = 4  # animation values: 0.1 mm, 1e-4 of a unit quaternion
@@ -204,7 +205,7 @@ def record_replay(
     poses = np.round(poses, DECIMALS) + 0.0  # + 0.0: no -0.0 in the page
     animation = Animation(default_framerate=fps)
     for k, body in enumerate(bodies):
-        keep = _key_frames(poses[:, k])
+        keep = key_frames(poses[:, k])
         clip = AnimationClip(fps=fps)
         for frame in keep:
             clip.set_property(int(frame), "position", "vector3", poses[frame, k, :3].tolist())
@@ -216,21 +217,6 @@ def record_replay(
         add_arrow_clips(vis, overlays, overlay_frames, animation, fps, decimals=DECIMALS)
     vis.set_animation(animation, play=True, repetitions=np.inf)
     return recording
-
-
-def _key_frames(track: np.ndarray) -> np.ndarray:
-    """Indices of the frames a body needs a key at: where its pose differs from a neighbour's.
-
-    A body that holds still between two keys is drawn still by the
-    animation's interpolation, so the frames in the middle of a hold are dropped.
-    """
-    n = len(track)
-    changed = np.any(track[1:] != track[:-1], axis=1)  # frame i+1 differs from frame i
-    keep = np.zeros(n, dtype=bool)
-    keep[[0, n - 1]] = True
-    keep[1:] |= changed
-    keep[:-1] |= changed
-    return np.flatnonzero(keep)
 
 
 @functools.lru_cache(maxsize=1)

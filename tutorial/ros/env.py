@@ -201,14 +201,6 @@ def use_project_profiles_by_default(environ: MutableMapping[str, str] | None = N
     return env[PROFILES_VARIABLE]
 
 
-def discovery_summary() -> str:
-    """One line saying which ROS 2 peers this process can reach, for start-up logs."""
-    return "ROS 2 discovery: range={} domain={}".format(
-        os.environ.get(DISCOVERY_RANGE_VARIABLE, "SYSTEM_DEFAULT"),
-        os.environ.get("ROS_DOMAIN_ID", "0"),
-    )
-
-
 def init(args: Sequence[str] | None = None):
     """Initialise rclpy for this process with localhost discovery by default.
 

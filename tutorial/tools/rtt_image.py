@@ -45,7 +45,8 @@ import time
 from tutorial.ros import env as ros_env
 from tutorial.ros import program as ros_program
 from tutorial.ros import spin as ros_spin
-from tutorial.view.images import DEFAULT_TOPIC, TRANSPORTS, ImageReceiver, PngWriter, format_image_status
+from tutorial.view.image_files import PngWriter, format_image_status
+from tutorial.view.images import DEFAULT_TOPIC, TRANSPORTS, ImageReceiver
 
 NODE_NAME = "rtt_image"
 STATUS_PERIOD = 1.0  # s

@@ -11,7 +11,8 @@ module                job
 ``meshcat_page``      the page that draws it: meshcat's own; lighter without a GPU
 ``widget/``           the same scene as a Jupyter widget, over the notebook's own connection
 ``status``            a monitor's status: rate, age of the newest state, stale or live
-``images``            camera pictures received over ROS 2, and PNG files of them
+``images``            camera pictures received over ROS 2
+``image_files``       PNG files of them, and ``rtt-image``'s status line
 ``joint_plot``        joint positions over time, received over ROS 2, and their plot
 ====================  ================================================================
 

@@ -190,21 +190,22 @@ def add_arrow_clips(
         poses[..., 7] = np.maximum(poses[..., 7], 10.0**-decimals)  # never a zero scale
         path = vis[f"{root}/{name}"]
         clip = animation.clips[path.path] = AnimationClip(fps=fps)
-        for frame in _key_frames(np.array(shown)[:, None]):
+        for frame in key_frames(np.array(shown)[:, None]):
             clip.set_property(int(frame), "visible", "boolean", shown[frame])
         for k, part in enumerate(("shaft", "head")):
             clip = animation.clips[path[part].path] = AnimationClip(fps=fps)
-            for frame in _key_frames(poses[:, k]):
+            for frame in key_frames(poses[:, k]):
                 p = poses[frame, k]
                 clip.set_property(int(frame), "position", "vector3", p[:3].tolist())
                 clip.set_property(int(frame), "quaternion", "quaternion", p[3:7].tolist())
                 clip.set_property(int(frame), "scale", "vector3", [1.0, float(p[7]), 1.0])
 
 
-def _key_frames(track: np.ndarray) -> np.ndarray:
-    """Indices of the frames (rows of ``track``) that differ from a neighbour, and the first and last.
+def key_frames(track: np.ndarray) -> np.ndarray:
+    """Indices of the frames (rows of ``track``, (n, k)) that differ from a neighbour, and the first and last.
 
-    The frames in the middle of a hold add nothing to an animation: it holds between two equal keys.
+    The frames in the middle of a hold add nothing to an animation: it holds between two equal keys
+    (the arrows' animations here, and the recordings of :mod:`tutorial.notebook.replay`).  Any thread.
     """
     n = len(track)
     changed = np.any(track[1:] != track[:-1], axis=1)
