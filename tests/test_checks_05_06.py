@@ -9,6 +9,7 @@ answers).
 
 from __future__ import annotations
 
+import functools
 import math
 import random
 
@@ -277,3 +278,70 @@ def test_5_1_a_reading_at_the_shortest_arrow_shown_is_drawn_again():
     assert step5._reading(ReadingsRandom([(0.3, 0.4, 1.0), (0.2, 0.1, 2.0)])) == (0.2, 0.1, 2.0)
     assert step5._reading(ReadingsRandom([(0.4, -0.3, 1.0), (0.2, 0.1, 2.0)])) == (0.2, 0.1, 2.0)
     assert step5._reading(ReadingsRandom([(0.3, 0.41, 1.0)])) == (0.3, 0.41, 1.0)  # 0.0505 m: shown
+
+
+# ---- 6.1's stamp rule, at its edges ----------------------------------------------------------------
+
+
+def _header(sec: int, nanosec: int):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=nanosec))
+
+
+def test_6_1_a_stamp_is_right_to_the_nanosecond_with_nanosec_below_a_second():
+    from tutorial.exercises import step6_camera as step6
+
+    assert step6._stamp_fault(_header(5, 0), 5.0) is None  # whole seconds in sec
+    assert step6._stamp_fault(_header(0, 500_000_001), 0.5) is None  # 1 ns off: truncated or rounded
+    assert step6._stamp_fault(_header(0, 499_999_999), 0.5) is None
+    assert "nanosec=500000002" in step6._stamp_fault(_header(0, 500_000_002), 0.5)  # 2 ns off
+    assert step6._stamp_fault(_header(1, 1_000_000_000), 2.0) is not None  # the sum is right, nanosec is not
+    assert step6._stamp_fault(_header(0, 2_000_000_000), 2.0) is not None
+    assert step6._stamp_fault(_header(2, -1), 2.0) is not None
+
+
+# ---- 6.1's picture rule: each fault named with its rule and hint -------------------------------------------
+
+
+def _gray_picture(camera, colour, **changed):
+    """A message as a right answer publishes it for ``colour`` at 2.5 s, with the fields ``changed``."""
+    from types import SimpleNamespace
+
+    from tutorial.exercises import step6_camera as step6
+
+    gray = np.round(colour @ np.array(step6.LUMA)).astype(np.uint8)
+    msg = SimpleNamespace(
+        encoding="mono8", height=camera.height, width=camera.width, step=camera.width, is_bigendian=0,
+        header=SimpleNamespace(frame_id=camera.name, stamp=SimpleNamespace(sec=2, nanosec=500_000_000)),
+        data=gray.tobytes(),
+    )  # fmt: skip
+    for name, value in changed.items():
+        setattr(msg.header if name in ("frame_id", "stamp") else msg, name, value)
+    return msg
+
+
+def test_6_1_a_gray_pictures_faults_each_name_their_rule_and_hint():
+    from tutorial.exercises import step6_camera as step6
+    from tutorial.exercises.camera_rig import Camera
+
+    camera = Camera(name="Eye", width=4, height=3)
+    colour = np.random.default_rng(6).integers(0, 256, (3, 4, 3)).astype(float)
+    fault = functools.partial(step6._gray_fault, t=2.5, colour=colour, camera=camera)
+    assert fault(_gray_picture(camera, colour)) is None
+    assert fault(_gray_picture(camera, colour, width=3)) == (
+        "layout", "width was 3, expected 4", "height is the number of rows, width the pixels in a row."
+    )  # fmt: skip
+    assert fault(_gray_picture(camera, colour, is_bigendian=1)) == (
+        "layout", "is_bigendian was 1, expected 0", "set is_bigendian to 0."
+    )  # fmt: skip
+    assert fault(_gray_picture(camera, colour, frame_id="Kinect")) == (
+        "frame",
+        "frame_id was 'Kinect', expected 'Eye'",
+        "keep the frame_id RttCameraImagePublisher.configure set: reuse self.msg.",
+    )
+    assert fault(_gray_picture(camera, colour, data=bytes(24))) == (
+        "layout", "data has 24 bytes, expected step x height = 12", "one byte a pixel: the gray array as uint8."
+    )  # fmt: skip
+    stamp = fault(_gray_picture(camera, colour, stamp=_header(2, 0).stamp))
+    assert stamp[0] == "stamp" and stamp[2] == "stamp each picture with its time_s: stamp_parts(time_s)."
