@@ -345,3 +345,55 @@ def test_6_1_a_gray_pictures_faults_each_name_their_rule_and_hint():
     )  # fmt: skip
     stamp = fault(_gray_picture(camera, colour, stamp=_header(2, 0).stamp))
     assert stamp[0] == "stamp" and stamp[2] == "stamp each picture with its time_s: stamp_parts(time_s)."
+
+
+def test_6_1_off_by_one_in_at_most_1_percent_of_the_pixels_and_more_than_one_never():
+    from tutorial.exercises import step6_camera as step6
+    from tutorial.exercises.camera_rig import Camera
+
+    camera = Camera(width=10, height=10)  # 100 pixels: one may be off by one
+    colour = np.random.default_rng(61).integers(0, 256, (10, 10, 3)).astype(float)
+    right = np.frombuffer(_gray_picture(camera, colour).data, np.uint8).reshape(10, 10).astype(int)
+
+    def fault(*changes):  # (row, column, change) of the right picture's pixels
+        gray = right.copy()
+        for r, c, d in changes:
+            gray[r, c] = gray[r, c] + d if 0 <= gray[r, c] + d <= 255 else gray[r, c] - d
+        found = step6._gray_fault(
+            _gray_picture(camera, colour, data=gray.astype(np.uint8).tobytes()), 2.5, colour, camera
+        )
+        return found and found[1].split(", e.g.")[0]
+
+    assert fault() is None
+    assert fault((3, 4, 1)) is None  # one pixel in a hundred
+    assert fault((3, 4, 1), (5, 6, 1)) == "2 of 100 pixels are off by 1"
+    assert fault((3, 4, 2)) == "1 of 100 pixels are off by more than 1"
+    assert fault((3, 4, 2), (5, 6, 1), (7, 8, 1)) == "1 of 100 pixels are off by more than 1"  # the worse first
+    gray = right.copy()
+    gray[0, 0] += 2 if gray[0, 0] < 200 else -2
+    rule, what, hint = step6._gray_fault(
+        _gray_picture(camera, colour, data=gray.astype(np.uint8).tobytes()), 2.5, colour, camera
+    )
+    assert (rule, what.split(", e.g. ")[1].split(" is ")[0]) == ("pixels", "row 0, column 0")
+    assert hint == (
+        "gray = 0.299 R + 0.587 G + 0.114 B, rounded (np.round: astype alone cuts the fraction off): "
+        "green counts most, blue least."
+    )
+
+
+def test_6_1_a_camera_publishing_no_image_on_its_topic_is_told_so(monkeypatch):
+    """Fast DDS refuses a second type on one topic, so only an answer that makes its own publisher instead of
+    the Image's gets here: a stand-in rig shows the line."""
+    from types import SimpleNamespace
+
+    from sensor_msgs.msg import CompressedImage
+
+    from tutorial.exercises import step6_camera as step6
+
+    publisher = SimpleNamespace(msg_type=CompressedImage, topic="/Tank/camera/image")
+    rig = SimpleNamespace(name="RttGrayCameraPublisher", images=lambda: publisher)
+    monkeypatch.setattr(step6, "drive", lambda cls, camera, poses: rig)
+    monkeypatch.setattr(step6, "hidden_random", lambda exercise: None)
+    result = step6.check_gray_camera(type("RttGrayCameraPublisher", (), {}))
+    assert not result.passed
+    assert "RttGrayCameraPublisher publishes CompressedImage on /Tank/camera/image, expected an Image." in str(result)
