@@ -100,8 +100,9 @@ def test_the_layout_page_states_the_lessons_librarys_size_as_measured():
 
 
 # The tooling the lessons' library (notebooks 01 to 06, their checks and project files) never reaches: the URDF
-# tools, recording, Foxglove, the test hosts, the programs, and the App rtt-run runs (its own meshcat server,
-# robot descriptions).
+# tools, recording, Foxglove, the test hosts, the programs, the App rtt-run runs (its own meshcat server and the
+# sink that draws on it, robot descriptions), rtt-image's PNG files, and the lesson modules (the checks stand on
+# app/reference's frozen copies).
 TOOLING = (
     "tutorial.urdf",
     "tutorial.bag",
@@ -112,6 +113,9 @@ TOOLING = (
     "tutorial.app.floating_base",
     "tutorial.app.standalone",
     "tutorial.view.meshcat_server",
+    "tutorial.view.sinks",
+    "tutorial.view.image_files",
+    "tutorial.controllers",
     "tutorial.joystick.sources",
     "tutorial.joystick.publisher",
     "tutorial.interfaces.robot_description",

@@ -283,14 +283,13 @@ class App:
 
     def _open_view(self) -> None:
         from tutorial.view.scene import Scene, look_at_geoms
-        from tutorial.view.sinks import frame_sink
 
         if self.vis is None:
             self.vis = self.open_visualizer()
         # A robot drawn from its description, with no world around it: meshcat's grid is its ground, and the
         # camera frames the robot whatever its size (the tank's close-up assumes the tank's).
         described = self.project.simulator is None and any(m.description for m in self.project.models)
-        self.scene = Scene(self.vis, self.model, sink=frame_sink(self.vis))  # the fastest way its view takes
+        self.scene = Scene(self.vis, self.model, sink=self.frame_sink())  # the fastest way its view takes
         self.scene.build(self.data, grid=described)
         self.overlay_view = MeshcatOverlays(self.vis, self.overlays)
         robot = self.bodies[self.project.models[-1].name]
@@ -305,6 +304,15 @@ class App:
         self.scene.set_camera(*self.camera)  # (position, target), m: a notebook's recording reuses it
         url, via = self.view_address()
         self.output({"event": "meshcat", "node": self.node_fqn, "url": url, "through_jupyter": via})
+
+    def frame_sink(self):
+        """Where the scene sends each frame's transforms (owner thread, in :meth:`open`): a notebook's widget
+        window takes a frame as one message (:class:`tutorial.view.widget.widget.WidgetWindow`); any other
+        window gets meshcat's own way, one ``set_transform`` a body (:class:`tutorial.view.scene.VisualizerSink`)."""
+        from tutorial.view.scene import VisualizerSink
+
+        window = self.vis.window
+        return window if getattr(window, "send_transforms", None) is not None else VisualizerSink(self.vis)
 
     def step(self, timeout: float = 1.0 / FRAME_RATE) -> bool:
         """Run posted calls, and draw a frame when there is something new to show (owner thread).

@@ -54,6 +54,13 @@ class StandaloneApp(App):
                 self.attach.append((entry.name, f"{entry.name}/floating_base", FloatingBase(entry.odometry)))
         return project
 
+    def frame_sink(self):
+        """The fastest way this App's view takes a frame (owner thread): on its own meshcat server, the frame as
+        one ``set_transforms`` command (:func:`tutorial.view.sinks.frame_sink`)."""
+        from tutorial.view.sinks import frame_sink
+
+        return frame_sink(self.vis)
+
     def open_visualizer(self):
         """A meshcat server of this App's own (closed with it), and its ``Visualizer`` (owner thread)."""
         from tutorial.view.meshcat_server import start_server

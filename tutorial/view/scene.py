@@ -13,8 +13,9 @@ A frame's transforms go out through one *sink*: an object with
 ``send_transforms([(meshcat path, 4x4 pose), ...])``.  By default it is
 meshcat's own ``Visualizer`` (:class:`VisualizerSink`: one ``set_transform``
 per body); the :class:`tutorial.app.app.App` gives the scene a faster one
-that its view can serve (:mod:`tutorial.view.sinks`: a frame as one message
-to a notebook's widget or to the project's meshcat server).
+that its view can serve (``App.frame_sink``): a frame as one message to a
+notebook's widget, or, for ``rtt-run``'s own meshcat server, to that server
+(:mod:`tutorial.view.sinks`).
 
 Geoms in group 3 and above are hidden, as in MuJoCo's own viewer (the tank's
 road wheels live there, inside the track covers).

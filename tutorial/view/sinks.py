@@ -5,8 +5,10 @@ object with ``send_transforms(transforms)``, ``transforms`` being
 ``[(meshcat path, 4x4 pose), ...]`` (translation in m).  Its default is
 meshcat's own ``Visualizer`` (:class:`tutorial.view.scene.VisualizerSink`:
 one ``set_transform`` each, and meshcat-python waits for its server's reply
-after each).  The faster ways are here, and :func:`frame_sink` picks one for
-a visualizer's window; the :class:`tutorial.app.app.App` asks it:
+after each).  :func:`frame_sink` picks the fastest a visualizer's window
+can serve; ``rtt-run``'s :class:`tutorial.app.standalone.StandaloneApp`, whose
+view is a meshcat server of its own, asks it (the lessons' ``App`` tells a
+widget from anything else itself, and never imports this module):
 
 * a notebook's widget (:class:`tutorial.view.widget.widget.WidgetWindow`) is a
   sink itself: a frame goes to the browser as one message;

@@ -259,7 +259,7 @@ class WidgetWindow:
 
     It stands in for meshcat's ``ViewerWindow`` (a connection to meshcat's
     server): ``send`` takes one command, and :meth:`send_transforms` a frame's
-    transforms at once: the window is a scene's sink (:func:`tutorial.view.sinks.frame_sink`).
+    transforms at once: the window is a scene's sink (``tutorial.app.app.App.frame_sink``).
     """
 
     zmq_url = None  # no server: everything goes through this window
