@@ -11,7 +11,7 @@ output                      how its bytes travel
 ``views.LiveView``          a run's 3D view (and ``views.show``: side by side,
                             the IMU's arrows, notebook 07's replay into a
                             fresh viewer): a ``MeshcatWidget``
-``views.MeshcatPage``       a page drawn by hand (notebook 00): a ``MeshcatWidget``
+``drawing.MeshcatPage``     a page drawn by hand (notebook 00): a ``MeshcatWidget``
 ``live_plot.LivePlot``      a picture redrawn in place: a display update
 ``live_image.LiveImage``    the camera's picture: a display update
 ``teleop.TeleopPanel``,     ipywidgets
@@ -37,7 +37,7 @@ NOTEBOOK_LAYER = Path(__file__).resolve().parents[1] / "tutorial" / "notebook"
 
 TRAVELS = {
     "tutorial.notebook.views.LiveView": "MeshcatWidget",
-    "tutorial.notebook.views.MeshcatPage": "MeshcatWidget",
+    "tutorial.notebook.drawing.MeshcatPage": "MeshcatWidget",
     "tutorial.notebook.live.LiveOutput": "display_id=True",  # LivePlot's and LiveImage's base
     "tutorial.notebook.teleop.TeleopPanel": "ipywidgets",
 }

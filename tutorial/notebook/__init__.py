@@ -5,7 +5,8 @@ module             what it gives a notebook
 =================  ==============================================================
 ``session``        ``init_ros``, ``reset``, ``TEST_MODE``, ``wait_until``, paths
 ``runs``           ``run_project`` (deterministic), ``BackgroundApp`` (live, over ROS 2), ``load``
-``views``          ``LiveView`` (a run's 3D view: live, then its recording), ``show``, ``MeshcatPage``
+``views``          ``LiveView`` (a run's 3D view: live, then its recording), ``show``
+``drawing``        ``MeshcatPage``: a meshcat page to draw in by hand (notebook 00)
 ``replay``         self-contained meshcat pages of recorded runs (no server)
 ``panels``         widget panels that say what they are doing, and a stand-in where widgets cannot run
 ``teleop``         ``TeleopPanel``: sliders and a gamepad publishing ``/joy``
