@@ -397,3 +397,15 @@ def test_6_1_a_camera_publishing_no_image_on_its_topic_is_told_so(monkeypatch):
     result = step6.check_gray_camera(type("RttGrayCameraPublisher", (), {}))
     assert not result.passed
     assert "RttGrayCameraPublisher publishes CompressedImage on /Tank/camera/image, expected an Image." in str(result)
+
+
+def test_6_1_hidden_poses_are_three_with_the_yaw_anywhere_and_the_pitch_within_the_turrets_range():
+    from tutorial.exercises import step6_camera as step6
+
+    drawn = [step6._hidden_poses(random.Random(seed)) for seed in SEEDS]
+    assert {len(poses) for poses in drawn} == {3}
+    assert {label for poses in drawn for label, _, _ in poses} == {""}
+    yaws = [yaw for poses in drawn for _, yaw, _ in poses]
+    pitches = [pitch for poses in drawn for _, _, pitch in poses]
+    assert -math.pi <= min(yaws) < -3.0 and 3.0 < max(yaws) <= math.pi
+    assert -0.15 <= min(pitches) < -0.14 and 0.74 < max(pitches) <= 0.75

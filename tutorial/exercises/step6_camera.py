@@ -45,6 +45,12 @@ def _random_camera(rng) -> Camera:
     return Camera(rng.choice(("Scout", "Rover")), rng.choice(("Eye", "Xtion")), *size, rng.uniform(30, 100), start)
 
 
+def _hidden_poses(rng) -> list[tuple[str, float, float]]:
+    """6.1's hidden turret poses: three ``("", yaw, pitch)``, rad, the yaw anywhere (-pi to pi), the pitch within
+    the turret's range (-10 to 45 deg) with a margin (-0.15 to 0.75)."""
+    return [("", rng.uniform(-math.pi, math.pi), rng.uniform(-0.15, 0.75)) for _ in range(3)]
+
+
 def _stamp_fault(header, t: float) -> str | None:
     """What is wrong with ``header``'s stamp for ``t`` s, or None: whole seconds in ``sec``, the rest in
     ``nanosec`` (below a second), to the nanosecond (truncated or rounded)."""
@@ -153,7 +159,7 @@ def check_gray_camera(cls) -> Result:
     rng = hidden_random("6.1")  # while grading: this learner's own camera and poses
     if rng:
         camera = _random_camera(rng)
-        poses = [("", rng.uniform(-math.pi, math.pi), rng.uniform(-0.15, 0.75)) for _ in range(3)]
+        poses = _hidden_poses(rng)
         for rule, call, hint in [
             ("layout", "a camera of another size: encoding, height, width, step", "take the size from the picture."),
             ("frame", "a camera of another name: the frame_id", "reuse self.msg: its frame_id is the camera's."),
