@@ -409,3 +409,20 @@ def test_6_1_hidden_poses_are_three_with_the_yaw_anywhere_and_the_pitch_within_t
     pitches = [pitch for poses in drawn for _, _, pitch in poses]
     assert -math.pi <= min(yaws) < -3.0 and 3.0 < max(yaws) <= math.pi
     assert -0.15 <= min(pitches) < -0.14 and 0.74 < max(pitches) <= 0.75
+
+
+def test_6_hidden_cameras_are_of_every_size_field_of_view_and_name_the_rules_allow():
+    from tutorial.exercises import step6_camera as step6
+
+    cameras = [step6._random_camera(random.Random(seed)) for seed in range(2000)]  # each size at least once
+    assert {c.body for c in cameras} == {"Scout", "Rover"} and {c.name for c in cameras} == {"Eye", "Xtion"}
+    assert (min(c.width for c in cameras), max(c.width for c in cameras)) == (64, 240)
+    assert (min(c.height for c in cameras), max(c.height for c in cameras)) == (48, 180)
+    assert any(c.height > c.width for c in cameras) and any(c.width > c.height for c in cameras)
+    fovy = [c.fovy for c in cameras]
+    assert 30 <= min(fovy) < 31 and 99 < max(fovy) <= 100
+    starts = [c.start for c in cameras]
+    assert {math.floor(s) for s in starts} == {1, 2, 3}  # a second or more, below four
+    fractions = [round(s - math.floor(s), 3) for s in starts]
+    assert 0.5 <= min(fractions) < 0.51 and 0.69 < max(fractions) <= 0.7  # past the half second
+    assert all(abs(s * 1000 - round(s * 1000)) < 1e-6 for s in starts)  # whole milliseconds
