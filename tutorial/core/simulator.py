@@ -97,9 +97,7 @@ class Simulator:
     any thread; everything else runs on the simulation thread.
     """
 
-    def __init__(
-        self, model, data, attachments, node=None, realtime_sync=True, duration=None, log=None, record_timing=False
-    ):
+    def __init__(self, model, data, attachments, node=None, realtime_sync=True, duration=None, record_timing=False):
         self.model = model
         self.data = data
         self.attachments = list(attachments)
@@ -107,7 +105,6 @@ class Simulator:
         self.realtime_sync = realtime_sync
         self.realtime_slice = realtime_slice(os.environ.get(REALTIME_SLICE_VARIABLE))  # s
         self.duration = duration
-        self.log = log
         self.time_step = float(model.opt.timestep)
         self.steps = 0
         self.wall_time = 0.0
