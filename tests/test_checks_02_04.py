@@ -270,6 +270,9 @@ def test_4_2_the_threshold_y_decides_lies_between_the_larger_part_and_the_hypot(
     assert step4._y_threshold(_imu((0.9, 0.0), (0.003, 0.003))) == (0.003 + math.hypot(0.003, 0.003)) / 2
     with pytest.raises(RuntimeError, match=r"^the Imu messages have no mean whose y part decides"):
         step4._y_threshold(_imu((0.0, 0.0), (0.0, 0.0)))  # nothing moves: no threshold of 0
+    y = 0.3201562118716422  # hypot(1, y) is 1.05 exactly, in floats: 5 % above its larger part is enough
+    assert math.hypot(1.0, y) == 1.05 * 1.0
+    assert step4._y_threshold(_imu((1.0, y))) == (1.0 + 1.05) / 2
 
 
 def test_4_x_the_noting_node_gives_rclpy_every_argument_of_a_publisher_and_notes_each_message_in_turn():

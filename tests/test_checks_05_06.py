@@ -426,3 +426,54 @@ def test_6_hidden_cameras_are_of_every_size_field_of_view_and_name_the_rules_all
     fractions = [round(s - math.floor(s), 3) for s in starts]
     assert 0.5 <= min(fractions) < 0.51 and 0.69 < max(fractions) <= 0.7  # past the half second
     assert all(abs(s * 1000 - round(s * 1000)) < 1e-6 for s in starts)  # whole milliseconds
+
+
+@pytest.mark.parametrize(
+    "rule, broken, told",
+    [
+        ("layout", {"width": -1}, "a camera of another size: encoding, height, width, step"),
+        ("frame", {"frame_id": "Kinect"}, "a camera of another name: the frame_id"),
+        ("stamp", {"sec": 1}, "stamps of a second or more: sec and nanosec"),
+        ("pixels", {"luma": 3}, "the turret at random poses: each pixel's luma"),
+    ],
+)
+def test_6_1_each_hidden_case_fails_on_its_own_rule_on_the_hidden_camera(monkeypatch, rule, broken, told):
+    """A stand-in rig publishes right pictures of the Kinect, and pictures of the hidden camera that break one
+    rule: the hidden case of that rule is the one that fails."""
+    from types import SimpleNamespace
+
+    from sensor_msgs.msg import Image
+
+    from tutorial.exercises import step6_camera as step6
+    from tutorial.interfaces.timing import stamp_parts
+
+    rng = np.random.default_rng(7)
+
+    def drive(cls, camera, poses):
+        times = [camera.start + 0.1 * k for k in range(len(poses))]
+        colours = [rng.integers(0, 256, (camera.height, camera.width, 3)).astype(float) for _ in poses]
+        messages = []
+        for t, colour in zip(times, colours):
+            sec, nanosec = stamp_parts(t)
+            msg = _gray_picture(camera, colour, stamp=SimpleNamespace(sec=sec, nanosec=nanosec))
+            if camera != step6.KINECT:  # the hidden camera's pictures break the rule
+                if "width" in broken:
+                    msg.width += broken["width"]
+                if "frame_id" in broken:
+                    msg.header.frame_id = broken["frame_id"]
+                if "sec" in broken:
+                    msg.header.stamp.sec += broken["sec"]
+                if "luma" in broken:
+                    gray = np.frombuffer(msg.data, np.uint8).astype(int)
+                    msg.data = np.clip(gray + np.where(gray < 128, 3, -3), 0, 255).astype(np.uint8).tobytes()
+            messages.append(msg)
+        publisher = SimpleNamespace(msg_type=Image, topic=camera.topic("image"), messages=lambda: messages)
+        return SimpleNamespace(
+            name="Gray", images=lambda: publisher, poses=[(t, None) for t in times], colours=colours
+        )  # fmt: skip
+
+    monkeypatch.setattr(step6, "drive", drive)
+    monkeypatch.setattr(step6, "references", lambda rig: rig.colours)
+    monkeypatch.setattr(step6, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
+    result = step6.check_gray_camera(type("Gray", (), {}))
+    assert not result.passed and result.case == told and result.message.startswith(f"a hidden case failed: {told}.")
