@@ -294,3 +294,93 @@ def test_4_x_the_noting_node_gives_rclpy_every_argument_of_a_publisher_and_notes
     assert made == [(Float64, "/Tank/imu", 1, {"callback_group": "group"}), (Float64, "/Tank/peak", 2, {})]
     assert node.order == ["/Tank/imu", "/Tank/peak", "/Tank/imu"]
     assert sent == [("/Tank/imu", 1.0), ("/Tank/peak", 2.0), ("/Tank/imu", 3.0)]
+
+
+# ---- 2.1's check on a stand-in drive: what it asks of each run, and its count of messages at the edge ----------
+
+JOINT_ADDRESSES = {"TURRET_Y": (7, 6), "TURRET_P": (8, 7)}  # (qpos, dof): the tank's free joint comes first
+
+
+def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 1):
+    """A stand-in for 2.1's drive, as a right answer runs: ``count(rate)`` messages 1/rate apart, of the joints
+    asked for, with the values of one state; refuses a name the tank lacks, logging an error.  Each run's
+    ``(joints, rate, script)`` is appended to ``runs``."""
+    import logging
+
+    from tutorial.app.app import ControllerError
+
+    qpos, qvel, effort = [0.0] * 7 + [0.25, -0.5], [0.0] * 6 + [1.5, -2.5], [0.0] * 6 + [3.0, 4.0]
+    state = (qpos, None, None, qvel, effort)
+    infos = {name: SimpleNamespace(qpos_adr=q, dof_adr=d) for name, (q, d) in JOINT_ADDRESSES.items()}
+    body = SimpleNamespace(joint=lambda name: SimpleNamespace(info=infos[name]))
+
+    def drive(name, cls, parameters, script=None, duration=None, tumble=None):
+        joints, rate = parameters["joints"], parameters["rate"]
+        runs.append((joints, rate, script))
+        names = [n.strip() for n in joints.split(",") if n.strip()] or step2.TANK
+        if not set(names) <= set(step2.TANK):
+            logging.getLogger("rtt.Selected").error("joints: Tank has no joint %s", names)
+            raise ControllerError("Selected refused to configure")
+        messages = []
+        for k in range(count(rate)):
+            sec, nanosec = divmod(round(k / rate * 1e9), 1_000_000_000)
+            messages.append(
+                SimpleNamespace(
+                    name=list(names),
+                    position=[qpos[JOINT_ADDRESSES[n][0]] for n in names],
+                    velocity=[qvel[JOINT_ADDRESSES[n][1]] for n in names],
+                    effort=[effort[JOINT_ADDRESSES[n][1]] for n in names],
+                    header=SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=nanosec)),
+                )
+            )
+        publisher = SimpleNamespace(messages=lambda: messages)
+        node = SimpleNamespace(published=lambda topic: [publisher] if topic == "/Tank/joint_state" else [])
+        return node, SimpleNamespace(at=lambda seconds: state), SimpleNamespace(bodies={"Tank": body})
+
+    return drive
+
+
+def test_2_1_each_hidden_run_drives_the_turret_with_the_script_drawn_for_it(monkeypatch):
+    runs: list = []
+    monkeypatch.setattr(step2, "_drive", _stand_in_2_1(runs))
+    monkeypatch.setattr(step2, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
+    result = step2.check_selected_joints(type("Selected", (), {}))
+    assert result.passed, str(result)
+    drawn = step2._hidden_choices(random.Random("test/2.1"))
+    chosen = [(joints, rate, script) for joints, _, rate, script in drawn]
+    assert [run for run in runs if run[2] is not None] == chosen
+    assert all(script is None for _, _, script in runs[: len(runs) - len(chosen) - len(step2.LACKING)])
+
+
+def test_2_1_a_run_needs_rate_x_duration_messages_at_least(monkeypatch):
+    def graded(count):
+        monkeypatch.setattr(step2, "_drive", _stand_in_2_1([], count))
+        monkeypatch.setattr(step2, "hidden_random", lambda exercise: None)
+        return step2.check_selected_joints(type("Selected", (), {}))
+
+    assert graded(lambda rate: round(rate * step2.DURATION)).passed  # exactly 100 at 50 Hz, 20 at 10 Hz
+    short = graded(lambda rate: round(rate * step2.DURATION) - 1)
+    assert not short.passed and short.case == "Selected with joints='TURRET_P,TURRET_Y', rate=50.0"
+    assert "published 99 messages in 2.0 s, expected at least 100." in short.message
+    assert "Hint: keep publishing through RttJointStatePublisher.control()." in short.message
+    assert not graded(lambda rate: round(rate * step2.DURATION) // 2).passed  # half the rate
+
+
+@pytest.mark.parametrize("publishers", [0, 2])
+def test_2_1_a_run_with_other_than_one_joint_state_publisher_is_told_so(monkeypatch, publishers):
+    drive = _stand_in_2_1([])
+
+    def drive_with(*args, **kwargs):
+        node, probe, app = drive(*args, **kwargs)
+        [publisher] = node.published("/Tank/joint_state")
+        return SimpleNamespace(published=lambda topic: [publisher] * publishers), probe, app
+
+    monkeypatch.setattr(step2, "_drive", drive_with)
+    monkeypatch.setattr(step2, "hidden_random", lambda exercise: None)
+    result = step2.check_selected_joints(type("Selected", (), {}))
+    assert str(result) == (
+        "✗ Exercise 2.1, publish chosen joints: Selected with joints='TURRET_P,TURRET_Y', rate=50.0: "
+        f"with joints='TURRET_P,TURRET_Y' the controller made {publishers} publishers of /Tank/joint_state, "
+        "expected 1. Hint: let RttJointStatePublisher.configure create it: call super().configure(config) and "
+        "check what it returns."
+    )
