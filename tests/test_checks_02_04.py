@@ -301,15 +301,16 @@ def test_4_x_the_noting_node_gives_rclpy_every_argument_of_a_publisher_and_notes
 JOINT_ADDRESSES = {"TURRET_Y": (7, 6), "TURRET_P": (8, 7)}  # (qpos, dof): the tank's free joint comes first
 
 
-def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 1):
+def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 1, edit=None, at=None):
     """A stand-in for 2.1's drive, as a right answer runs: ``count(rate)`` messages 1/rate apart, of the joints
-    asked for, with the values of one state; refuses a name the tank lacks, logging an error.  Each run's
-    ``(joints, rate, script)`` is appended to ``runs``."""
+    asked for, with the values of one state (``qpos``'s TURRET_Y 0); refuses a name the tank lacks, logging an
+    error.  Each run's ``(joints, rate, script)`` is appended to ``runs``; ``edit(message)`` changes each message;
+    ``at(seconds, state)`` stands in for the probe's state at a stamp."""
     import logging
 
     from tutorial.app.app import ControllerError
 
-    qpos, qvel, effort = [0.0] * 7 + [0.25, -0.5], [0.0] * 6 + [1.5, -2.5], [0.0] * 6 + [3.0, 4.0]
+    qpos, qvel, effort = [0.0] * 7 + [0.0, -0.5], [0.0] * 6 + [1.5, -2.5], [0.0] * 6 + [3.0, 4.0]
     state = (qpos, None, None, qvel, effort)
     infos = {name: SimpleNamespace(qpos_adr=q, dof_adr=d) for name, (q, d) in JOINT_ADDRESSES.items()}
     body = SimpleNamespace(joint=lambda name: SimpleNamespace(info=infos[name]))
@@ -333,9 +334,12 @@ def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 
                     header=SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=nanosec)),
                 )
             )
+        for msg in messages if edit else ():
+            edit(msg)
         publisher = SimpleNamespace(messages=lambda: messages)
         node = SimpleNamespace(published=lambda topic: [publisher] if topic == "/Tank/joint_state" else [])
-        return node, SimpleNamespace(at=lambda seconds: state), SimpleNamespace(bodies={"Tank": body})
+        probe = SimpleNamespace(at=lambda seconds: at(seconds, state) if at else state)
+        return node, probe, SimpleNamespace(bodies={"Tank": body})
 
     return drive
 
@@ -384,3 +388,39 @@ def test_2_1_a_run_with_other_than_one_joint_state_publisher_is_told_so(monkeypa
         "expected 1. Hint: let RttJointStatePublisher.configure create it: call super().configure(config) and "
         "check what it returns."
     )
+
+
+def _graded_2_1(monkeypatch, **stand_in):
+    monkeypatch.setattr(step2, "_drive", _stand_in_2_1([], **stand_in))
+    monkeypatch.setattr(step2, "hidden_random", lambda exercise: None)
+    return str(step2.check_selected_joints(type("Selected", (), {})))
+
+
+FIRST_CASE = "✗ Exercise 2.1, publish chosen joints: Selected with joints='TURRET_P,TURRET_Y', rate=50.0"
+ORDER_HINT = "publish the joints in the order the parameter names them."  # the first case's
+
+
+def test_2_1_names_out_of_order_are_told_with_the_cases_hint(monkeypatch):
+    def reverse(msg):
+        msg.name.reverse()
+
+    assert _graded_2_1(monkeypatch, edit=reverse) == (
+        f"{FIRST_CASE} published name=['TURRET_Y', 'TURRET_P'], expected ['TURRET_P', 'TURRET_Y']. Hint: {ORDER_HINT}"
+    )
+
+
+def test_2_1_a_stamp_that_is_no_step_of_the_run_is_told(monkeypatch):
+    told = _graded_2_1(monkeypatch, at=lambda seconds, state: None if seconds > 0.5 else state)
+    assert told == f"{FIRST_CASE}: a message stamped 0.520 s, not a step of the run. Hint: {ORDER_HINT}"
+
+
+def test_2_1_a_position_within_a_nanoradian_passes_and_a_hair_more_does_not(monkeypatch):
+    def off_by(rad):
+        def edit(msg):
+            if "TURRET_Y" in msg.name:
+                msg.position[msg.name.index("TURRET_Y")] = rad  # the state's TURRET_Y is 0
+
+        return edit
+
+    assert _graded_2_1(monkeypatch, edit=off_by(1e-9)).startswith("✓")
+    assert "TURRET_Y was published as 0.000000 rad" in _graded_2_1(monkeypatch, edit=off_by(1.0000001e-9))
