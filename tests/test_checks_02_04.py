@@ -301,11 +301,14 @@ def test_4_x_the_noting_node_gives_rclpy_every_argument_of_a_publisher_and_notes
 JOINT_ADDRESSES = {"TURRET_Y": (7, 6), "TURRET_P": (8, 7)}  # (qpos, dof): the tank's free joint comes first
 
 
-def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 1, edit=None, at=None):
+def _stand_in_2_1(
+    runs: list, count=lambda rate: round(rate * step2.DURATION) + 1, edit=None, at=None, refuse=True, log=True
+):
     """A stand-in for 2.1's drive, as a right answer runs: ``count(rate)`` messages 1/rate apart, of the joints
     asked for, with the values of one state (``qpos``'s TURRET_Y 0); refuses a name the tank lacks, logging an
     error.  Each run's ``(joints, rate, script)`` is appended to ``runs``; ``edit(message)`` changes each message;
-    ``at(seconds, state)`` stands in for the probe's state at a stamp."""
+    ``at(seconds, state)`` stands in for the probe's state at a stamp; ``refuse``: refuse a name the tank lacks
+    (``log``: with an error logged)."""
     import logging
 
     from tutorial.app.app import ControllerError
@@ -319,8 +322,9 @@ def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 
         joints, rate = parameters["joints"], parameters["rate"]
         runs.append((joints, rate, script))
         names = [n.strip() for n in joints.split(",") if n.strip()] or step2.TANK
-        if not set(names) <= set(step2.TANK):
-            logging.getLogger("rtt.Selected").error("joints: Tank has no joint %s", names)
+        if refuse and not set(names) <= set(step2.TANK):
+            if log:
+                logging.getLogger("rtt.Selected").error("joints: Tank has no joint %s", names)
             raise ControllerError("Selected refused to configure")
         messages = []
         for k in range(count(rate)):
@@ -328,9 +332,9 @@ def _stand_in_2_1(runs: list, count=lambda rate: round(rate * step2.DURATION) + 
             messages.append(
                 SimpleNamespace(
                     name=list(names),
-                    position=[qpos[JOINT_ADDRESSES[n][0]] for n in names],
-                    velocity=[qvel[JOINT_ADDRESSES[n][1]] for n in names],
-                    effort=[effort[JOINT_ADDRESSES[n][1]] for n in names],
+                    position=[qpos[JOINT_ADDRESSES[n][0]] for n in names if n in JOINT_ADDRESSES],
+                    velocity=[qvel[JOINT_ADDRESSES[n][1]] for n in names if n in JOINT_ADDRESSES],
+                    effort=[effort[JOINT_ADDRESSES[n][1]] for n in names if n in JOINT_ADDRESSES],
                     header=SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=nanosec)),
                 )
             )
@@ -390,9 +394,9 @@ def test_2_1_a_run_with_other_than_one_joint_state_publisher_is_told_so(monkeypa
     )
 
 
-def _graded_2_1(monkeypatch, **stand_in):
+def _graded_2_1(monkeypatch, hidden=False, **stand_in):
     monkeypatch.setattr(step2, "_drive", _stand_in_2_1([], **stand_in))
-    monkeypatch.setattr(step2, "hidden_random", lambda exercise: None)
+    monkeypatch.setattr(step2, "hidden_random", lambda exercise: random.Random(f"test/{exercise}") if hidden else None)
     return str(step2.check_selected_joints(type("Selected", (), {})))
 
 
@@ -424,3 +428,46 @@ def test_2_1_a_position_within_a_nanoradian_passes_and_a_hair_more_does_not(monk
 
     assert _graded_2_1(monkeypatch, edit=off_by(1e-9)).startswith("✓")
     assert "TURRET_Y was published as 0.000000 rad" in _graded_2_1(monkeypatch, edit=off_by(1.0000001e-9))
+
+
+def test_2_1_arrays_of_other_lengths_than_the_names_are_told(monkeypatch):
+    def shorten(msg):
+        msg.velocity = msg.velocity[:1]
+
+    assert _graded_2_1(monkeypatch, edit=shorten) == (
+        f"{FIRST_CASE}: name, position, velocity and effort have lengths 2, 2, 1, 2. "
+        "Hint: a JointState's arrays must all be as long as its name list."
+    )
+
+
+@pytest.mark.parametrize(
+    "field, unit, value, got",
+    [("velocity", "rad/s", "1.500000", "-2.500000"), ("effort", "N m", "3.000000", "4.000000")],
+)
+def test_2_1_a_velocity_or_effort_not_the_joints_own_is_told(monkeypatch, field, unit, value, got):
+    def swap(msg):
+        values = getattr(msg, field)
+        values.reverse()  # TURRET_P's value given to TURRET_Y and back
+
+    assert _graded_2_1(monkeypatch, edit=swap) == (
+        f"{FIRST_CASE}: at t = 0.000 s TURRET_P's {field} was published as {value} {unit}, but the simulation "
+        f"had {got} {unit}. Hint: a joint's {field} comes from its own dof address (qvel, qfrc_actuator), in the "
+        "order of the names you publish: not from its qpos address."
+    )
+
+
+def test_2_1_a_name_the_tank_lacks_accepted_is_told(monkeypatch):
+    assert _graded_2_1(monkeypatch, refuse=False) == (
+        "✗ Exercise 2.1, publish chosen joints: Selected with joints='GUN' was accepted, but the tank has no joint "
+        "'GUN'. Hint: configure() should return False when a name is not in config.body.joint_names (and log why "
+        "with config.log.error)."
+    )
+
+
+def test_2_1_a_hidden_refusal_without_an_error_logged_fails_and_the_visible_ones_pass(monkeypatch):
+    told = _graded_2_1(monkeypatch, hidden=True, log=False)
+    assert told.startswith(
+        "✗ Exercise 2.1, publish chosen joints: a hidden case failed: a name the tank lacks (a joint of the tank in "
+        "the wrong case): configure logs an error, returns False."
+    ), told
+    assert _graded_2_1(monkeypatch, hidden=True).startswith("✓"), "the same, logged"
