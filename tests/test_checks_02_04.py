@@ -305,15 +305,15 @@ def _stand_in_2_1(
     runs: list, count=lambda rate: round(rate * step2.DURATION) + 1, edit=None, at=None, refuse=True, log=True
 ):
     """A stand-in for 2.1's drive, as a right answer runs: ``count(rate)`` messages 1/rate apart, of the joints
-    asked for, with the values of one state (``qpos``'s TURRET_Y 0); refuses a name the tank lacks, logging an
-    error.  Each run's ``(joints, rate, script)`` is appended to ``runs``; ``edit(message)`` changes each message;
-    ``at(seconds, state)`` stands in for the probe's state at a stamp; ``refuse``: refuse a name the tank lacks
-    (``log``: with an error logged)."""
+    asked for, with the values of one state (TURRET_Y's position and velocity 0); refuses a name the tank lacks,
+    logging an error.  Each run's ``(joints, rate, script)`` is appended to ``runs``; ``edit(message)`` changes
+    each message; ``at(seconds, state)`` stands in for the probe's state at a stamp; ``refuse``: refuse a name the
+    tank lacks (``log``: with an error logged)."""
     import logging
 
     from tutorial.app.app import ControllerError
 
-    qpos, qvel, effort = [0.0] * 7 + [0.0, -0.5], [0.0] * 6 + [1.5, -2.5], [0.0] * 6 + [3.0, 4.0]
+    qpos, qvel, effort = [0.0] * 7 + [0.0, -0.5], [0.0] * 6 + [0.0, -2.5], [0.0] * 6 + [3.0, 4.0]
     state = (qpos, None, None, qvel, effort)
     infos = {name: SimpleNamespace(qpos_adr=q, dof_adr=d) for name, (q, d) in JOINT_ADDRESSES.items()}
     body = SimpleNamespace(joint=lambda name: SimpleNamespace(info=infos[name]))
@@ -418,7 +418,7 @@ def test_2_1_a_stamp_that_is_no_step_of_the_run_is_told(monkeypatch):
     assert told == f"{FIRST_CASE}: a message stamped 0.520 s, not a step of the run. Hint: {ORDER_HINT}"
 
 
-def test_2_1_a_position_within_a_nanoradian_passes_and_a_hair_more_does_not(monkeypatch):
+def test_2_1_a_position_or_velocity_within_1e_9_passes_and_a_hair_more_does_not(monkeypatch):
     def off_by(rad):
         def edit(msg):
             if "TURRET_Y" in msg.name:
@@ -428,6 +428,16 @@ def test_2_1_a_position_within_a_nanoradian_passes_and_a_hair_more_does_not(monk
 
     assert _graded_2_1(monkeypatch, edit=off_by(1e-9)).startswith("✓")
     assert "TURRET_Y was published as 0.000000 rad" in _graded_2_1(monkeypatch, edit=off_by(1.0000001e-9))
+
+    def velocity_off_by(rad_s):
+        def edit(msg):
+            if "TURRET_Y" in msg.name:
+                msg.velocity[msg.name.index("TURRET_Y")] = rad_s  # the state's TURRET_Y velocity is 0
+
+        return edit
+
+    assert _graded_2_1(monkeypatch, edit=velocity_off_by(1e-9)).startswith("✓")
+    assert "TURRET_Y's velocity was published" in _graded_2_1(monkeypatch, edit=velocity_off_by(1.0000001e-9))
 
 
 def test_2_1_arrays_of_other_lengths_than_the_names_are_told(monkeypatch):
@@ -442,7 +452,7 @@ def test_2_1_arrays_of_other_lengths_than_the_names_are_told(monkeypatch):
 
 @pytest.mark.parametrize(
     "field, unit, value, got",
-    [("velocity", "rad/s", "1.500000", "-2.500000"), ("effort", "N m", "3.000000", "4.000000")],
+    [("velocity", "rad/s", "0.000000", "-2.500000"), ("effort", "N m", "3.000000", "4.000000")],
 )
 def test_2_1_a_velocity_or_effort_not_the_joints_own_is_told(monkeypatch, field, unit, value, got):
     def swap(msg):
