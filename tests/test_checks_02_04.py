@@ -308,7 +308,8 @@ def _stand_in_2_1(
     asked for, with the values of one state (TURRET_Y's position and velocity 0); refuses a name the tank lacks,
     logging an error.  Each run's ``(joints, rate, script)`` is appended to ``runs``; ``edit(message)`` changes
     each message; ``at(seconds, state)`` stands in for the probe's state at a stamp; ``refuse``: refuse a name the
-    tank lacks (``log``: with an error logged)."""
+    tank lacks, or those names for which ``refuse(names)`` is true (``log``: with an error logged; "not done": a
+    stub's NotImplementedError instead)."""
     import logging
 
     from tutorial.app.app import ControllerError
@@ -322,7 +323,9 @@ def _stand_in_2_1(
         joints, rate = parameters["joints"], parameters["rate"]
         runs.append((joints, rate, script))
         names = [n.strip() for n in joints.split(",") if n.strip()] or step2.TANK
-        if refuse and not set(names) <= set(step2.TANK):
+        if refuse(names) if callable(refuse) else refuse and not set(names) <= set(step2.TANK):
+            if log == "not done":  # the refusal left as a stub
+                raise ControllerError("Selected raised in configure") from NotImplementedError()
             if log:
                 logging.getLogger("rtt.Selected").error("joints: Tank has no joint %s", names)
             raise ControllerError("Selected refused to configure")
@@ -481,3 +484,19 @@ def test_2_1_a_hidden_refusal_without_an_error_logged_fails_and_the_visible_ones
         "the wrong case): configure logs an error, returns False."
     ), told
     assert _graded_2_1(monkeypatch, hidden=True).startswith("✓"), "the same, logged"
+
+
+def test_2_1_a_name_the_tank_lacks_after_one_it_has_is_named(monkeypatch):
+    first_only = _graded_2_1(monkeypatch, refuse=lambda names: names[0] not in step2.TANK)  # only the first checked
+    assert first_only == (
+        "✗ Exercise 2.1, publish chosen joints: Selected with joints='TURRET_Y,GUN' was accepted, but the tank has "
+        "no joint 'GUN'. Hint: configure() should return False when a name is not in config.body.joint_names (and "
+        "log why with config.log.error)."
+    )
+
+
+def test_2_1_a_refusal_left_as_a_stub_is_not_done_yet(monkeypatch):
+    told = _graded_2_1(monkeypatch, log="not done")
+    assert told.startswith("✗ Exercise 2.1, publish chosen joints: not done yet: Selected with joints='GUN' raised"), (
+        told
+    )
