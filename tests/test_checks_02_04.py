@@ -500,3 +500,118 @@ def test_2_1_a_refusal_left_as_a_stub_is_not_done_yet(monkeypatch):
     assert told.startswith("✗ Exercise 2.1, publish chosen joints: not done yet: Selected with joints='GUN' raised"), (
         told
     )
+
+
+# ---- 4.2's rule, as the check models it (_compare_reports), at its edges and in its words ----------------------
+
+
+def _imu_at(*readings):
+    """Imu messages ``(t in ms, x, y)``, frame "imu"."""
+    return [
+        SimpleNamespace(
+            linear_acceleration=SimpleNamespace(x=x, y=y, z=9.8),
+            header=SimpleNamespace(
+                stamp=SimpleNamespace(sec=ms // 1000, nanosec=ms % 1000 * 1_000_000), frame_id="imu"
+            ),
+        )
+        for ms, x, y in readings
+    ]
+
+
+def _reports_of(imu, indices, **changed):
+    """The reports a right answer publishes for ``imu[k]`` at each of ``indices``, with the fields ``changed``."""
+    out = []
+    for k in indices:
+        a, header = imu[k].linear_acceleration, imu[k].header
+        stamp = SimpleNamespace(sec=header.stamp.sec, nanosec=header.stamp.nanosec)
+        report = SimpleNamespace(
+            header=SimpleNamespace(stamp=stamp, frame_id=header.frame_id), vector=SimpleNamespace(x=a.x, y=a.y, z=0.0)
+        )
+        for name, value in changed.items():
+            if name == "frame_id":
+                report.header.frame_id = value
+            elif name == "nanosec":
+                report.header.stamp.nanosec += value
+            else:
+                setattr(report.vector, name, value)
+        out.append(report)
+    return out
+
+
+# 0.5 s apart at 50 ms: above 20 at 1.0 s (just), 1.2 s (inside the holdoff) and 1.5 s (exactly a holdoff after)
+WALL = _imu_at((950, 3.0, 0.0), (1000, 20.0, 1e-6), (1200, 30.0, 0.0), (1250, 20.0, 0.0), (1500, 0.0, 25.0))
+
+
+def test_4_2_above_threshold_strictly_then_again_a_whole_holdoff_after_the_last_report():
+    assert step4._compare_reports("c", {}, WALL, _reports_of(WALL, [1, 4])) == [1, 4]
+    # 20.0 exactly (at 1.25 s) is not above; 1.5 s is exactly 0.5 s after 1.0 s: reported
+    assert step4._compare_reports("c", {"threshold": 2.0, "holdoff": 0.25}, WALL, _reports_of(WALL, [0, 2, 4])) == [
+        0,
+        2,
+        4,
+    ]
+
+
+def test_4_2_a_run_without_a_collision_is_the_checks_own_fault_said_as_such():
+    from tutorial.exercises.grader import CaseFailed
+
+    with pytest.raises(CaseFailed) as caught:
+        step4._compare_reports("c", {}, _imu_at((100, 1.0, 1.0)), [])
+    assert (caught.value.what, caught.value.hint) == (
+        "c: the Imu messages show no collision at all; the tank should have hit the wall at about 2.05 s.",
+        "keep RttImuStatePublisher's behaviour: call super().publish().",
+    )
+
+
+@pytest.mark.parametrize(
+    "indices, changed, what, hint",
+    [
+        (
+            [1],
+            {},
+            "c made 1 report, stamped t = [1.0] s; expected 2 reports, at t = [1.0, 1.5] s.",
+            "report when hypot(x, y) of the mean is above threshold, and then not again until holdoff s of "
+            "simulated time have passed since that report (a period above threshold that is not reported does not "
+            "start it again).",
+        ),
+        (
+            [1, 2, 4],
+            {},
+            "c made 3 reports, stamped t = [1.0, 1.2, 1.5] s; expected 2 reports, at t = [1.0, 1.5] s.",
+            None,
+        ),
+        (
+            [1, 4],
+            {"nanosec": 1},
+            "c: the report of the Imu message of t = 1.0 s is stamped sec=1, nanosec=1; expected sec=1, nanosec=0.",
+            "copy the Imu message's header (stamp and frame_id).",
+        ),
+        (
+            [1, 4],
+            {"frame_id": "Tank"},
+            "c: the report at t = 1.0 s has frame_id 'Tank', expected 'imu'.",
+            "the vector is in the IMU's frame: use the Imu message's frame_id.",
+        ),
+        (
+            [1, 4],
+            {"z": 9.8},
+            "c: the report at t = 1.0 s carries [20.0, 0.0, 9.8], expected [20.0, 0.0, 0.0].",
+            "the vector is the mean acceleration's horizontal part: (x, y, 0).",
+        ),
+    ],
+)
+def test_4_2_each_way_a_report_differs_is_told_in_its_own_words(indices, changed, what, hint):
+    from tutorial.exercises.grader import CaseFailed
+
+    with pytest.raises(CaseFailed) as caught:
+        step4._compare_reports("c", {}, WALL, _reports_of(WALL, indices, **changed))
+    assert caught.value.what == what
+    assert hint is None or caught.value.hint == hint
+
+
+def test_4_2_a_reports_vector_within_1e_9_passes_and_a_hair_more_does_not():
+    from tutorial.exercises.grader import CaseFailed
+
+    assert step4._compare_reports("c", {}, WALL, _reports_of(WALL, [1, 4], z=1e-9)) == [1, 4]
+    with pytest.raises(CaseFailed, match="carries"):
+        step4._compare_reports("c", {}, WALL, _reports_of(WALL, [1, 4], z=1.0000001e-9))
