@@ -574,6 +574,12 @@ def test_4_2_a_run_without_a_collision_is_the_checks_own_fault_said_as_such():
             "simulated time have passed since that report (a period above threshold that is not reported does not "
             "start it again).",
         ),
+        (  # a stamp off the Imu's, told to the millisecond, as the expected ones are
+            [1],
+            {"nanosec": 300_000},
+            "c made 1 report, stamped t = [1.0] s; expected 2 reports, at t = [1.0, 1.5] s.",
+            None,
+        ),
         (
             [1, 2, 4],
             {},
