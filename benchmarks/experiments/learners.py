@@ -47,15 +47,13 @@ import numpy as np
 import psutil
 
 from benchmarks.stats import pct
-from tutorial.view.widget.flow import WINDOW
+from tutorial.view.widget.flow import ANSWER_EVERY, LONE_WAIT_MS  # as widget.js answers (widget.py writes them in)
 
 ROOT = Path(__file__).resolve().parents[2]
 LEARNERS = (1, 2, 4, 8, 16)
 # ROS domains for the hub to give out: one upper block (215-232) and 101, clear of the 1-100 that test
 # sessions and the other benchmarks pick from.
 DOMAINS = (101, *range(215, 233))
-ANSWER_EVERY = WINDOW // 2  # frames answered at once, as widget.js answers them (widget.py writes it in)
-LONE_WAIT_MS = 250  # how long the first frame owed waits for the others: widget.js's LONE_WAIT_MS
 # The code path before the cuts of 2026-11-27 and 28, kept for a same-run baseline (--before; rtt-joy's own cut
 # is not undone, and the kernel keeps today's window of eight frames): a view answered two frames at a time and
 # a lone frame two animation frames later, and a class's simulation slept before every step (the hub's

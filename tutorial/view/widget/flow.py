@@ -52,6 +52,10 @@ import umsgpack
 from tutorial.view.meshcat_batch import pack_batch
 
 WINDOW = 8  # frames sent and not yet answered, at most (a view answers four frames at a time: widget.js)
+# How a view answers (widget.js, where widget.py writes both in): the frames drawn it answers at once, half the
+# window (as many more are on their way meanwhile), and how long the first frame owed waits for the others, ms.
+ANSWER_EVERY = WINDOW // 2
+LONE_WAIT_MS = 250
 BUSY_RATE = 10.0  # frames/s sent while the kernel runs a cell (no answers can arrive then)
 BUSY_UNANSWERED = 600  # frames sent in a row with no answer, while busy, before the flow stops (a minute)
 KINDS = ("set_transform", "set_object", "set_property", "delete", "set_animation")

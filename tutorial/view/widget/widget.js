@@ -21,7 +21,7 @@ const LIMITS = __LIMITS__;
 const KNOWN = ["set_transform", "set_transforms", "set_object", "set_property", "delete", "set_animation"];
 const SCRIPT_KEY = "__rttMeshcatViewerScript";
 const ANSWER_EVERY = __ANSWER_EVERY__;  // frames drawn that are answered at once: half flow.py's WINDOW (widget.py)
-const LONE_WAIT_MS = 250;  // how long the first frame owed waits for the others before what is owed is answered, ms
+const LONE_WAIT_MS = __LONE_WAIT_MS__;  // how long the first frame owed waits for the others before it is answered, ms
 
 // meshcat's viewer script as a blob: URL, asked of the kernel once per browser page and shared by every view.
 function viewerScript(model) {

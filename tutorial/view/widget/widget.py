@@ -44,7 +44,7 @@ import traitlets
 
 from tutorial.view import meshcat_batch
 from tutorial.view.meshcat_page import PAGE_SCRIPT, viewer_script_gzip
-from tutorial.view.widget.flow import WINDOW, FrameFlow
+from tutorial.view.widget.flow import ANSWER_EVERY, LONE_WAIT_MS, FrameFlow
 from tutorial.view.widget.subshell import ViewSubshell, current_kernel
 
 # What a view takes in one command (widget.js refuses more and says so): a mesh of a few hundred
@@ -60,10 +60,11 @@ LIMITS = {
 
 
 def _esm() -> str:
-    """widget.js with the page script, the limits and how many frames a view answers at once written in (half the
-    flow's window: as many more are on their way meanwhile), as JavaScript literals."""
+    """widget.js with the page script, the limits and how a view answers the frames it draws written in
+    (:data:`tutorial.view.widget.flow.ANSWER_EVERY`, :data:`~tutorial.view.widget.flow.LONE_WAIT_MS`), as
+    JavaScript literals."""
     source = (Path(__file__).with_name("widget.js")).read_text(encoding="utf-8")
-    source = source.replace("__ANSWER_EVERY__", str(WINDOW // 2))
+    source = source.replace("__ANSWER_EVERY__", str(ANSWER_EVERY)).replace("__LONE_WAIT_MS__", str(LONE_WAIT_MS))
     return source.replace("__PAGE_SCRIPT__", json.dumps(PAGE_SCRIPT)).replace("__LIMITS__", json.dumps(LIMITS))
 
 
