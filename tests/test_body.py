@@ -39,6 +39,17 @@ def test_two_bodies_in_one_world_keep_their_own_names():
     assert b.joint("TURRET_Y").q == 0.0 and a.joint_names == b.joint_names
 
 
+def test_a_roots_free_joint_is_found_in_qpos_and_a_fixed_root_has_none():
+    model = build_world([ModelEntry("Tank", MODEL / "tank.xml"), ModelEntry("Tank2", MODEL / "tank.xml", (2, 0, 0))])
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    a, b = Body(model, data, "Tank"), Body(model, data, "Tank2")
+    assert b.root_qpos_address not in (None, a.root_qpos_address)
+    assert list(data.qpos[b.root_qpos_address : b.root_qpos_address + 3]) == list(data.xpos[b.root_id])
+    crane = build_world([ModelEntry("Crane", MODEL / "crane.xml")])
+    assert Body(crane, mujoco.MjData(crane), "Crane").root_qpos_address is None  # bolted to the ground
+
+
 # ---- models whose links and joints have no names -------------------------------------
 
 UNNAMED = FIXTURES / "unnamed_links.xml"

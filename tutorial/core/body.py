@@ -362,6 +362,15 @@ class Body:
         """
         return self.data.xpos[self.root_id].copy(), self.data.xquat[self.root_id].copy()
 
+    @property
+    def root_qpos_address(self) -> int | None:
+        """Where the root link's free joint starts in ``qpos``: its position (3,), m, then its orientation (4,),
+        w x y z; None when the root has no free joint (it is fixed in the world).  Any thread (the model only)."""
+        m, joint = self.model, self.model.body_jntadr[self.root_id]
+        if joint < 0 or m.jnt_type[joint] != mujoco.mjtJoint.mjJNT_FREE:
+            return None
+        return int(m.jnt_qposadr[joint])
+
     def joint_positions(self) -> dict[str, float]:
         """Numbered joint positions by name, rad or m."""
         return {j.name: j.q for j in self.joints}

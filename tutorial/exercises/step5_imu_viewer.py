@@ -107,8 +107,7 @@ def _turn_left(app, controller, angle: float) -> None:
 
 def _place(app, controller, position=None, orientation=None) -> None:
     """Put the viewer's tank's root at ``position`` (m), turned by the quaternion ``orientation`` (w, x, y, z)."""
-    model = app.model  # the tank's root has a free joint: its position (3,), then its orientation (4,)
-    root = int(model.jnt_qposadr[model.body_jntadr[controller.body.root_id]])
+    root = controller.body.root_qpos_address  # the tank's free joint: its position (3,), then its orientation (4,)
     if position is not None:
         app.data.qpos[root : root + 3] = position
     if orientation is not None:

@@ -301,12 +301,9 @@ class BackgroundApp:
         app = self.app
         if app is None or app.sim is None:
             raise RuntimeError(f"/{self.node_name} is not simulating")
-        model = app.model
-        root = app.bodies[body].root_id
-        joint = model.body_jntadr[root]
-        if joint < 0 or model.jnt_type[joint] != 0:  # mjJNT_FREE is 0
+        adr = app.bodies[body].root_qpos_address
+        if adr is None:
             raise ValueError(f"{body}'s root has no free joint: it does not move in the world")
-        adr = model.jnt_qposadr[joint]
         return [float(v) for v in app.sim.snapshot().qpos[adr : adr + 3]]
 
     def controller(self, name: str):
