@@ -10,9 +10,9 @@ read the same stream at the same time:
 
 * a bare raw subscriber that only counts, with the QoS the recorder
   requests and on the same executor (``SpinThread``);
-* the recorder with its write-through policy (:mod:`tutorial.bag.writer`:
+* the recorder with its write-through policy (:mod:`tutorial.tools.bag.writer`:
   a chunk closed at least every 0.5 s, flushed and fsync'ed): the
-  :class:`tutorial.bag.record.BagRecorder` that ``rtt-bag record`` runs;
+  :class:`tutorial.tools.bag.record.BagRecorder` that ``rtt-bag record`` runs;
 * the same recorder without write-through (``write_through=False``: 1 MiB
   chunks, no flush, no fsync, the policy before issue 26): the baseline.
 
@@ -133,9 +133,9 @@ def record(path: str, compression: str, write_through: bool) -> int:
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
-    from tutorial.bag.record import BagRecorder
     from tutorial.ros import env as ros_env
     from tutorial.ros import program as ros_program
+    from tutorial.tools.bag.record import BagRecorder
 
     stop = ros_program.StopRequest()
     signal.signal(signal.SIGINT, stop)  # SIGINT only, as count()
@@ -269,7 +269,7 @@ def run(rate: float, seconds: float, compression: str, keep: str | None) -> dict
 
 def file_numbers(path: Path) -> list[int]:
     """The message numbers in the file, in log-time order (decoded without ROS, as a reader would)."""
-    from tutorial.bag.reader import read_messages
+    from tutorial.tools.bag.reader import read_messages
 
     return [int(msg.position[0]) for _topic, _t, msg in read_messages(path)]
 

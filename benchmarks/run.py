@@ -246,7 +246,7 @@ def _suite(args) -> int:
     measure("browser", lambda: pixel_latency(list(BROWSER_CASES), seconds, warmup))
     measure("widget", lambda: widget_vs_page(list(WIDGET_CASES), seconds, warmup))
     measure("first_picture", lambda: first_picture(4 if args.quick else 10))
-    from tutorial.network.hosts import why_unavailable
+    from tutorial.tools.network.hosts import why_unavailable
 
     hosts_problem = why_unavailable()
     if hosts_problem:  # its targets are left out of the table, and this says why

@@ -27,9 +27,9 @@ import msgpack
 import rclpy
 from rclpy.signals import SignalHandlerOptions
 
-from tutorial.app.standalone import StandaloneApp
 from tutorial.core.project import load_project
 from tutorial.ros import env as ros_env
+from tutorial.tools.standalone.app import StandaloneApp
 from tutorial.view.meshcat_batch import SET_TRANSFORMS
 
 
@@ -46,7 +46,7 @@ def main() -> int:
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     server = vis = tape = None
     if args.record_meshcat:
-        from tutorial.view.meshcat_server import start_server
+        from tutorial.tools.standalone.meshcat_server import start_server
 
         server = start_server(batch=not args.meshcat_no_batch)
         vis = server.visualizer()
@@ -65,7 +65,8 @@ def main() -> int:
         app.open()
         probes = [c for _, c, _ in app.controllers if hasattr(c, "frame_drawn")]
         sink = None if app.scene is None else app.scene.sink
-        if tape is not None and hasattr(sink, "socket"):  # a BatchSink (tutorial.view.sinks): its frames' socket
+        # a BatchSink (tutorial.tools.standalone.sinks): its frames' socket
+        if tape is not None and hasattr(sink, "socket"):
             tape.probes = {probe.config.body_name: probe for probe in probes}
             sink.socket = tape.tap(sink.socket)
 

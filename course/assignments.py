@@ -10,7 +10,7 @@ learner's code cell, its check cell, and its folded worked solution):
 - the learner's code cell becomes an **autograded answer** cell: the worked
   solution (after the stub, as the teacher's notebook runs them) sits between
   nbgrader's ``### BEGIN SOLUTION`` and ``### END SOLUTION``, and the release shows the notebook's own stub instead
-  (``tutorial.exercises.release.ReleaseStubs``, which runs inside ``nbgrader generate_assignment``
+  (``tutorial.tools.grading.release.ReleaseStubs``, which runs inside ``nbgrader generate_assignment``
   right after nbgrader's own ``ClearSolutions``);
 - the check cell becomes a **read-only autograder test** cell worth the
   exercise's :data:`POINTS`; its call ends in ``.require()``, which raises
@@ -96,7 +96,7 @@ def source_notebook(notebook: dict) -> dict:
         stub["source"] = f"### BEGIN SOLUTION\n{stub_text.rstrip()}\n\n\n{solution}### END SOLUTION"
         stub["metadata"] = {
             "nbgrader": dict(NBGRADER, grade=False, solution=True, locked=False, grade_id=f"exercise_{tag}"),
-            "rtt_stub": stub_text,  # what the release shows in its place (tutorial.exercises.release)
+            "rtt_stub": stub_text,  # what the release shows in its place (tutorial.tools.grading.release)
         }
         check = cells[ex["check"]]
         check["source"] = CHECK_CALL.sub(r"\1(\2).require()", "".join(check["source"]))

@@ -23,7 +23,7 @@ from nbgrader.preprocessors import (
     SaveCells,
 )
 
-from tutorial.exercises.release import ReleaseStubs
+from tutorial.tools.grading.release import ReleaseStubs
 
 c = get_config()  # noqa: F821 - given by nbgrader when it reads this file
 
@@ -32,7 +32,7 @@ c.CourseDirectory.course_id = "ros-tank-tutorial"
 c.Exchange.root = os.environ.get("RTT_NBGRADER_EXCHANGE", str(Path(__file__).resolve().parent / ".hub" / "exchange"))
 c.Exchange.path_includes_course = True
 
-# The release shows each exercise's own stub (tutorial/exercises/release.py), right after nbgrader's
+# The release shows each exercise's own stub (tutorial/tools/grading/release.py), right after nbgrader's
 # ClearSolutions has taken the worked solution out; the rest is nbgrader's own list, in its order.
 c.ClearSolutions.code_stub = {"python": "raise NotImplementedError"}
 c.GenerateAssignment.preprocessors = [
@@ -56,7 +56,7 @@ c.GenerateAssignment.preprocessors = [
 # its own (a camera's render thread) cannot be interrupted and slows the kernel for the rest of the
 # notebook: its outputs may come late, which must not end the grading of the notebook.
 c.Execute.timeout = int(os.environ.get("RTT_GRADING_CELL_TIMEOUT", "120"))
-# course/grade.py grades in a sandbox (tutorial/exercises/sandbox.py): each kernel as the job's own user,
+# course/grade.py grades in a sandbox (tutorial/tools/grading/sandbox.py): each kernel as the job's own user,
 # without network, limited and sealed; RTT_SANDBOX describes the job.
 if os.environ.get("RTT_SANDBOX"):
     from nbconvert.preprocessors import ClearMetadataPreprocessor
@@ -67,7 +67,7 @@ if os.environ.get("RTT_SANDBOX"):
         SaveAutoGrades,
     )
 
-    from tutorial.exercises.sandbox import SandboxedExecute
+    from tutorial.tools.grading.sandbox import SandboxedExecute
 
     # nbgrader's own list (nbgrader.converters.autograde), its Execute sandboxed
     c.Autograde.autograde_preprocessors = [

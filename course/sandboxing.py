@@ -1,10 +1,10 @@
 """The grading sandbox's side in ``course/grade.py``: its users, the seal's verdicts, the flags a teacher sees.
 
 ``grade.py`` grades each submission in a sandbox
-(:mod:`tutorial.exercises.sandbox`): :class:`Sandboxes` makes one Unix user
+(:mod:`tutorial.tools.grading.sandbox`): :class:`Sandboxes` makes one Unix user
 per grading job and removes it afterwards.  After each ``nbgrader autograde``,
 :func:`settle` has :func:`judge` read what the kernel's seal
-(:mod:`tutorial.exercises.seal`) signed, nbgrader's own log and the
+(:mod:`tutorial.tools.grading.seal`) signed, nbgrader's own log and the
 autograded notebook, and decide each
 exercise: its points stand only if nbgrader *and* the seal say it passed.
 Its flags say why not, or what else was seen:
@@ -41,7 +41,7 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tutorial.exercises.sandbox import Job
+from tutorial.tools.grading.sandbox import Job
 
 ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")

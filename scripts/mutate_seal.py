@@ -2,7 +2,7 @@
 
     python scripts/mutate_seal.py [--dir DIR] [--sample N] [--seed S]
 
-The seal (``tutorial/exercises/seal.py``) is tested in a Python of its own
+The seal (``tutorial/tools/grading/seal.py``) is tested in a Python of its own
 (``tests/test_seal.py``: a sealed process stays sealed), where mutmut sees
 neither which test reaches which function nor, as it runs, the function it
 wraps.  This makes a git worktree of HEAD in ``DIR`` (default: beside this
@@ -37,12 +37,12 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-SEAL = "tutorial/exercises/seal.py"
+SEAL = "tutorial/tools/grading/seal.py"
 HOOK = """
 
 def _rtt_make_hook_code():  # scripts/mutate_seal.py: the code of the mutant under test's _make_hook
     name = os.environ.get("MUTANT_UNDER_TEST", "")
-    prefix = "tutorial.exercises.seal.x__make_hook__mutmut_"
+    prefix = "tutorial.tools.grading.seal.x__make_hook__mutmut_"
     if name.startswith(prefix):
         return globals()["x__make_hook__mutmut_" + name[len(prefix):]].__code__
     return x__make_hook__mutmut_orig.__code__
@@ -52,7 +52,7 @@ REACHED = """    if os.environ.get("MUTANT_UNDER_TEST") == "stats":  # scripts/m
         from mutmut.stats import record_trampoline_hit
 
         for name in {names!r}:
-            record_trampoline_hit("tutorial.exercises.seal." + name)
+            record_trampoline_hit("tutorial.tools.grading.seal." + name)
 """
 
 

@@ -111,7 +111,7 @@ def skip_cells_needing_hosts(items) -> None:
     """Skip, saying why, the notebook cells that need network hosts where none can be made.
 
     Notebook 08 runs programs on two hosts made of network namespaces
-    (:mod:`tutorial.network.hosts`, root only).  Its cells that need them begin
+    (:mod:`tutorial.tools.network.hosts`, root only).  Its cells that need them begin
     with ``# NEEDS_HOSTS``; without hosts they print ``no hosts here: <why>``,
     not their saved outputs (from a run that had hosts), so nbval skips
     exactly those cells.  Every other cell, the exercises too, is checked.
@@ -119,7 +119,7 @@ def skip_cells_needing_hosts(items) -> None:
     needing = [i for i in items if NEEDS_HOSTS in getattr(getattr(i, "cell", None), "source", "")]
     if not needing:
         return
-    from tutorial.network.hosts import why_unavailable
+    from tutorial.tools.network.hosts import why_unavailable
 
     problem = why_unavailable()
     if problem is not None:

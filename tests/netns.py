@@ -1,6 +1,6 @@
 """The network tier's hosts: a fixture that makes two hosts, runs our programs on them, and removes them.
 
-``net`` gives a :class:`tutorial.network.hosts.Network` with the hosts
+``net`` gives a :class:`tutorial.tools.network.hosts.Network` with the hosts
 ``robot`` (198.18.25.1) and ``operator`` (198.18.25.2), each a network
 namespace joined to the other through a switch namespace.  Programs started
 with :func:`on` run inside a host with ``ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET``
@@ -22,7 +22,7 @@ import json
 
 import pytest
 
-from tutorial.network.hosts import Host, Network, why_unavailable
+from tutorial.tools.network.hosts import Host, Network, why_unavailable
 
 from conftest import Proc, module_command
 

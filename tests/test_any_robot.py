@@ -115,10 +115,10 @@ def test_the_monitor_mirrors_every_robot_of_example_robot_data(ros, node, monkey
     from sensor_msgs.msg import JointState
     from std_msgs.msg import String
 
-    from tutorial.app.standalone import StandaloneApp
     from tutorial.interfaces.joint_state import joint_state_qos
     from tutorial.interfaces.robot_description import robot_description_qos
-    from tutorial.urdf.mesh_files import MeshError, resolve_mesh
+    from tutorial.tools.standalone.app import StandaloneApp
+    from tutorial.tools.urdf.mesh_files import MeshError, resolve_mesh
 
     if rel in URDFDOM_REFUSES:  # the list test_urdfdom_accepts_68_of_the_69_files_and_yourdfpy_reads_them checks
         pytest.skip(f"urdfdom refuses it: {URDFDOM_REFUSES[rel]}")
@@ -208,7 +208,7 @@ def test_the_monitor_mirrors_every_robot_of_example_robot_data(ros, node, monkey
 def test_the_description_line_says_what_was_changed_to_draw_it(tmp_path, monkeypatch):
     """HyQ's inertias MuJoCo refuses are replaced, and said once, the first links named; Baxter's thin visual
     meshes have no volume, which a drawing does not need: nothing to say."""
-    from tutorial.urdf.mujoco_load import mujoco_text
+    from tutorial.tools.urdf.mujoco_load import mujoco_text
 
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(PREFIX))
     hyq = mujoco_text((ROBOTS / "hyq_description/robots/hyq_no_sensors.urdf").read_text(), cache=tmp_path)
@@ -220,7 +220,7 @@ def test_the_description_line_says_what_was_changed_to_draw_it(tmp_path, monkeyp
 
 
 def test_a_mesh_that_cannot_be_found_or_read_leaves_out_only_its_visual(tmp_path, monkeypatch):
-    from tutorial.urdf.mujoco_load import mujoco_text
+    from tutorial.tools.urdf.mujoco_load import mujoco_text
 
     monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))
     broken = tmp_path / "broken.dae"
@@ -285,7 +285,7 @@ def test_an_inertia_mujoco_refuses_is_replaced_and_only_then(tmp_path):
     from hypothesis import strategies as st
 
     from tutorial.core.world import drawing_spec
-    from tutorial.urdf.mujoco_load import mujoco_text
+    from tutorial.tools.urdf.mujoco_load import mujoco_text
 
     from fuzzing import examples
 
@@ -326,9 +326,9 @@ def test_a_mesh_over_mujocos_limit_is_simplified_and_one_it_refuses_is_left_out(
     import trimesh
 
     from tutorial.core.world import drawing_spec
-    from tutorial.urdf.mesh_files import MAX_FACES, drawable_meshes
-    from tutorial.urdf.meshes import write_stl
-    from tutorial.urdf.mujoco_load import mujoco_text
+    from tutorial.tools.urdf.mesh_files import MAX_FACES, drawable_meshes
+    from tutorial.tools.urdf.meshes import write_stl
+    from tutorial.tools.urdf.mujoco_load import mujoco_text
 
     sphere = trimesh.creation.icosphere(subdivisions=7, radius=0.05)
     big = write_stl(tmp_path / "big.stl", sphere.vertices, sphere.faces)
@@ -350,7 +350,7 @@ def test_a_mesh_over_mujocos_limit_is_simplified_and_one_it_refuses_is_left_out(
 
 
 def test_package_uris_are_found_as_ros_finds_them(tmp_path):
-    from tutorial.urdf.mesh_files import MeshError, resolve_mesh
+    from tutorial.tools.urdf.mesh_files import MeshError, resolve_mesh
 
     ament, ros1 = tmp_path / "install", tmp_path / "src"
     (ament / "share" / "arm" / "meshes").mkdir(parents=True)
@@ -368,7 +368,7 @@ def test_package_uris_are_found_as_ros_finds_them(tmp_path):
 
 
 def test_a_converted_mesh_is_cached(tmp_path):
-    from tutorial.urdf.mesh_files import drawable_meshes
+    from tutorial.tools.urdf.mesh_files import drawable_meshes
 
     dae = ROBOTS / "panda_description" / "meshes" / "visual" / "link0.dae"
     cold = drawable_meshes(dae, tmp_path)
@@ -404,8 +404,8 @@ def test_the_robot_is_drawn_with_its_meshes(ros, node, tmp_path, monkeypatch, na
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from std_msgs.msg import String
 
-    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
+    from tutorial.tools.standalone.app import StandaloneApp
 
     from browser import chromium, screenshot
 
@@ -456,9 +456,9 @@ def test_a_floating_base_stands_where_its_odometry_puts_it(ros, node, tmp_path, 
     from sensor_msgs.msg import JointState
     from std_msgs.msg import String
 
-    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
     from tutorial.interfaces.joint_state import joint_state_qos
+    from tutorial.tools.standalone.app import StandaloneApp
 
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(PREFIX))
     monkeypatch.setenv("RTT_MESH_CACHE", str(tmp_path / "meshes"))

@@ -7,14 +7,14 @@ import sys
 import pytest
 import yaml
 
-from tutorial.bag import qos
-from tutorial.bag.info import bag_info, format_info
-from tutorial.bag.reader import BagError, check_file, iter_raw
-from tutorial.bag.series import joint_series
-from tutorial.bag.writer import BagWriter
 from tutorial.interfaces import definitions
 from tutorial.interfaces.definitions import UnknownMessageType
 from tutorial.tools import rtt_bag
+from tutorial.tools.bag import qos
+from tutorial.tools.bag.info import bag_info, format_info
+from tutorial.tools.bag.reader import BagError, check_file, iter_raw
+from tutorial.tools.bag.series import joint_series
+from tutorial.tools.bag.writer import BagWriter
 
 from conftest import ROOT, module_command, wait_until
 
@@ -176,7 +176,7 @@ def test_recorded_file_is_what_rosbag2_writes_and_stock_readers_open_it(ros, nod
     from rosbags.highlevel import AnyReader
     from sensor_msgs.msg import JointState, Joy
 
-    from tutorial.bag.record import BagRecorder
+    from tutorial.tools.bag.record import BagRecorder
 
     path = tmp_path / "drive.mcap"
     states = node.create_publisher(JointState, "/bag_test/joint_state", reliable_keep_last_1())
@@ -267,8 +267,8 @@ def test_all_topics_takes_late_publishers_but_not_hidden_topics(ros, node, tmp_p
     """Here on a node the caller owns and spins (a notebook's), which outlives the recorder."""
     from std_msgs.msg import String
 
-    from tutorial.bag.record import BagRecorder
     from tutorial.ros.spin import SpinThread
+    from tutorial.tools.bag.record import BagRecorder
 
     own = ros.create_node("test_bag_own_node")
     spin = SpinThread(own).start()
@@ -315,8 +315,8 @@ def test_player_keeps_the_timing_and_honours_rate_offset_topics_and_loop(ros, no
 
     from sensor_msgs.msg import Joy
 
-    from tutorial.bag.play import BagPlayer
     from tutorial.ros.spin import SpinThread
+    from tutorial.tools.bag.play import BagPlayer
 
     bag = timed_bag(tmp_path / "timed.mcap")
     lock = threading.Lock()  # the spin thread appends, the test thread reads
@@ -652,8 +652,8 @@ def test_reading_needs_no_ros():
     import subprocess
 
     code = (
-        "import sys; import tutorial.bag; from tutorial.bag import joint_series, bag_info, format_info; "
-        "import tutorial.bag.reader, tutorial.bag.info; "
+        "import sys; import tutorial.tools.bag; from tutorial.tools.bag import joint_series, bag_info, format_info; "
+        "import tutorial.tools.bag.reader, tutorial.tools.bag.info; "
         "bad = [m for m in sys.modules if m.startswith(('rclpy', 'sensor_msgs'))]; print(bad)"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, cwd=ROOT)

@@ -4,9 +4,9 @@ import signal
 
 import pytest
 
-from tutorial.bag.info import bag_info
-from tutorial.bag.qos import offer_for_recorded
-from tutorial.bag.series import joint_series
+from tutorial.tools.bag.info import bag_info
+from tutorial.tools.bag.qos import offer_for_recorded
+from tutorial.tools.bag.series import joint_series
 
 from conftest import module_command, publishers_seen, wait_until
 

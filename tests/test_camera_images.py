@@ -10,7 +10,7 @@ import pytest
 from sensor_msgs.msg import Image
 
 from tutorial.interfaces.image import ImageError, image_to_array
-from tutorial.view.image_files import PngWriter, format_image_status, png_bytes
+from tutorial.tools.image_files import PngWriter, format_image_status, png_bytes
 from tutorial.view.images import ImageReceiver
 
 from conftest import wait_until

@@ -17,7 +17,7 @@ from tutorial.interfaces.compressed_image import (
     fill_compressed_image,
 )
 from tutorial.interfaces.image import ImageError
-from tutorial.view.image_files import format_image_status
+from tutorial.tools.image_files import format_image_status
 from tutorial.view.images import ImageReceiver, transport_topic
 
 

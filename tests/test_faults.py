@@ -504,7 +504,7 @@ def test_recorder_stops_with_one_line_when_the_disk_is_full_and_its_file_stays_r
 
     from sensor_msgs.msg import JointState
 
-    from tutorial.bag.info import bag_info
+    from tutorial.tools.bag.info import bag_info
 
     from test_bag import recovered_by_stock_readers
 

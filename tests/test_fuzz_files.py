@@ -19,13 +19,13 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tutorial.bag.info import bag_info
-from tutorial.bag.reader import BagError, iter_raw, read_messages
-from tutorial.bag.recover import recover
-from tutorial.bag.series import joint_series
 from tutorial.core.project import ProjectError, load_project
 from tutorial.core.world import ModelEntry, ModelError, build_world
 from tutorial.tools import rtt_bag as bag_cli
+from tutorial.tools.bag.info import bag_info
+from tutorial.tools.bag.reader import BagError, iter_raw, read_messages
+from tutorial.tools.bag.recover import recover
+from tutorial.tools.bag.series import joint_series
 
 from conftest import MODEL, PROJECT
 from fuzzing import examples

@@ -294,7 +294,7 @@ def odometries():
 
 @pytest.fixture(scope="module")
 def floating_base():
-    from tutorial.app.floating_base import FloatingBase
+    from tutorial.tools.standalone.floating_base import FloatingBase
 
     model, data = world(("Tank", "tank.xml"), odometry="/Tank/odom")
     controller = FloatingBase("/Tank/odom")
@@ -419,8 +419,8 @@ def test_a_viewer_takes_any_robot_description():
     ``DescriptionError`` or ``ValueError`` (``rtt-run``: one line), whatever the text: junk, or the tank's
     own URDF cut short, with a value or a name changed."""
     from tutorial.interfaces.robot_description import DescriptionError
-    from tutorial.urdf.export import export_body
-    from tutorial.urdf.mujoco_load import load_description
+    from tutorial.tools.urdf.export import export_body
+    from tutorial.tools.urdf.mujoco_load import load_description
 
     model = build_world([ModelEntry("Tank", MODEL / "tank.xml")])
     tank = export_body(Body(model, mujoco.MjData(model), "Tank")).xml()

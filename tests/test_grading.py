@@ -473,7 +473,7 @@ def test_grading_every_assignment(tmp_path, monkeypatch):
     grade_all(tmp_path, ALL)
 
 
-# ---- submissions that cheat (the sandbox and seal: tutorial/exercises/sandbox.py, seal.py; course/sandboxing.py) ----
+# ---- submissions that cheat (the sandbox and seal: tutorial/tools/grading/, course/sandboxing.py) ----
 
 STUB_1_1 = "def dpad_track_velocities(axes):\n    raise NotImplementedError\n"
 GRADER = "import tutorial.exercises.grader as grader\n"

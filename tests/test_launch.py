@@ -150,8 +150,8 @@ def test_record_option_records_the_steps_topics_alongside(procs, tmp_path):
     ``/robot_description``, ``/tf_static`` and ``/tf`` (read back with the ``mcap`` reader
     and ``mcap-ros2-support``'s decoder, as Foxglove reads them).
     """
-    from tutorial.bag.info import bag_info
-    from tutorial.bag.reader import read_messages
+    from tutorial.tools.bag.info import bag_info
+    from tutorial.tools.bag.reader import read_messages
 
     bag = tmp_path / "launch.mcap"
     launch = procs(

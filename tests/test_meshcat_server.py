@@ -192,7 +192,7 @@ def server_of():
     servers = []
 
     def start(batch: bool):
-        from tutorial.view.meshcat_server import start_server
+        from tutorial.tools.standalone.meshcat_server import start_server
 
         servers.append(start_server(batch=batch))
         return servers[-1]
@@ -205,8 +205,8 @@ def server_of():
 @pytest.mark.cross_process
 @pytest.mark.parametrize("batch", [True, False], ids=["project_server", "meshcats_own_server"])
 def test_the_scene_sends_a_frame_as_one_message_where_it_can_and_every_pose_arrives(server_of, batch):
+    from tutorial.tools.standalone.sinks import BatchSink, frame_sink
     from tutorial.view.scene import Scene
-    from tutorial.view.sinks import BatchSink, frame_sink
 
     server = server_of(batch)
     model, data = tank()
@@ -283,7 +283,7 @@ def test_a_page_that_closed_meanwhile_is_skipped_and_the_others_still_get_the_fr
 
     import tornado.websocket
 
-    from tutorial.view.meshcat_server import _bridge_classes
+    from tutorial.tools.standalone.meshcat_server import _bridge_classes
 
     class Page:
         def __init__(self, closed: bool):
@@ -318,7 +318,7 @@ def test_a_programs_page_is_also_named_through_the_jupyter_it_runs_under():
     """rtt-run's line: under a JupyterHub (its server's environment) or in a Jupyter terminal, the page through
     jupyter-server-proxy as well; outside Jupyter, the page alone.  tests/test_hub.py opens it on a hub."""
     from tutorial.tools.rtt_run import format_record
-    from tutorial.view.meshcat_server import through_jupyter
+    from tutorial.tools.standalone.meshcat_server import through_jupyter
 
     url = "http://127.0.0.1:7003/static/"
     hub = {"JUPYTERHUB_SERVICE_PREFIX": "/user/ada/", "JUPYTER_SERVER_URL": "http://127.0.0.1:41000/user/ada/"}
@@ -567,7 +567,7 @@ FRAME = [("/meshcat/rtt/a", pose(1.0)), ("/meshcat/rtt/b", pose(2.0))]
 
 @pytest.mark.unit
 def test_meshcats_unknown_command_answer_turns_batching_off_and_the_frame_goes_as_singles():
-    from tutorial.view.sinks import BatchSink
+    from tutorial.tools.standalone.sinks import BatchSink
 
     server = StandInServer([b"error: unrecognized comand", b"ok", b"ok", b"ok", b"ok"])
     pipe = BatchSink(server.url)
@@ -585,7 +585,7 @@ def test_meshcats_unknown_command_answer_turns_batching_off_and_the_frame_goes_a
 
 @pytest.mark.unit
 def test_any_other_refusal_of_a_frame_is_raised_not_hidden_by_a_fallback():
-    from tutorial.view.sinks import BatchSink
+    from tutorial.tools.standalone.sinks import BatchSink
 
     server = StandInServer([b"error: not msgpack within the limits: ExtraData"])
     pipe = BatchSink(server.url)
@@ -602,7 +602,7 @@ def test_any_other_refusal_of_a_frame_is_raised_not_hidden_by_a_fallback():
 def test_after_a_timeout_a_late_reply_is_not_taken_for_the_next_frames():
     import threading
 
-    from tutorial.view.sinks import BatchSink
+    from tutorial.tools.standalone.sinks import BatchSink
 
     release = threading.Event()
     # The first frame's reply comes late, and says something the next frame must never read as its own.

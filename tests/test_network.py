@@ -18,13 +18,13 @@ import time
 
 import pytest
 
-from tutorial.network.discovery import (
+from tutorial.tools.network.discovery import (
     discovery_server_command,
     discovery_server_env,
     fast_dds_library_path,
     static_peers_env,
 )
-from tutorial.network.hosts import PREFIX, SHM_ROOT, SUBNET, Network, namespaces, remove_stale, run
+from tutorial.tools.network.hosts import PREFIX, SHM_ROOT, SUBNET, Network, namespaces, remove_stale, run
 
 from conftest import publishers_seen, wait_until
 from netns import is_event, net, network_problem, on  # noqa: F401 - net is a fixture
@@ -88,7 +88,7 @@ def test_hosts_are_closed_off_and_removed_even_after_a_killed_run():
 
 NOTEBOOK_08_KERNEL = """
 import json
-from tutorial.network.hosts import SHM_ROOT, namespaces
+from tutorial.tools.network.hosts import SHM_ROOT, namespaces
 from tutorial.notebook.two_hosts import TwoHosts
 
 first = TwoHosts()  # notebook 08's first cell ...

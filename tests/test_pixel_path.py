@@ -119,8 +119,8 @@ def path_of(viewer_class, node, server: bool = False) -> PathProfiler:
     from sensor_msgs.msg import JointState
 
     from tutorial.app.app import App
-    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
+    from tutorial.tools.standalone.app import StandaloneApp
 
     project = load_project(ROOT / "project" / "tank_view.yaml").with_controller("Tank", "Viewer", viewer_class)
     vis = None if server else meshcat.Visualizer(window=KeepingWindow())

@@ -82,7 +82,7 @@ def test_the_lessons_app_refuses_a_model_only_rtt_run_draws(tmp_path, model, top
     """The notebooks' App leaves robot descriptions and odometry to the tooling (StandaloneApp, rtt-run): it says
     so, naming the model and the topic, before it builds anything; StandaloneApp takes the same project."""
     from tutorial.app.app import App
-    from tutorial.app.standalone import StandaloneApp
+    from tutorial.tools.standalone.app import StandaloneApp
 
     (tmp_path / "v.yaml").write_text(VIEW.format(model=model, simulator=""))
     project = load_project(tmp_path / "v.yaml")
@@ -134,7 +134,7 @@ def test_a_received_description_is_checked(text, says):
 
 def description_error(node_name: str, timeout: float) -> DescriptionError:
     """The error a viewer of ``step3_description.yaml`` fails with when no description reaches it in ``timeout`` s."""
-    from tutorial.app.standalone import StandaloneApp
+    from tutorial.tools.standalone.app import StandaloneApp
 
     app = StandaloneApp(
         load_project(PROJECT / "step3_description.yaml"),

@@ -161,7 +161,7 @@ def test_the_pipeline_packs_what_meshcat_python_packs():
     import umsgpack
     from meshcat.commands import SetTransform
 
-    from tutorial.view.sinks import pack_command
+    from tutorial.tools.standalone.sinks import pack_command
 
     class Path:
         def lower(self):

@@ -1,4 +1,4 @@
-"""The grading kernel's seal (tutorial/exercises/seal.py), in a process of its own (a sealed process stays sealed).
+"""The grading kernel's seal (tutorial/tools/grading/seal.py), in a process of its own (a sealed process stays sealed).
 
 A genuine check signs a verdict that passes; the same check after the grader
 was patched, or a Result made by hand, does not; a patched function's code is
@@ -27,7 +27,7 @@ KEY = b"k" * 32
 SCRIPT = textwrap.dedent(
     """
     import os, sys
-    from tutorial.exercises import seal
+    from tutorial.tools.grading import seal
     seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"], seed="learner-seed")
     from tutorial.exercises.step1_tank_controller import check_dpad_steering
     from tutorial.interfaces import joy
@@ -117,7 +117,7 @@ def test_the_seal_trusts_the_modules_a_check_imports_only_when_it_runs():
     """2.1's check imports the scripted run's modules inside its functions: they are imported, and so snapshot,
     before any answer runs (an answer could otherwise import one first and replace what is in it, unseen)."""
     done = sealed(
-        "from tutorial.exercises import seal\n"
+        "from tutorial.tools.grading import seal\n"
         "print(*(m.__name__ for m in seal.trusted_modules(['tutorial.exercises.step2_joint_state_publisher'])))"
     )
     trusted = set(done.stdout.split())
@@ -126,7 +126,7 @@ def test_the_seal_trusts_the_modules_a_check_imports_only_when_it_runs():
     assert "tutorial.exercises.step1_tank_controller" not in trusted  # only the checks named, and the grader
     done = sealed(
         "import sys\n"
-        "from tutorial.exercises import seal\n"
+        "from tutorial.tools.grading import seal\n"
         "seal.install(b'k' * 32, 1, [], checks=['tutorial.exercises.step1_tank_controller'])\n"
         "print(*sorted(n for n in sys.modules if n.startswith('tutorial.exercises.step')))"
     )
@@ -143,7 +143,7 @@ def test_an_answer_reading_the_projects_and_models_is_not_noted_and_one_reading_
         textwrap.dedent(
             f"""
             import os, tutorial
-            from tutorial.exercises import seal
+            from tutorial.tools.grading import seal
             seal.install(b"k" * 32, 1, [], hidden=[{str(tmp_path / "hidden")!r}])
             repository = os.path.dirname(os.path.dirname(os.path.realpath(tutorial.__file__)))
             with open("mine.txt", "w") as f:
@@ -200,7 +200,7 @@ def test_an_answer_cannot_open_a_process_s_memory_directly_or_through_a_chain_of
             with open("real.txt", "w") as f:
                 f.write("plain")
             os.symlink("real.txt", "c")
-            from tutorial.exercises import seal
+            from tutorial.tools.grading import seal
             seal.install(b"k" * 32, 1, [])
             for path in ("/proc/self/mem", os.path.abspath("a"), "a", "links/x", "c"):
                 try:
@@ -246,10 +246,10 @@ def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_
         textwrap.dedent(
             """
             import os, sys
-            from tutorial.exercises import seal
+            from tutorial.tools.grading import seal
             seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
             from tutorial.exercises.step1_tank_controller import check_dpad_steering
-            from tutorial.exercises.sandbox import Job
+            from tutorial.core.controller import SimpleController
             from tutorial.interfaces import joy
             import tutorial.exercises.grader as grader
 
@@ -282,7 +282,7 @@ def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_
             except OSError:
                 pass
             try:
-                Job.from_env.__func__.__code__ = (lambda cls: None).__code__
+                SimpleController.start.__code__ = (lambda self: True).__code__  # the library's lifecycle
             except RuntimeError as e:
                 print("refused:", e, file=sys.stderr)
             real_axis = joy.axis
@@ -342,12 +342,12 @@ def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_
         ["tampering", "a verdict not made by the teacher's check and require()", "?"],
         ["outside", "opened /var/rtt-during", "1.1"],  # during the check: the check's
         ["outside", "opened /var/rtt-after", ""],  # after it: the next check's
-        ["refused", "changing Job.from_env.__code__", ""],
+        ["refused", "changing SimpleController.start.__code__", ""],
         ["tampering", "an answer returned a Same, a class of its own that compares as it likes", "1.1"],
         ["refused", "sys._current_frames", ""],
         ["refused", "sys.settrace", ""],  # in the thread, which its tracer would have watched
     ], notes
-    assert "refused: the grader's sandbox refused: changing Job.from_env.__code__" in done.stderr, done.stderr
+    assert "refused: the grader's sandbox refused: changing SimpleController.start.__code__" in done.stderr, done.stderr
     assert "refused: the grader's sandbox refused: sys._current_frames" in done.stderr, done.stderr
 
 
@@ -360,7 +360,7 @@ def test_frames_code_processes_and_connections_of_an_answer_are_refused_or_noted
             import inspect, os, socket, subprocess, sys, threading, types
             import tutorial
             import tutorial.exercises.grader as grader
-            from tutorial.exercises import seal
+            from tutorial.tools.grading import seal
             seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
             from tutorial.exercises.step1_tank_controller import check_dpad_steering
             from tutorial.interfaces import joy
@@ -440,7 +440,7 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
     """A clone in a hidden folder (a home): the kernel keeps tutorial/, project/, model/, never notebooks/."""
     from pathlib import Path
 
-    from tutorial.exercises.sandbox import Job, kept_paths, sandbox_command
+    from tutorial.tools.grading.sandbox import Job, kept_paths, sandbox_command
 
     root = Path(__file__).resolve().parent.parent
     kept = kept_paths([str(root.parent)])
@@ -459,7 +459,7 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
 ATTACKS = textwrap.dedent(
     """
     import gc, os, sys, types
-    from tutorial.exercises import seal
+    from tutorial.tools.grading import seal
     seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
     import tutorial.exercises.grader as g
     import tutorial.exercises.step1_tank_controller as s

@@ -1,4 +1,4 @@
-"""Two tanks in one TF tree (tutorial/bag/record_tf.py): with ``frame_prefix="{body}/"`` their frames are
+"""Two tanks in one TF tree (tutorial/tools/bag/record_tf.py): with ``frame_prefix="{body}/"`` their frames are
 apart, without it a warning says they collide.
 
 Unit tier: messages are serialized with rclpy (no context, no node) and fed to a :class:`TfRecording` writing
@@ -10,9 +10,9 @@ import io
 
 import pytest
 
-from tutorial.bag.record_tf import TfRecording, check_frame_prefix
 from tutorial.interfaces.tf import decode_tf_message
-from tutorial.urdf.export import export_model_file
+from tutorial.tools.bag.record_tf import TfRecording, check_frame_prefix
+from tutorial.tools.urdf.export import export_model_file
 
 from conftest import MODEL
 

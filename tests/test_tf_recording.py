@@ -43,7 +43,7 @@ class Probe(SimpleController):
 
 
 def transform_matrix(t) -> np.ndarray:
-    from tutorial.urdf.frames import pose_matrix
+    from tutorial.tools.urdf.frames import pose_matrix
 
     r, p = t.transform.rotation, t.transform.translation
     return pose_matrix((p.x, p.y, p.z), (r.w, r.x, r.y, r.z))
@@ -55,9 +55,9 @@ def test_tf_in_a_recording_is_the_simulation(ros, tmp_path):
 
     from tutorial.app.app import App
     from tutorial.app.reference.robot_model_publisher import RttRobotModelPublisher
-    from tutorial.bag.record import BagRecorder
     from tutorial.core.project import load_project
     from tutorial.joystick.scripted import ScriptedJoy
+    from tutorial.tools.bag.record import BagRecorder
 
     path = tmp_path / "drive_tf.mcap"
     recorder = BagRecorder(path, [], tf=True, output=None, node_name="tf_test_bag").start()
@@ -119,7 +119,7 @@ def test_tf_in_a_recording_is_the_simulation(ros, tmp_path):
         spinning.qpos[:] = qpos
         mujoco.mj_kinematics(model, spinning)
         # The road wheels' joints (group 3, not in JointState) are fixed in the URDF at their
-        # reference angle (tutorial/urdf/export.py): the simulation's pose with them there.
+        # reference angle (tutorial/tools/urdf/export.py): the simulation's pose with them there.
         data.qpos[:] = qpos
         data.qpos[wheels] = model.qpos0[wheels]
         mujoco.mj_kinematics(model, data)

@@ -1,4 +1,4 @@
-"""The URDF of a body (tutorial/urdf): checked by a parser we did not write.
+"""The URDF of a body (tutorial/tools/urdf): checked by a parser we did not write.
 
 Unit tier, but for ``rtt-urdf``'s command line (a process of its own: cross-process).
 
@@ -23,10 +23,10 @@ import numpy as np
 import pytest
 from test_third_party_models import CASES
 
-from tutorial.urdf.export import export_model_file
-from tutorial.urdf.frames import pose_matrix
-from tutorial.urdf.kinematics import UrdfKinematics
-from tutorial.urdf.records import ROOT_FREE, ROOT_WORLD
+from tutorial.tools.urdf.export import export_model_file
+from tutorial.tools.urdf.frames import pose_matrix
+from tutorial.tools.urdf.kinematics import UrdfKinematics
+from tutorial.tools.urdf.records import ROOT_FREE, ROOT_WORLD
 
 from conftest import MODEL, ROOT
 
@@ -214,7 +214,7 @@ def test_capsules_ellipsoids_planes_and_meshes(exported, tmp_path):
 
 def test_a_description_mujoco_reads_back(exported):
     """What a viewer with no model file builds: the joints, by name, with their limits."""
-    from tutorial.urdf.mujoco_load import mujoco_text
+    from tutorial.tools.urdf.mujoco_load import mujoco_text
 
     _, urdf, _ = exported("Tank", None)
     text, left_out, changed = mujoco_text(urdf.description())

@@ -6,7 +6,7 @@ example-robot-data, cold and cached.
 
 A publisher keeps the Franka Panda's description (``example-robot-data``,
 ``package://`` URIs as shipped) on ``/Panda/robot_description``; a monitor
-(a :class:`tutorial.app.standalone.StandaloneApp`, with its meshcat server,
+(a :class:`tutorial.tools.standalone.app.StandaloneApp`, with its meshcat server,
 as ``rtt-run`` runs it) opens on it and draws its first frame.  The figure is from the
 description's arrival to the end of that frame: the meshes found, the
 Collada files converted to STL (cold: an empty cache) or read from the
@@ -46,8 +46,8 @@ def first_frame_s(project: Path) -> tuple[float, float]:
     ``receive_robot_description`` hands the URDF it received to the monitor.
     """
     import tutorial.interfaces.robot_description as descriptions
-    from tutorial.app.standalone import StandaloneApp
     from tutorial.core.project import load_project
+    from tutorial.tools.standalone.app import StandaloneApp
 
     arrived = []
     receive = descriptions.receive_robot_description

@@ -351,7 +351,7 @@ def bare_run(tape: list, lead_s: float = 1.0, batch: bool = False) -> tuple[dict
     """
     import zmq
 
-    from tutorial.view.meshcat_server import start_server
+    from tutorial.tools.standalone.meshcat_server import start_server
 
     tape = tape if batch else bare_commands(tape)
     server = start_server(batch=batch)

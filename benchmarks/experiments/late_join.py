@@ -10,7 +10,7 @@ times, a fresh process starts a node (a new DDS participant) and waits:
 * ``viewer``: the subscription the Step 3 monitor makes for late joiners
   (transient local, :func:`tutorial.interfaces.joint_state.joint_state_qos`);
   the figure is from its creation to the kept state's arrival;
-* ``recorder``: ``rtt-bag record``'s :class:`tutorial.bag.record.BagRecorder`
+* ``recorder``: ``rtt-bag record``'s :class:`tutorial.tools.bag.record.BagRecorder`
   on the topic; from its start to the first message written.
 
 Both run under the project's Fast DDS profile (``tutorial/ros/fastdds_profiles.xml``)
@@ -83,7 +83,7 @@ RECORDER = """
 import json, sys, time
 import tutorial
 import rclpy
-from tutorial.bag.record import BagRecorder
+from tutorial.tools.bag.record import BagRecorder
 rclpy.init()
 t0 = time.monotonic()
 rec = BagRecorder(sys.argv[3], [sys.argv[1]], output=lambda text: None).start()

@@ -4,7 +4,7 @@
     python -m benchmarks.experiments.network --bandwidth     # each topic's bandwidth at its default rate
     python -m benchmarks.experiments.network --encoders      # Pillow against simplejpeg on the camera's pictures
 
-Two hosts (:class:`tutorial.network.hosts.Network`, network namespaces joined by
+Two hosts (:class:`tutorial.tools.network.hosts.Network`, network namespaces joined by
 a switch; root only).  On ``robot``: the simulation with the tank's joystick
 controller, joint states (50 Hz), IMU (20 Hz) and camera (30 Hz), plus the
 step clock probe.  On ``operator``: the Step 3 monitor (``rtt-run``
@@ -54,7 +54,7 @@ import numpy as np
 from benchmarks.paths import ROOT
 from benchmarks.procs import py
 from benchmarks.stats import pct
-from tutorial.network.host_program import HostProgram
+from tutorial.tools.network.host_program import HostProgram
 
 SIM_PROJECT = "benchmarks/projects/tank_net_sim.yaml"
 VIEW_PROJECT = "benchmarks/projects/tank_view.yaml"
@@ -226,7 +226,7 @@ def measure(seconds: float = 14.0, cases=tuple(CASES)) -> dict:
     Raises:
         RuntimeError: hosts cannot be made here (the reason), or a run failed.
     """
-    from tutorial.network.hosts import Network, why_unavailable
+    from tutorial.tools.network.hosts import Network, why_unavailable
 
     problem = why_unavailable()
     if problem:
@@ -288,7 +288,7 @@ def bandwidth(seconds: float = 8.0) -> dict:
     raw pictures than are sent (best effort), so the bandwidth at the
     default rate is the measured size times that rate.
     """
-    from tutorial.network.hosts import Network, why_unavailable
+    from tutorial.tools.network.hosts import Network, why_unavailable
 
     problem = why_unavailable()
     if problem:

@@ -133,9 +133,9 @@ def page_cost(model: str, count: int, details: list[str], seconds: float) -> dic
     from benchmarks.experiments.browser import Page
     from benchmarks.paths import ROOT
     from tutorial.core.world import ModelEntry, build_world
-    from tutorial.view.meshcat_server import start_server
+    from tutorial.tools.standalone.meshcat_server import start_server
+    from tutorial.tools.standalone.sinks import frame_sink
     from tutorial.view.scene import Scene
-    from tutorial.view.sinks import frame_sink
 
     entries = [ModelEntry(f"M{i}", str(ROOT / "model" / f"{model}.xml")) for i in range(count)]
     m = build_world(entries)

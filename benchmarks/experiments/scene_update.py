@@ -19,9 +19,9 @@ def scene_update_cost(model_file: str, frames: int) -> dict:
     import mujoco
 
     from tutorial.core.world import ModelEntry, build_world
-    from tutorial.view.meshcat_server import start_server
+    from tutorial.tools.standalone.meshcat_server import start_server
+    from tutorial.tools.standalone.sinks import BatchSink
     from tutorial.view.scene import Scene, VisualizerSink
-    from tutorial.view.sinks import BatchSink
 
     model = build_world([ModelEntry("M", ROOT / model_file)])
     data = mujoco.MjData(model)

@@ -32,7 +32,7 @@ report where the states they count landed (``send_phase_ms``,
 ``browser.since_frame_ms``).
 
 ``--remote`` also runs the browser on a second host with a 5 Mbit/s link
-(50 ms latency) to the kernel's (``tutorial.network.hosts``; root only):
+(50 ms latency) to the kernel's (``tutorial.tools.network.hosts``; root only):
 the frames the view draws from the kernel per second, and a trivial
 cell's time (tests/lab_browser.py).
 """
@@ -340,7 +340,7 @@ def remote(mbit: float = 5.0) -> dict:
     """JupyterLab on one host, Chromium on another over a ``mbit`` link: the view's frames/s and a cell's time."""
     from tests.jupyterlab import JupyterLab
     from tests.lab_browser import step2_notebook
-    from tutorial.network.hosts import Network
+    from tutorial.tools.network.hosts import Network
 
     with tempfile.TemporaryDirectory() as d, Network(("robot", "operator")) as net:
         robot, operator = net["robot"], net["operator"]

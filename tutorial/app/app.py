@@ -66,7 +66,7 @@ class App:
 
     Two things are a program's, not the lessons': a model that names a robot
     description topic instead of a file, or an odometry topic, and a meshcat
-    server of its own for the view.  :class:`tutorial.app.standalone.StandaloneApp`
+    server of its own for the view.  :class:`tutorial.tools.standalone.app.StandaloneApp`
     (what ``rtt-run`` runs) does both; this class refuses such a model, and
     draws only in a view it is given (``vis``) unless ``headless``.
 
@@ -190,7 +190,7 @@ class App:
 
         A subclass may fill models in, and add to ``self.attach``, here: the
         node exists, its spin thread has not started
-        (:class:`tutorial.app.standalone.StandaloneApp` takes models from robot descriptions).
+        (:class:`tutorial.tools.standalone.app.StandaloneApp` takes models from robot descriptions).
 
         Raises:
             ValueError: a model takes a robot description or odometry from a topic.
@@ -205,7 +205,7 @@ class App:
     def open_visualizer(self):
         """The ``meshcat.Visualizer`` to draw in when none was given (owner thread, in :meth:`open`).
 
-        :class:`tutorial.app.standalone.StandaloneApp` starts a meshcat server of its own here.
+        :class:`tutorial.tools.standalone.app.StandaloneApp` starts a meshcat server of its own here.
 
         Raises:
             ValueError: always, here: give ``vis``, or open it ``headless``.

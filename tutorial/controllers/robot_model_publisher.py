@@ -25,7 +25,7 @@ from tutorial.interfaces.robot_description import (
     robot_description_topic,
 )
 from ..interfaces.timing import stamp_parts
-from ..urdf.export import export_body
+from ..tools.urdf.export import export_body
 
 DEFAULT_RATE = 50.0  # Hz of simulated time: the joint states' rate
 

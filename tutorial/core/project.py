@@ -24,7 +24,7 @@ simulation publishes there (:mod:`tutorial.interfaces.robot_description`),
 received when the project is opened.  A model of a viewer project may also
 name an odometry topic (``odometry: /Go2/odom``): its root link then floats,
 placed where the robot's ``nav_msgs/Odometry`` says
-(:mod:`tutorial.app.floating_base`).
+(:mod:`tutorial.tools.standalone.floating_base`).
 
 Every mistake raises one :class:`ProjectError` naming the file and the key,
 e.g. ``project/step1.yaml: models[1].controllers[0].class: no module named 'x'``,

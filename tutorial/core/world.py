@@ -69,9 +69,9 @@ class ModelEntry:
         description: a robot-description topic to take the model from instead
             of a file (a viewer project); whoever receives it sets ``text``.
         text: the model as text (MJCF, or a robot description prepared by
-            :func:`tutorial.urdf.mujoco_load.mujoco_text`), used instead of ``file``.
+            :func:`tutorial.tools.urdf.mujoco_load.mujoco_text`), used instead of ``file``.
         odometry: an odometry topic a viewer places the model's root link by
-            (:mod:`tutorial.app.floating_base`); the root then gets a free
+            (:mod:`tutorial.tools.standalone.floating_base`); the root then gets a free
             joint if it has none, so it can be placed anywhere.
     """
 

@@ -6,9 +6,6 @@ A notebook imports the check of each exercise from its notebook's module, e.g.
 The checks' helpers: ``capture`` (what a controller publishes, kept in-process) and ``camera_rig``
 (Step 6's camera controller driven on the tank, picture by picture).
 
-Grading's own parts, which no notebook imports: ``release`` (the release's
-stubs, in ``nbgrader generate_assignment``), ``sandbox`` (each graded
-kernel as a user of its own, without network, limited), ``seal`` and
-``sealed_kernel`` (the grading kernel's verdicts, signed only when the
-teacher's own check made them).  ``course/grade.py`` uses them.
+Grading's own machinery, which no notebook imports (the release's stubs, the
+seal, the sandbox), is tooling: :mod:`tutorial.tools.grading`.
 """

@@ -92,7 +92,7 @@ class Result:
             AssertionError: the check failed; the message is the line a learner sees, wrapped at
                 :data:`WRAP` characters (nbgrader's feedback shows it in a box that does not wrap).
         """
-        sys.audit("rtt.verdict", self)  # to the grading kernel's seal (tutorial.exercises.seal), if any
+        sys.audit("rtt.verdict", self)  # to the grading kernel's seal (tutorial.tools.grading.seal), if any
         if not self.passed:
             raise AssertionError(textwrap.fill(str(self), WRAP, subsequent_indent="  ", break_long_words=False))
         return self
@@ -114,7 +114,7 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
     quiet, propagate = logging.NullHandler(), logger.propagate
     logger.addHandler(quiet)  # a handler, so Python's last-resort handler does not print to stderr
     logger.propagate = False
-    sys.audit("rtt.check_begin", exercise)  # the grading kernel's seal (tutorial.exercises.seal) takes note
+    sys.audit("rtt.check_begin", exercise)  # the grading kernel's seal (tutorial.tools.grading.seal) takes note
     try:
         result = _run_cases(exercise, cases)
         sys.audit("rtt.result", result)
@@ -129,7 +129,7 @@ def hidden_random(exercise: str) -> random.Random | None:
     """The random source of this learner's hidden cases of ``exercise`` (e.g. ``"1.1"``), while grading; else None.
 
     Its seed is the grader's: drawn per learner from a seed the teacher keeps (``course/grade.py``) and given
-    only to the teacher's own checks by the grading kernel's seal (:mod:`tutorial.exercises.seal`).  Outside
+    only to the teacher's own checks by the grading kernel's seal (:mod:`tutorial.tools.grading.seal`).  Outside
     grading (a learner's own run) there is none, and a check runs its visible cases alone.  Any thread.
     """
     box: list[str] = []

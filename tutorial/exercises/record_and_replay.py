@@ -3,10 +3,10 @@
 Exercise 7.1, when did the operator let go: ``release_times(path) -> list[float]``,
 the seconds (since the bag's first ``/joy``) at which every stick came back to the centre.
 Exercise 7.2, the turret's top speed: ``peak_speed(series, joint) -> (rad/s, s)`` from a
-:class:`tutorial.bag.reader.JointSeries`.
+:class:`tutorial.tools.bag.reader.JointSeries`.
 
 The checks write small bags of their own with the library's
-:class:`tutorial.bag.writer.BagWriter` (messages with known values at known
+:class:`tutorial.tools.bag.writer.BagWriter` (messages with known values at known
 times), so every case is exact, and read nothing from the network.  Over
 400 lines, one job: one notebook's checks, with the bags and series their
 hidden cases draw.
@@ -31,9 +31,9 @@ def write_bag(path: Path, messages: list[tuple[str, float, object]]) -> Path:
     from rclpy.qos import QoSProfile
     from rclpy.serialization import serialize_message
 
-    from tutorial.bag.qos import profile_dict, serialize_profiles
-    from tutorial.bag.writer import BagWriter
     from tutorial.interfaces.definitions import full_text
+    from tutorial.tools.bag.qos import profile_dict, serialize_profiles
+    from tutorial.tools.bag.writer import BagWriter
 
     writer = BagWriter(path, overwrite=True)
     try:
@@ -250,7 +250,7 @@ def check_peak_speed(func) -> Result:
     second or more, uneven, repeated; exact ties; states without the joint)
     are judged by :func:`_peak`.
     """
-    from tutorial.bag.series import JointSeries
+    from tutorial.tools.bag.series import JointSeries
 
     def series(stamps, q):
         stamps = np.asarray(stamps, dtype=float)
@@ -377,7 +377,7 @@ def _random_series(rng, kind: str):
     simulation time, states 1 ms to 0.1 s apart, received 0 to 5 ms later, the other joint moving too.
     ``ties``: speeds of a few values, exact in binary, the top one more than once; ``repeats``: states sharing a
     stamp; ``nan``, ``one``: states without the joint; ``still``: the joint does not move."""
-    from tutorial.bag.series import JointSeries
+    from tutorial.tools.bag.series import JointSeries
 
     n = rng.randrange(6, 40)
     if kind == "ties":

@@ -120,7 +120,7 @@ def full_text(type_name: str) -> tuple[str, str]:
     Raises:
         UnknownMessageType: no definition file of the type or of a type it
             uses is installed (rosbag2 then writes an empty ``unknown``
-            schema; :class:`tutorial.bag.record.BagRecorder` does the same).
+            schema; :class:`tutorial.tools.bag.record.BagRecorder` does the same).
 
     Any thread may call this (it reads files only).
     """

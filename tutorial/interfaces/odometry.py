@@ -4,7 +4,7 @@ JointState says how the body's joints are set; it does not say where the
 body is.  The odometry does: the pose of the body's URDF root link (the
 tank's ``CHASSIS``) in the world, and its velocity, stamped with simulation
 time.  With the joint states and the robot description it is all a TF tree
-needs (:mod:`tutorial.bag.record_tf`).
+needs (:mod:`tutorial.tools.bag.record_tf`).
 
 Frames and units (REP 103, REP 105):
 
@@ -61,7 +61,7 @@ class RootMotion:
         model: the world's ``MjModel``.
         root_body: the MuJoCo id of the root link's body, or None when the
             root link stands for the world frame the model is placed in
-            (``tutorial.urdf.export.ROOT_WORLD``: its pose is the identity).
+            (``tutorial.tools.urdf.export.ROOT_WORLD``: its pose is the identity).
 
     The pose and velocity come from ``qpos``/``qvel`` directly (a free
     joint's numbers; the model's placement for a body welded to the world),

@@ -6,7 +6,7 @@ time can draw the robot.  The simulation does the same for each body, on a
 topic named after it (:func:`robot_description_topic`), with the same QoS
 (:func:`robot_description_qos`): published once, kept for late joiners.
 
-The text is the URDF of :mod:`tutorial.urdf.export`.  A received description
+The text is the URDF of :mod:`tutorial.tools.urdf.export`.  A received description
 is checked by :func:`check_robot_description` before anything is built from
 it: it may come from any publisher on the network.
 """

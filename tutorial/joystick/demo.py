@@ -2,7 +2,7 @@
 
 :class:`DemoInput` has ``read(now) -> (axes, buttons)`` in the convention of
 :mod:`tutorial.interfaces.joy` (8 axes, stick up/left = +1; 8 buttons), as
-the gamepad and keyboard sources of :mod:`tutorial.joystick.sources` do.
+the gamepad and keyboard sources of :mod:`tutorial.tools.joystick.sources` do.
 One thread calls ``read``.
 """
 

@@ -1,6 +1,6 @@
 """Notebook 08's two hosts: the robot and the operator as network namespaces, and the programs on them.
 
-:class:`TwoHosts` makes them (:class:`tutorial.network.hosts.Network`) when this
+:class:`TwoHosts` makes them (:class:`tutorial.tools.network.hosts.Network`) when this
 computer allows it (root, ``ip``, ``nft``, ``tc``), starts the tutorial's
 programs on either host as separate processes, reads what they print, and
 removes everything in :meth:`TwoHosts.close` (also what a notebook's earlier
@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import atexit
 
-from tutorial.network.host_program import HostProgram, python
-from tutorial.network.hosts import Host, Network, why_unavailable
+from tutorial.tools.network.host_program import HostProgram, python
+from tutorial.tools.network.hosts import Host, Network, why_unavailable
 
 _current: TwoHosts | None = None  # this kernel's pair of hosts (main thread only)
 

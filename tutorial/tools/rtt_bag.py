@@ -14,7 +14,7 @@ info``/``play`` (with the mcap storage plugin) and Foxglove open them.
 with ``--ros-args -r __node:=NAME``.  Ctrl-C or SIGTERM ends a recording
 cleanly: the file is closed with its indexes and summary.  A recorder
 that is killed loses less than its last second (the write-through policy,
-:mod:`tutorial.bag.writer`); ``info`` and ``play`` read such a file that was
+:mod:`tutorial.tools.bag.writer`); ``info`` and ``play`` read such a file that was
 not closed, saying so on stderr, and ``recover`` writes a closed copy.
 
 Exit status: 0 done (also when stopped by Ctrl-C/SIGTERM, and for a file
@@ -43,7 +43,7 @@ _say = functools.partial(print, flush=True)
 
 def build_parser() -> argparse.ArgumentParser:
     """The command line of ``rtt-bag`` (ROS arguments are removed before it parses)."""
-    from tutorial.bag.record_tf import add_frame_prefix_argument
+    from tutorial.tools.bag.record_tf import add_frame_prefix_argument
 
     p = argparse.ArgumentParser(
         prog=PROG,
@@ -130,8 +130,8 @@ def record(args, argv: list[str]) -> int:
     """``rtt-bag record``: main thread; the recorder's callbacks run on its spin thread."""
     import rclpy
 
-    from tutorial.bag.record import BagRecorder
-    from tutorial.bag.writer import BagWriteError
+    from tutorial.tools.bag.record import BagRecorder
+    from tutorial.tools.bag.writer import BagWriteError
 
     if not args.topics and not args.all and not args.tf:
         return _fail("record: name the topics to record, or pass --all or --tf")
@@ -186,8 +186,8 @@ def _say_not_closed(command: str, info) -> None:
 
 def info(args) -> int:
     """``rtt-bag info``: no ROS needed."""
-    from tutorial.bag.info import bag_info, format_info
-    from tutorial.bag.reader import BagError
+    from tutorial.tools.bag.info import bag_info, format_info
+    from tutorial.tools.bag.reader import BagError
 
     try:
         summary = bag_info(args.file)
@@ -202,8 +202,8 @@ def play(args, argv: list[str]) -> int:
     """``rtt-bag play``: publishes from the main thread."""
     import rclpy
 
-    from tutorial.bag.play import BagPlayer
-    from tutorial.bag.reader import BagError
+    from tutorial.tools.bag.play import BagPlayer
+    from tutorial.tools.bag.reader import BagError
 
     if not all(_finite(v) for v in (args.rate, args.start_offset, args.delay)):
         return _fail("play: --rate, --start-offset and --delay must be finite numbers")
@@ -237,9 +237,9 @@ def play(args, argv: list[str]) -> int:
 
 def recover(args) -> int:
     """``rtt-bag recover IN -o OUT``: no ROS needed."""
-    from tutorial.bag.reader import BagError
-    from tutorial.bag.recover import recover as recover_file
-    from tutorial.bag.writer import BagWriteError
+    from tutorial.tools.bag.reader import BagError
+    from tutorial.tools.bag.recover import recover as recover_file
+    from tutorial.tools.bag.writer import BagWriteError
 
     try:
         result = recover_file(args.file, args.output, compression=args.compression, overwrite=args.overwrite)

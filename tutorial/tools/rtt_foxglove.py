@@ -6,7 +6,7 @@
 Serves every ROS 2 topic as it is (CDR with its ``ros2msg`` schema) and the
 robot in 3D: ``/robot_description`` and ``/tf``, ``/tf_static`` computed from
 the bodies' descriptions, odometry and joint states
-(:mod:`tutorial.foxglove.bridge`).  Binds to 127.0.0.1 unless ``--host`` says
+(:mod:`tutorial.tools.foxglove.bridge`).  Binds to 127.0.0.1 unless ``--host`` says
 otherwise.  Runs until Ctrl-C or SIGTERM (or ``--duration``).
 
 Exit status: 0 stopped; 1 a failure while running; 2 a bad command line or a
@@ -32,8 +32,8 @@ def main(argv: list[str] | None = None) -> int:
     import rclpy
     from rclpy.signals import SignalHandlerOptions
 
-    from tutorial.bag.record_tf import add_frame_prefix_argument
-    from tutorial.foxglove.bridge import DEFAULT_HOST, DEFAULT_PORT, NODE_NAME, FoxgloveBridge
+    from tutorial.tools.bag.record_tf import add_frame_prefix_argument
+    from tutorial.tools.foxglove.bridge import DEFAULT_HOST, DEFAULT_PORT, NODE_NAME, FoxgloveBridge
 
     argv = list(sys.argv if argv is None else argv)
     p = argparse.ArgumentParser(prog=PROG, description="Serve the ROS 2 topics and the robot in 3D to Foxglove.")

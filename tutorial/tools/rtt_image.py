@@ -45,7 +45,7 @@ import time
 from tutorial.ros import env as ros_env
 from tutorial.ros import program as ros_program
 from tutorial.ros import spin as ros_spin
-from tutorial.view.image_files import PngWriter, format_image_status
+from tutorial.tools.image_files import PngWriter, format_image_status
 from tutorial.view.images import DEFAULT_TOPIC, TRANSPORTS, ImageReceiver
 
 NODE_NAME = "rtt_image"

@@ -19,10 +19,10 @@ import contextlib
 import sys
 
 from tutorial.interfaces import joy
-from tutorial.joystick.publisher import JoyPublisher
 from tutorial.ros import env as ros_env
 from tutorial.ros import program as ros_program
 from tutorial.ros.spin import SpinThread
+from tutorial.tools.joystick.publisher import JoyPublisher
 
 NODE_NAME = "rtt_joy"
 
@@ -30,7 +30,7 @@ NODE_NAME = "rtt_joy"
 def choose_source(args, stack: contextlib.ExitStack):
     """The input source the command line asks for, and a line saying which it is."""
     from tutorial.joystick.demo import SCRIPTS, DemoInput
-    from tutorial.joystick.sources import KEYBOARD_HELP, GamepadInput, KeyboardInput
+    from tutorial.tools.joystick.sources import KEYBOARD_HELP, GamepadInput, KeyboardInput
 
     if args.demo:
         return (

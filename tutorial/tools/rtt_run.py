@@ -25,11 +25,11 @@ import signal
 import sys
 
 from tutorial.app.app import DEFAULT_NODE_NAME, App, ControllerError
-from tutorial.app.standalone import StandaloneApp
 from tutorial.core.project import ProjectError, load_project
 from tutorial.core.world import ModelError
 from tutorial.ros import env as ros_env
 from tutorial.ros import program as ros_program
+from tutorial.tools.standalone.app import StandaloneApp
 from tutorial.view.status import format_status
 
 

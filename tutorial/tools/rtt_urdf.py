@@ -6,7 +6,7 @@
 
 Mesh geoms become STL files in ``<FILE stem>_meshes/`` beside the URDF.  What
 is mapped, and what is approximated or left out, is in
-:mod:`tutorial.urdf.export` and in the file's opening comment.
+:mod:`tutorial.tools.urdf.export` and in the file's opening comment.
 
 Exit status: 0 written; 2 a bad command line, a model that does not load, a
 body that is not in the project, or a file that cannot be written (one line
@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = p.parse_args(sys.argv[1:] if argv is None else argv)
     from tutorial.core.project import ProjectError
-    from tutorial.urdf.export import export_model_file
+    from tutorial.tools.urdf.export import export_model_file
 
     model = Path(args.model)
     name = args.body

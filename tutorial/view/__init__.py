@@ -5,14 +5,11 @@ module                job
 ====================  ================================================================
 ``scene``             a MuJoCo model drawn in meshcat, moved from an ``MjData``
 ``meshcat_overlays``  arrows a controller draws over the 3D view
-``meshcat_server``    a meshcat server on 127.0.0.1 that ends with its process
-``sinks``             where a frame's transforms go: the fast ways, and which a view gets
 ``meshcat_batch``     a frame's transforms as one message (``set_transforms``)
 ``meshcat_page``      the page that draws it: meshcat's own; lighter without a GPU
 ``widget/``           the same scene as a Jupyter widget, over the notebook's own connection
 ``status``            a monitor's status: rate, age of the newest state, stale or live
 ``images``            camera pictures received over ROS 2
-``image_files``       PNG files of them, and ``rtt-image``'s status line
 ``joint_plot``        joint positions over time, received over ROS 2, and their plot
 ====================  ================================================================
 

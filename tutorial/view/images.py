@@ -7,7 +7,7 @@ two transports: ``raw`` (``sensor_msgs/Image``, checked by
 :func:`tutorial.interfaces.compressed_image.compressed_to_array`); it keeps
 the newest picture accepted, counting the rest; ``rtt-image`` and the notebooks' live picture
 (:mod:`tutorial.notebook.live_image`) show what it holds (``rtt-image`` writes it with
-:mod:`tutorial.view.image_files`).
+:mod:`tutorial.tools.image_files`).
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ as meshcat-python lowers it::
     {"type": "set_transforms", "commands": [{"type": "set_transform", "path": ..., "matrix": [16 floats]}, ...]}
 
 sent to the server as the zmq frames ``[b"set_transforms", b"", packed]``.
-The project's server (:mod:`tutorial.view.meshcat_server`) keeps each inner
+The project's server (:mod:`tutorial.tools.standalone.meshcat_server`) keeps each inner
 command in its scene tree, as if it had come alone (a page that opens
 later is sent the newest pose of each body, by meshcat's own code), and
 forwards the whole as one WebSocket message.  The page it serves
@@ -22,7 +22,7 @@ forwards the whole as one WebSocket message.  The page it serves
 meshcat's own ``handle_command``.  meshcat's own server does not know the
 command: it answers ``error: unrecognized comand`` and forwards nothing,
 and the scene's sink then sends one command per transform again
-(:class:`tutorial.view.sinks.BatchSink`).
+(:class:`tutorial.tools.standalone.sinks.BatchSink`).
 
 Every function here may be called from any thread.
 """

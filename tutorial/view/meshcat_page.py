@@ -53,7 +53,7 @@ which the notebooks' recordings (:mod:`tutorial.notebook.replay`) call on
 each of their viewers too.
 
 The page runs in the browser; this module only holds the scripts and adds
-them (any thread), for :mod:`tutorial.view.meshcat_server`.
+them (any thread), for :mod:`tutorial.tools.standalone.meshcat_server`.
 """
 
 from __future__ import annotations

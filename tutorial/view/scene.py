@@ -15,7 +15,7 @@ meshcat's own ``Visualizer`` (:class:`VisualizerSink`: one ``set_transform``
 per body); the :class:`tutorial.app.app.App` gives the scene a faster one
 that its view can serve (``App.frame_sink``): a frame as one message to a
 notebook's widget, or, for ``rtt-run``'s own meshcat server, to that server
-(:mod:`tutorial.view.sinks`).
+(:mod:`tutorial.tools.standalone.sinks`).
 
 Geoms in group 3 and above are hidden, as in MuJoCo's own viewer (the tank's
 road wheels live there, inside the track covers).

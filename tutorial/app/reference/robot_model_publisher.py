@@ -26,7 +26,7 @@ from tutorial.interfaces.robot_description import (
 from ...core.controller import ControllerConfig, ControllerIO, SimpleController
 from ...core.period import PeriodAccumulator
 from ...interfaces.timing import stamp_parts
-from ...urdf.export import export_body
+from ...tools.urdf.export import export_body
 
 DEFAULT_RATE = 50.0  # Hz of simulated time: the joint states' rate
 

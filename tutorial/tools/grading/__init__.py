@@ -1,0 +1,14 @@
+"""The course's grading machinery, which no notebook imports (the checks themselves are :mod:`tutorial.exercises`).
+
+==================  ================================================================
+module              job
+==================  ================================================================
+``release``         the release's stubs, in ``nbgrader generate_assignment``
+``sandbox``         each graded kernel as a user of its own, without network, limited
+``seal``            the grading kernel's verdicts, signed only when the teacher's own
+                    check made them
+``sealed_kernel``   the kernel the sandbox starts, sealed before any cell runs
+==================  ================================================================
+
+``course/grade.py`` and ``course/nbgrader_config.py`` use them.
+"""

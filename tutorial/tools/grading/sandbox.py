@@ -1,0 +1,264 @@
+"""Grading in a sandbox: each submission's kernel as a user of its own, without network, limited, sealed.
+
+``course/grade.py`` gives each grading job a Unix user of its own and sets
+``RTT_SANDBOX`` (:class:`Job`, as JSON) for ``nbgrader autograde``; the
+course's ``nbgrader_config.py`` then executes notebooks with
+:class:`SandboxedExecute`, whose :class:`SandboxedKernelManager` starts the
+kernel:
+
+* in a network namespace of its own (loopback only: ROS 2 still runs inside,
+  nothing leaves it) and a mount namespace of its own, where the course
+  folder, the repository's teacher-only folders (``notebooks``, ``course``,
+  ``book``, ``.git``), ``/home``, ``/root`` (but the Python installation)
+  and ``/srv`` are empty, and ``/tmp``, ``/var/tmp`` and ``/dev/shm`` are
+  the kernel's own;
+* as the job's user, with no privileges (``setpriv --no-new-privs``), in a
+  working folder of its own (a copy of the submission's folder), with a
+  scrubbed environment (no ``NBGRADER_EXECUTION``);
+* under limits: address space (a ``MemoryError`` in the cell), processes
+  and threads (``RLIMIT_NPROC``, per user), CPU seconds, and, where root
+  can write cgroup v1, a memory and a pids cgroup as a backstop;
+* sealed (:mod:`tutorial.tools.grading.seal`): the grader reads the seal's
+  signed verdicts from a pipe and writes the good ones to the job's
+  verdict file, which ``course/grade.py`` turns into grades and flags.
+
+The kernel talks to nbgrader over Unix sockets (ZeroMQ's ``ipc``), which
+cross the network namespace.  Needs root (Linux: ``unshare``, ``setpriv``,
+``prlimit``, ``ip`` from util-linux and iproute2).  The manager runs in
+nbgrader's process, on its event loop's thread; its pipe reader on a thread of its own.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import hmac
+import json
+import os
+import secrets
+import shlex
+import shutil
+import sys
+import threading
+from pathlib import Path
+
+from jupyter_client.manager import AsyncKernelManager
+from nbgrader.preprocessors import Execute
+
+ENV = "RTT_SANDBOX"
+PRIVATE = ("/tmp", "/var/tmp", "/dev/shm")  # the kernel's own, empty at its start
+PASSED_ENV = ("PATH", "LANG", "LC_ALL", "ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RTT_TEST_MODE", "MUJOCO_GL")
+
+
+@dataclasses.dataclass
+class Job:
+    """One grading job's sandbox (``RTT_SANDBOX``, as JSON).
+
+    Attributes:
+        user, uid, gid: the job's Unix user.
+        folder: the job's folder (root's, 0711): each kernel gets a subfolder.
+        verdicts: the file the seal's checked verdicts are appended to (the grader's alone).
+        hide: folders the kernel sees empty (the course, the teacher's notebooks, ...).
+        test_calls: each test cell's statement (``check_x(answer).require()``): the seal's only callers of require().
+        checks: the modules the test cells import their checks from: what the seal snapshots.
+        seed: the learner's seed of hidden cases (from the teacher's, ``course/grade.py``).
+        memory_bytes: the address space a kernel may have (RLIMIT_AS): past it, a ``MemoryError``.
+        processes: processes and threads the job's user may have (RLIMIT_NPROC).
+        cpu_seconds: CPU time a kernel may use (RLIMIT_CPU).
+        cgroup_memory_bytes: the memory cgroup's limit (resident memory, a backstop); 0: none.
+    """
+
+    user: str
+    uid: int
+    gid: int
+    folder: str
+    verdicts: str
+    hide: list[str]
+    test_calls: list[str]
+    checks: list[str] = dataclasses.field(default_factory=list)
+    seed: str = ""
+    memory_bytes: int = 4 << 30
+    processes: int = 256
+    cpu_seconds: int = 600
+    cgroup_memory_bytes: int = 3 << 30
+
+    @classmethod
+    def from_env(cls) -> Job | None:
+        text = os.environ.get(ENV)
+        return cls(**json.loads(text)) if text else None
+
+    def to_env(self) -> str:
+        return json.dumps(dataclasses.asdict(self))
+
+
+def cgroups(job: Job) -> list[Path]:
+    """The job's memory and pids cgroups (cgroup v1), made with their limits; none where they cannot be
+    (no cgroup v1, not root: the rlimits alone then bound the kernel).  Never raises; any thread."""
+    made = []
+    for controller, settings in (
+        ("memory", {"memory.limit_in_bytes": job.cgroup_memory_bytes}),
+        ("pids", {"pids.max": job.processes}),
+    ):
+        base = Path("/sys/fs/cgroup") / controller
+        if not (base / "cgroup.procs").exists() or not os.access(base, os.W_OK):
+            continue
+        group = base / f"rtt-grade-{job.user}"
+        try:
+            group.mkdir(exist_ok=True)
+            for name, value in settings.items():
+                if value:
+                    (group / name).write_text(str(value))
+        except OSError:
+            continue
+        made.append(group)
+    return made
+
+
+def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[Path] = ()) -> list[str]:
+    """``kernel`` wrapped: namespaces, hidden folders (``keep`` bound back), the cgroups ``groups``, the job's
+    user and limits: the command to run as root (a list for ``subprocess``; every path shell-quoted).
+
+    Pure: it makes nothing; any thread.  The command fails (exit status 1, unshare's or mount's message on
+    stderr) where namespaces cannot be made."""
+    script = [
+        "set -e",
+        "ip link set lo up",
+        "mount --make-rprivate /",
+    ]
+    q = shlex.quote
+    held = Path(job.folder) / ".keep"
+    for k, path in enumerate(keep):
+        script += [f"mkdir -p {q(f'{held}/{k}')}", f"mount --bind {q(path)} {q(f'{held}/{k}')}"]
+    for path in job.hide:
+        script.append(f"if [ -d {q(path)} ]; then mount -t tmpfs -o mode=755,size=1m tmpfs {q(path)}; fi")
+    for path in PRIVATE:
+        script.append(f"mount -t tmpfs -o mode=1777,size=2g tmpfs {path}")
+    for k, path in enumerate(keep):  # last: a clone under /tmp keeps its library and environment
+        script += [f"mkdir -p {q(path)}", f"mount --move {q(f'{held}/{k}')} {q(path)}"]
+    for group in groups:
+        script.append(f"echo $$ > {q(str(group / 'cgroup.procs'))}")
+    script.append('exec "$@"')
+    return [
+        "unshare",
+        "--mount",
+        "--net",
+        "--ipc",
+        "--",
+        "/bin/sh",
+        "-c",
+        "\n".join(script),
+        "sandbox",
+        "setpriv",
+        f"--reuid={job.uid}",
+        f"--regid={job.gid}",
+        "--clear-groups",
+        "--no-new-privs",
+        "--",
+        "prlimit",
+        f"--as={job.memory_bytes}",
+        f"--nproc={job.processes}",
+        f"--cpu={job.cpu_seconds}",
+        "--core=0",
+        "--",
+        *kernel,
+    ]
+
+
+def kept_paths(hide: list[str]) -> list[str]:
+    """What a hidden or private folder holds that the kernel needs: the Python installation (root's pyenv,
+    say), the environment, and the library's own folders of a clone in a home folder or under /tmp (never its
+    notebooks or course)."""
+    repository = Path(__file__).resolve().parents[3]  # tutorial/tools/grading/sandbox.py
+    needed = {os.path.realpath(sys.base_prefix), os.path.realpath(sys.prefix)}
+    needed |= {str(repository / p) for p in ("tutorial", "project", "model") if (repository / p).is_dir()}
+    keep = []
+    for path in needed:
+        if any(path.startswith(h.rstrip("/") + "/") for h in [*hide, *PRIVATE]):
+            keep.append(path)
+    return sorted(keep)
+
+
+class SandboxedKernelManager(AsyncKernelManager):
+    """A kernel started in the job's sandbox (:func:`sandbox_command`), sealed, over Unix sockets."""
+
+    async def _async_pre_start_kernel(self, **kw):
+        job = Job.from_env()
+        if job is None:
+            raise RuntimeError(f"{ENV} is not set: grade with course/grade.py, which sets up the sandbox")
+        self._job = job
+        here = Path(job.folder) / secrets.token_hex(6)
+        work, ipc = here / "work", here / "ipc"
+        source = Path(kw.get("cwd") or os.getcwd())
+        # links copied as links (root must not follow a submission's link), then given to the job's user
+        shutil.copytree(source, work, symlinks=True, ignore=shutil.ignore_patterns(".ipynb_checkpoints"))
+        ipc.mkdir()
+        for path in (here, work, ipc, *work.rglob("*")):
+            os.lchown(path, job.uid, job.gid)
+        os.chmod(here, 0o700)
+        self.transport = "ipc"
+        self.ip = str(ipc / "kernel")
+        self.connection_file = str(here / "connection.json")
+        kw["cwd"] = str(work)
+        kw["env"] = {k: v for k, v in (kw.get("env") or os.environ).items() if k in PASSED_ENV}
+        kw["env"].update(HOME=str(work), PYTHONDONTWRITEBYTECODE="1")
+        cmd, kw = await super()._async_pre_start_kernel(**kw)
+        os.chown(self.connection_file, job.uid, job.gid)
+        self._key = secrets.token_bytes(32)
+        self._key_read, self._key_write = os.pipe()
+        self._verdict_read, self._verdict_write = os.pipe()
+        kw["pass_fds"] = (self._key_read, self._verdict_write)
+        kw["env"]["RTT_SEAL_FDS"] = f"{self._key_read},{self._verdict_write}"
+        # ipykernel's own launcher's arguments (the connection file, nbgrader's history in memory), sealed first
+        kernel = [sys.executable, "-I", "-m", "tutorial.tools.grading.sealed_kernel", *cmd[cmd.index("-f") :]]
+        return sandbox_command(job, kernel, kept_paths(job.hide), cgroups(job)), kw
+
+    async def _async_launch_kernel(self, kernel_cmd, **kw):
+        try:
+            await super()._async_launch_kernel(kernel_cmd, **kw)
+        finally:
+            os.close(self._key_read)
+            os.close(self._verdict_write)
+        job = self._job
+        given = {
+            "key": self._key.hex(),
+            "test_calls": job.test_calls,
+            "hidden": job.hide,
+            "checks": job.checks,
+            "seed": job.seed,
+        }
+        with os.fdopen(self._key_write, "w") as out:
+            json.dump(given, out)
+        self._reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
+        self._reader.start()
+
+    async def _async_shutdown_kernel(self, now: bool = False, restart: bool = False):
+        await super()._async_shutdown_kernel(now=now, restart=restart)
+        reader = getattr(self, "_reader", None)
+        if reader is not None:  # every line the kernel wrote is in the verdict file before nbgrader goes on
+            await asyncio.get_running_loop().run_in_executor(None, reader.join, 10.0)
+
+    shutdown_kernel = _async_shutdown_kernel  # what nbclient calls (the base class binds its own function)
+
+    def _read_verdicts(self) -> None:
+        """The seal's pipe, line by line, to the job's verdict file (its reader thread, until the pipe closes).
+
+        A signed line goes as it is, without its signature; any other (bytes an answer wrote on the pipe) as
+        a note of tampering.
+        """
+        fd = os.open(self._job.verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
+        with os.fdopen(self._verdict_read, "rb") as pipe, os.fdopen(fd, "a", encoding="utf-8") as out:
+            for raw in pipe:
+                line = raw.decode("utf-8", "replace").rstrip("\n")
+                body, _, mac = line.rpartition("\t")
+                good = hmac.new(self._key, body.encode(), "sha256").hexdigest()
+                ok = hmac.compare_digest(mac.encode(), good.encode())
+                out.write((body if ok else "note\ttampering\tan unsigned line on the seal's pipe\t") + "\n")
+                out.flush()
+
+
+class SandboxedExecute(Execute):
+    """nbgrader's Execute, with each kernel in the sandbox (:class:`SandboxedKernelManager`)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs["kernel_manager_class"] = SandboxedKernelManager
+        super().__init__(*args, **kwargs)

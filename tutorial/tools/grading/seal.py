@@ -1,0 +1,484 @@
+"""The grading kernel's seal: a check's verdict leaves the kernel only if the teacher's own code made it.
+
+nbgrader grades a test cell by whether it raised, in the same Python
+process as the learner's answer, so one line of an answer (rebinding a
+check, patching ``Result.require``, silencing IPython's traceback) could
+turn a failing check into full points.  When ``course/grade.py`` grades,
+each submission's kernel starts sealed (:mod:`tutorial.tools.grading.sealed_kernel`,
+started by :mod:`tutorial.tools.grading.sandbox`) before any cell runs, and the grade of a check cell
+comes from the seal's signed verdicts, not from the cell's output:
+
+* :func:`install` snapshots the teacher's code: every ``tutorial`` module's
+  names, the classes and functions in them (code, defaults, closures),
+  ``builtins``; and an audit hook (PEP 578: it cannot be removed) with
+  private builtins and no name any Python code can reach.
+* ``grade()`` announces each check (``rtt.check_begin``) and its result
+  (``rtt.result``); the hook takes them only from the teacher's ``grade``
+  (its code, with its module's real globals),
+  called by one of the teacher's check functions.  ``Result.require()``
+  asks for the verdict (``rtt.verdict``), taken only from the teacher's
+  ``require`` called by a statement compiled exactly like the test cell's
+  call.  Each time the snapshot is compared, object by object.
+* The hook refuses what would let an answer read or change the checks, or
+  the hook, from inside: during a check, frames of the answer's own code;
+  at any time, an answer's ``ctypes`` and ``/proc/*/mem`` (raw memory), the
+  garbage collector's object lists, tracers, other threads' frames, the
+  hook's own frames in a traceback, a second audit hook, and changing the
+  code or defaults of the teacher's functions.  It notes (without refusing)
+  an answer's connections, processes and files outside its folder.
+* Each verdict (``begin``, ``verdict``, ``note``) goes out as a line signed with
+  a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
+  grader's; :mod:`tutorial.tools.grading.sandbox` reads and checks it.
+
+What the seal does not stop: code that changes a check's objects *and*
+puts them back within one call from the check, or from a thread of its
+own while the check runs (the snapshot is compared at the check's start
+and end), and frames reached through a library function that walks the
+stack (``traceback.walk_stack``), which can read a check's expected values.
+The sandbox (:mod:`tutorial.tools.grading.sandbox`) bounds what such code could
+reach.  The hook itself never calls an answer's code (no ``str()``, no
+library function an answer could replace), so nothing runs unwatched inside it.
+
+The module is over 400 lines and still one job: the hook and all it keeps
+are closures of one function (:func:`_make_hook`), which no other module,
+and no answer, can reach.  Main thread only: ``install`` runs once, before
+the kernel starts.
+"""
+
+from __future__ import annotations
+
+import ast
+import builtins
+import importlib
+import importlib.util
+import inspect
+import os
+import pkgutil
+import sys
+import types
+
+# What a verdict line carries: the fields below, tab-separated, then the HMAC-SHA256 of the line so far.
+BEGIN, VERDICT, NOTE = "begin", "verdict", "note"
+FRAME_ATTRIBUTES = frozenset({"tb_frame", "gi_frame", "cr_frame", "ag_frame"})
+NOTED = frozenset({"socket.connect", "socket.sendto", "os.fork", "os.forkpty", "subprocess.Popen", "os.posix_spawn"})
+NOT_COMPARED = frozenset(
+    {"_", "input", "exit", "quit", "display", "get_ipython", "__IPYTHON__", "copyright", "credits"}
+)
+
+
+def trusted_modules(checks: list[str] | None = None) -> list[types.ModuleType]:
+    """The check modules ``checks`` (default: every module of ``tutorial.exercises``) and the grader, imported
+    with what they import; then every ``tutorial`` module imported so far: what the checks run."""
+    import tutorial.exercises as package
+
+    if checks is None:
+        checks = [f"tutorial.exercises.{i.name}" for i in pkgutil.iter_modules(package.__path__)]
+    wanted, done = ["tutorial.exercises.grader", *checks], set()
+    while wanted:  # each module, and the tutorial modules it imports anywhere (inside a check, lazily) too
+        name = wanted.pop()
+        if name in done:
+            continue
+        done.add(name)
+        module = importlib.import_module(name)
+        if name.startswith("tutorial.exercises"):
+            wanted += _tutorial_imports(module)
+    return [m for name, m in sorted(sys.modules.items()) if m is not None and name.split(".")[0] == "tutorial"]
+
+
+def _tutorial_imports(module: types.ModuleType) -> list[str]:
+    """The ``tutorial`` modules ``module``'s source imports, at its top or inside a function."""
+    tree = ast.parse(inspect.getsource(module))
+    names = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("tutorial"):
+            names.append(node.module)
+            names += [f"{node.module}.{a.name}" for a in node.names if _find(f"{node.module}.{a.name}")]
+        elif isinstance(node, ast.Import):
+            names += [a.name for a in node.names if a.name.startswith("tutorial")]
+    return names
+
+
+def _find(name: str) -> bool:
+    """Whether ``name`` is a module (``from package import name`` may also import a module)."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def install(
+    key: bytes,
+    fd: int,
+    test_calls: list[str],
+    hidden: list[str] = (),
+    checks: list[str] | None = None,
+    seed: str = "",
+) -> None:
+    """Seal this process: snapshot the teacher's code and add the audit hook that signs verdicts on ``fd``.
+
+    ``key``: the HMAC key (the grader's; never stored where Python code can read it); ``fd``: the pipe's
+    write end; ``test_calls``: each test cell's last line as nbgrader gives it (``check_x(answer).require()``);
+    ``hidden``: folders the sandbox hides (the course's, ...): an answer opening a path there is noted;
+    ``checks``: the modules the test cells import their checks from (default: all of them); ``seed``: this
+    learner's seed of hidden cases, given only to a teacher's check (``grader.hidden_random``).
+
+    Raises:
+        RuntimeError: called twice in one process (the second audit hook is refused).
+    """
+    import _hashlib
+    import _thread
+
+    from tutorial.exercises import grader
+
+    modules = trusted_modules(checks)
+    package = os.path.dirname(os.path.dirname(os.path.realpath(grader.__file__)))  # tutorial/
+    roots = tuple(os.path.realpath(p) + os.sep for p in {sys.prefix, sys.base_prefix, package})
+    repository = os.path.dirname(package)
+    readable = tuple(os.path.join(repository, p) + os.sep for p in ("project", "model"))
+    calls = [compile(text, "<test cell>", "single") for text in test_calls]
+    private = {  # the hook's globals: an answer's changes to builtins or to this module do not reach it
+        "__builtins__": dict(builtins.__dict__),
+        "types": types,
+        "getcwd": os.getcwd,
+        "lstat": os.lstat,
+        "readlink": os.readlink,
+        "get_ident": _thread.get_ident,
+        **{name: globals()[name] for name in ("BEGIN", "VERDICT", "NOTE", "NOT_COMPARED", "NOTED")},
+        "FRAME_ATTRIBUTES": FRAME_ATTRIBUTES,
+        "_make_hook_code": _make_hook.__code__,
+        "loaded": sys.modules,  # the import system's own dict (rebinding sys.modules does not change it)
+    }
+    make = types.FunctionType(_make_hook.__code__, private, "_make_hook")
+    hidden = tuple(h.rstrip("/") + "/" for h in hidden)
+    hook = make(
+        key,
+        fd,
+        modules,
+        roots,
+        readable,
+        hidden,
+        seed,
+        calls,
+        grader,
+        builtins.__dict__,
+        _hashlib.hmac_digest,
+        os.write,
+        sys._getframe,
+    )
+    sys.addaudithook(hook)
+
+
+def _make_hook(
+    key, fd, modules, roots, readable, hidden, seed, calls, grader, builtin_names, hmac_digest, write, getframe
+):  # noqa: C901
+    """The audit hook, its state in closures only (made with private globals by :func:`install`)."""
+    trusted: dict[int, object] = {}  # id -> object (kept alive, so an id is never reused)
+    snapshot: list[tuple] = []  # (where, namespace, name, object): compared by identity
+    function_parts: list[tuple] = []  # (function, code, defaults, kwdefaults, closure contents)
+
+    def remember_function(where, f):
+        cells = tuple(c.cell_contents for c in (f.__closure__ or ()) if _filled(c))
+        function_parts.append((where, f, f.__code__, f.__defaults__, f.__kwdefaults__, cells))
+        trusted[id(f)] = f
+
+    def _filled(cell):
+        try:
+            cell.cell_contents  # noqa: B018 - an empty cell raises
+        except ValueError:
+            return False
+        return True
+
+    check_modules = {m.__name__ for m in modules if any(n.startswith("check_") for n in m.__dict__) and m is not grader}
+
+    def uses(code, space):
+        """The names of ``space`` that ``code`` reads, and what those read in turn (functions, classes)."""
+        names, seen, stack = set(), set(), [code]
+        while stack:
+            c = stack.pop()
+            if id(c) in seen:
+                continue
+            seen.add(id(c))
+            names.update(c.co_names)
+            stack.extend(k for k in c.co_consts if isinstance(k, types.CodeType))
+            for n in c.co_names:
+                value = space.get(n)
+                if isinstance(value, types.FunctionType):
+                    stack.append(value.__code__)
+                elif isinstance(value, type):
+                    stack.extend(v.__code__ for v in vars(value).values() if isinstance(v, types.FunctionType))
+        return names
+
+    for module in modules:
+        space = module.__dict__
+        for name, value in list(space.items()):
+            if name.startswith("__"):
+                continue
+            # the checks' modules and the seal's own: every name, data too; elsewhere, what code is made of
+            if module.__name__.startswith(("tutorial.exercises", "tutorial.tools.grading")) or isinstance(
+                value, (type, types.FunctionType, types.ModuleType, types.BuiltinFunctionType)
+            ):
+                snapshot.append((module.__name__, space, name, value))
+            if isinstance(value, types.FunctionType) and value.__module__ == module.__name__:
+                remember_function(f"{module.__name__}.{name}", value)
+            elif isinstance(value, type) and value.__module__ == module.__name__:
+                trusted[id(value)] = value
+                for attr, member in list(value.__dict__.items()):
+                    if attr in ("__dict__", "__weakref__", "__doc__"):
+                        continue
+                    snapshot.append((f"{module.__name__}.{name}", value.__dict__, attr, member))
+                    inner = member.__func__ if isinstance(member, (staticmethod, classmethod)) else member
+                    if isinstance(inner, types.FunctionType):
+                        remember_function(f"{module.__name__}.{name}.{attr}", inner)
+    for name, value in list(builtin_names.items()):
+        if name not in NOT_COMPARED:
+            snapshot.append(("builtins", builtin_names, name, value))
+    check_codes = {  # each check's code -> (its module, the module's names it uses)
+        id(f.__code__): (f.__code__, m.__name__, uses(f.__code__, m.__dict__), m.__dict__)
+        for m in modules
+        if m.__name__ in check_modules
+        for n, f in m.__dict__.items()
+        if n.startswith("check_") and isinstance(f, types.FunctionType)
+    }
+    grade_code, require_code = grader.grade.__code__, grader.Result.require.__code__
+    grader_globals = grader.__dict__
+    frame_type = type(getframe(0))
+    hook_codes = set()  # every code object of this function's: the hook's frames, never an answer's to read
+    stack = [_make_hook_code]  # noqa: F821 - a private global
+    while stack:
+        code = stack.pop()
+        hook_codes.add(code)
+        stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
+    modules_now = [(m.__name__, m) for m in modules]
+    frame_holders = (types.TracebackType, types.GeneratorType, types.CoroutineType, types.AsyncGeneratorType)
+    result_type = grader.Result
+    state = {"checks": 0, "refused": [], "results": {}, "number": ""}
+    suspecting = {grader._suspect.__code__}
+    seed_code = grader.hidden_random.__code__
+    missing = object()
+
+    def changed(check=None):
+        """What differs from the snapshot; of the check modules, only what ``check`` (a code id) uses."""
+        module, used = check_codes[check][1:3] if check in check_codes else (None, ())
+        out = [f"{name} was replaced in sys.modules" for name, m in modules_now if loaded.get(name) is not m]  # noqa: F821
+        for where, space, name, value in snapshot:
+            if where in check_modules and (where != module or name not in used):
+                continue  # another check's module, or a name this check does not use
+            if space.get(name, missing) is not value:
+                out.append(f"{where}.{name} was replaced")
+        for where, f, code, defaults, kwdefaults, cells in function_parts:
+            owner, _, short = where.rpartition(".")
+            if owner in check_modules and (owner != module or short not in used):
+                continue
+            now = tuple(c.cell_contents for c in (f.__closure__ or ()) if _filled(c))
+            if f.__code__ is not code or f.__defaults__ is not defaults or f.__kwdefaults__ is not kwdefaults:
+                out.append(f"{where}'s code or defaults were changed")
+            elif len(now) != len(cells) or any(a is not b for a, b in zip(now, cells)):
+                out.append(f"{where}'s closure was changed")
+        return out
+
+    def send(*fields):
+        line = "\t".join(str(f).replace("\t", " ").replace("\n", " ") for f in fields)
+        mac = hmac_digest(key, line.encode(), "sha256").hex()
+        try:
+            write(fd, (line + "\t" + mac + "\n").encode())
+        except OSError:
+            pass  # the pipe closed or taken over by the answer: no verdict reaches the grader, which gives 0
+
+    def learner_code(code):
+        """Whether ``code`` is an answer's: not the library's, the environment's or Python's own."""
+        name = code.co_filename
+        return not name.startswith("<frozen ") and not name.startswith(roots)
+
+    def learner(frame):
+        return learner_code(frame.f_code)
+
+    def absolute(path):
+        """``path`` made absolute and normal here, never by a library function an answer could replace."""
+        parts = []
+        for part in (path if path.startswith("/") else getcwd() + "/" + path).split("/"):  # noqa: F821
+            if part == "..":
+                parts = parts[:-1]
+            elif part and part != ".":
+                parts.append(part)
+        return "/" + "/".join(parts)
+
+    def reaches_memory(path):
+        """Whether ``path`` is a process's memory (``.../mem``), itself or through symbolic links."""
+        for _ in range(10):
+            if path.endswith("/mem"):
+                return True
+            try:
+                if lstat(path).st_mode & 0o170000 != 0o120000:  # noqa: F821 - a private global
+                    return False
+                target = readlink(path)  # noqa: F821 - a private global
+            except OSError:
+                return False
+            path = absolute(target if target.startswith("/") else path.rsplit("/", 1)[0] + "/" + target)
+        return True  # a chain of links this long is not a file an answer needs
+
+    def learner_near(frame, depth=6):
+        """Whether answer code called this within ``depth`` frames (through IPython's open(), socket.py, ...)."""
+        while frame is not None and depth > 0:
+            if learner(frame):
+                return True
+            frame, depth = frame.f_back, depth - 1
+        return False
+
+    def number_of(exercise):
+        if type(exercise) is not str:
+            return "?"  # never str() of an answer's own object: its __str__ would run inside the hook
+        words = exercise.split()
+        return words[1].rstrip(",") if len(words) > 1 and words[0] == "Exercise" else "?"
+
+    def same_call(code):
+        for call in calls:
+            if code.co_code == call.co_code and code.co_names == call.co_names and code.co_consts == call.co_consts:
+                return True
+        return False
+
+    def here():
+        """The exercise whose check is running, or "" (then the grader gives a note to the next check)."""
+        return state["number"] if state["checks"] else ""
+
+    class Refused(Exception):  # noqa: N818 - what act() says to refuse; the hook raises the RuntimeError
+        pass
+
+    def refuse(what):
+        state["refused"].append(what)
+        send(NOTE, "refused", what, here())
+        raise Refused(what)
+
+    busy = set()  # the threads inside the hook: what it does itself raises events, which it lets pass
+
+    def hook(event, args):
+        if not (event.startswith("rtt.") or event in WATCHED or event.startswith("ctypes.")):
+            return
+        me = get_ident()  # noqa: F821 - a private global
+        if me in busy:
+            return
+        busy.add(me)
+        why = None
+        try:
+            act(event, args)
+        except Refused as refused:
+            why = refused.args[0]
+        except Exception:  # noqa: BLE001, S110 - an event raised by hand with odd arguments: nothing to do
+            pass
+        finally:
+            busy.discard(me)
+        if why is not None:  # raised here, its traceback holds no frame of act(); the hook's own is refused
+            raise RuntimeError(f"the grader's sandbox refused: {why}")
+
+    def ours(frame):
+        """Whether ``frame`` runs with the grader module's real globals (not a copy an answer made)."""
+        return frame is not None and frame.f_globals is grader_globals
+
+    def act(event, args):  # noqa: C901 - one branch per event
+        try:
+            caller = getframe(2)  # 0: act, 1: hook, 2: the code that raised the event
+        except ValueError:
+            return  # raised from no Python code at all: nobody's answer
+        if event == "rtt.check_begin":
+            if caller.f_code is grade_code and ours(caller):
+                state["checks"] += 1
+                state["refused"] = []
+                state["number"] = number_of(args[0])
+                state["begin_changes"] = changed(genuine_check(caller.f_back))
+                send(BEGIN, number_of(args[0]))
+        elif event == "rtt.check_end":
+            if caller.f_code is grade_code and ours(caller):
+                state["checks"] = max(0, state["checks"] - 1)  # also after an interrupt (a cell's timeout)
+        elif event == "rtt.result":
+            result = args[0]
+            if caller.f_code is grade_code and ours(caller) and type(result) is result_type:
+                check = genuine_check(caller.f_back)
+                reasons = list(state.get("begin_changes", [])) + changed(check) + list(state["refused"])
+                if check is None:
+                    reasons.append("grade() was not called by one of the teacher's checks")
+                fields = result.__dict__
+                passed = dict.get(fields, "passed") is True  # an identity: no method of an answer's object
+                record = (result, number_of(dict.get(fields, "exercise")), passed, reasons, check)
+                state["results"][id(result)] = record
+        elif event == "rtt.verdict":
+            result = args[0]
+            record = state["results"].get(id(result))
+            if caller.f_code is not require_code or not ours(caller) or record is None:
+                exercise = dict.get(result.__dict__, "exercise") if type(result) is result_type else None
+                send(NOTE, "tampering", "a verdict not made by the teacher's check and require()", number_of(exercise))
+                return
+            _, number, passed, reasons, check = record
+            statement = caller.f_back
+            reasons = list(reasons) + changed(check)
+            if statement is None or not same_call(statement.f_code):
+                reasons.append("require() was not called by the test cell's statement")
+            reasons = list(dict.fromkeys(reasons))
+            send(VERDICT, number, int(passed), int(not reasons), "; ".join(reasons[:3]))
+        elif event == "rtt.seed":
+            if seed and caller.f_code is seed_code and ours(caller) and genuine_check(caller.f_back) is not None:
+                if type(args[0]) is list:
+                    list.append(args[0], seed)
+        elif event == "rtt.suspect":
+            if caller.f_code in suspecting and ours(caller) and type(args[0]) is str:
+                send(NOTE, "tampering", "an answer returned " + args[0], here())
+        elif event == "sys.addaudithook":
+            refuse(event)
+        elif event in ("sys._current_frames", "sys.settrace", "sys.setprofile"):
+            # a way to the frames of this hook (another thread's, a tracer's): the answer's own call, or a thread
+            # started with the answer's tracer (threading.settrace, set by the thread's bootstrap)
+            hooks = [dict.get(caller.f_globals, n) for n in ("_trace_hook", "_profile_hook")]
+            if learner_near(caller) or any(type(f) is types.FunctionType and learner_code(f.__code__) for f in hooks):
+                refuse(event)
+        elif event in ("object.__setattr__", "object.__delattr__"):
+            if id(args[0]) in trusted:
+                attribute = args[1] if type(args[1]) is str else "?"
+                refuse(f"changing {getattr(args[0], '__qualname__', '?')}.{attribute}")
+        elif event in ("compile", "code.__new__"):
+            filename = args[1] if type(args[1]) is str else ""
+            if learner(caller) and (filename.startswith(roots) or filename.startswith("<frozen")):
+                refuse(f"code claiming to be the library's ({filename})")
+        elif event == "open":
+            path = args[0]
+            if type(path) is not str:
+                return  # a file descriptor, or bytes: not an answer's way to a path here
+            path = absolute(path)
+            if reaches_memory(path):
+                refuse(f"opening {path}")
+            allowed = ALLOWED + roots + readable + (getcwd() + "/",)  # noqa: F821 - a private global
+            outside = not path.startswith(allowed) or (path.startswith(hidden) and not path.startswith(roots))
+            if outside and learner_near(caller):
+                send(NOTE, "outside", f"opened {path}", here())
+        elif event in ("os.symlink", "os.link") and type(args[0]) is str and "/proc/" in absolute(args[0]):
+            refuse(f"a link to {args[0]}")
+        elif event.startswith("ctypes.") and learner(caller):
+            refuse(event)  # raw memory: the seal's key, or any object
+        elif event in ("gc.get_objects", "gc.get_referrers", "gc.get_referents") and learner_near(caller):
+            refuse(event)  # every object, the hook's closures among them
+        elif event == "object.__getattr__" and type(args[0]) in frame_holders and args[1] in FRAME_ATTRIBUTES:
+            frame = getattr(args[0], args[1], None)  # read here, where the hook lets its own events pass
+            if type(frame) is frame_type and frame.f_code in hook_codes:
+                refuse("reading the grader's own frames")
+            if state["checks"] > 0 and learner(caller):
+                refuse(f"reading {args[1]} during a check")
+        elif event in NOTED:
+            if learner_near(caller):
+                send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
+        elif event == "sys._getframe" and state["checks"] > 0 and type(args[0]) is frame_type:
+            if learner(caller) or (learner(args[0]) and caller.f_back is not None and learner(caller.f_back)):
+                refuse("reading frames during a check")  # the answer's own call, or inspect.currentframe()'s
+
+    def genuine_check(frame):
+        """The id of the teacher's check whose code ``frame`` runs with its module's real globals, or None."""
+        if frame is None or id(frame.f_code) not in check_codes:
+            return None
+        return id(frame.f_code) if frame.f_globals is check_codes[id(frame.f_code)][3] else None
+
+    WATCHED = (
+        NOTED
+        | {"sys.addaudithook", "sys._current_frames", "sys.settrace", "sys.setprofile"}
+        | {"gc.get_objects", "gc.get_referrers", "gc.get_referents"}
+        | {"object.__setattr__", "object.__delattr__", "compile", "code.__new__", "open"}
+        | {"os.symlink", "os.link"}
+        | {"sys._getframe", "object.__getattr__"}
+    )
+    ALLOWED = ("/tmp/", "/dev/", "/proc/self/", "/sys/", "/etc/", "/usr/", "/lib", "/run/")
+    return hook
