@@ -621,3 +621,46 @@ def test_4_2_a_reports_vector_within_1e_9_passes_and_a_hair_more_does_not():
     assert step4._compare_reports("c", {}, WALL, _reports_of(WALL, [1, 4], z=1e-9)) == [1, 4]
     with pytest.raises(CaseFailed, match="carries"):
         step4._compare_reports("c", {}, WALL, _reports_of(WALL, [1, 4], z=1.0000001e-9))
+
+
+# ---- 4.2's check around its runs: its defaults case and a run that publishes no Imu message ------------------
+
+
+@pytest.mark.parametrize(
+    "parameters, got",
+    [
+        (None, "{'threshold': None, 'holdoff': None}"),  # no PARAMETERS at all: not a RttImuStatePublisher
+        ({"rate": (float, 20.0, "")}, "{'threshold': None, 'holdoff': None}"),  # neither declared
+        ({"threshold": (float, 20.0, ""), "holdoff": (float, 0.25, "")}, "{'threshold': 20.0, 'holdoff': 0.25}"),
+    ],
+)
+def test_4_2_defaults_not_declared_are_told_as_none_before_any_run(monkeypatch, parameters, got):
+    def no_run(*args, **kwargs):
+        raise AssertionError("the defaults are judged before any run")
+
+    monkeypatch.setattr(step4, "_drive", no_run)
+    cls = type("Reporter", (), {} if parameters is None else {"PARAMETERS": parameters})
+    assert str(step4.check_collision_reporter(cls)) == (
+        f"✗ Exercise 4.2, report collisions: Reporter.PARAMETERS: its defaults are {got}, expected threshold 20.0 "
+        'and holdoff 0.5. Hint: declare them: PARAMETERS = {**RttImuStatePublisher.PARAMETERS, "threshold": '
+        '(float, 20.0, ...), "holdoff": (float, 0.5, ...)}.'
+    )
+
+
+def test_4_2_a_run_without_an_imu_publisher_is_named_by_its_case(monkeypatch):
+    runs = []
+
+    def drive(name, cls, parameters, script="wall", duration=step4.DURATION):
+        runs.append(parameters)
+        return SimpleNamespace(published=lambda topic=None: []), None
+
+    monkeypatch.setattr(step4, "_drive", drive)
+    monkeypatch.setattr(step4, "hidden_random", lambda exercise: None)
+    cls = type("Reporter", (), {"PARAMETERS": {"threshold": (float, 20.0, ""), "holdoff": (float, 0.5, "")}})
+    result = str(step4.check_collision_reporter(cls))
+    call = f"Reporter with default parameters, the wall script for {step4.DURATION} s"
+    assert result == (
+        f"✗ Exercise 4.2, report collisions: {call} made 0 publishers of /Tank/imu (its topics: []), expected 1. "
+        "Hint: keep publishing the Imu: call super().configure(config) and super().publish() (or super().control())."
+    )
+    assert runs == [{}]

@@ -645,6 +645,8 @@ MISTAKES = [
 # More wrong answers, each found by make mutate: a mutant of the check that only it fails (make test-more runs
 # them, and make mutate).  A mistake in two places gives its texts as tuples, each put in its place.
 MUTANT_MISTAKES = [
+    # configure() that raises (a parameter the statement does not name): told with the controller's name
+    ("4.2", 'self.threshold = config.parameters["threshold"]', 'self.threshold = config.parameters["limit"]', "with"),
     # the CameraInfo beside the camera, not under it: no publisher of the camera_info topic a subscriber asks for
     (
         "6.2",

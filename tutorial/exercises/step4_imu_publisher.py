@@ -385,8 +385,11 @@ def check_collision_reporter(cls) -> Result:
     def reports(parameters: dict, label: str = ""):
         where = ", ".join(f"{k}={v}" for k, v in parameters.items()) or "default parameters"
         call = label or f"{cls.__name__} with {where}, the wall script for {DURATION} s"
-        hint = "above threshold, then not again for holdoff s of self.data.time: time, not a count of messages."
-        return Case(call, lambda: outcome(parameters, call), hint if label else "", bool(label))
+        if label:  # a hidden run: its rule
+            hint = "above threshold, then not again for holdoff s of self.data.time: time, not a count of messages."
+        else:  # a visible run that raised (a wrong report has a hint of its own)
+            hint = "read threshold and holdoff from config.parameters in configure(); report in publish()."
+        return Case(call, lambda: outcome(parameters, call), hint, bool(label))
 
     def exactly_at_threshold(holdoff: float):
         """Threshold: the horizontal mean of one Imu message of the default run; holdoff: less than a period."""
