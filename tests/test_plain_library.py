@@ -45,16 +45,18 @@ def long_modules_without_a_reason(package: Path) -> list[str]:
 def unnamed_or_gone_modules(package: Path) -> list[str]:
     """What the docstring of ``package``'s subpackages (``__init__.py``) gets wrong about their modules."""
     found = []
-    for init in sorted(package.glob("*/__init__.py")):
+    for init in sorted(package.glob("**/__init__.py")):  # every depth: tools/, and tools/bag/ in it
         sub = init.parent
-        if sub.name in ONE_PER_NOTEBOOK:
+        if sub == package or sub.name in ONE_PER_NOTEBOOK:
             continue
+        where = ".".join(sub.relative_to(package.parent).parts)  # tutorial.tools.bag
         doc = ast.get_docstring(ast.parse(init.read_text())) or ""
         held = {p.stem for p in sub.glob("[!_]*.py")} | {p.parent.name for p in sub.glob("[!_]*/__init__.py")}
         named = set(TABLE_ROW.findall(doc))
-        named |= {m.group(1) for m in re.finditer(rf":mod:`{package.name}\.{sub.name}\.(\w+)", doc)}
-        found += [f"{sub.name}: {name} not named" for name in sorted(held - named)]
-        found += [f"{sub.name}: {name} named, not there" for name in sorted(named - held)]
+        named |= {m.group(1) for m in re.finditer(rf":mod:`{re.escape(where)}\.(\w+)", doc)}
+        label = where.removeprefix(package.name + ".")
+        found += [f"{label}: {name} not named" for name in sorted(held - named)]
+        found += [f"{label}: {name} named, not there" for name in sorted(named - held)]
     return found
 
 
@@ -98,6 +100,18 @@ def test_the_module_map_check_catches_a_module_unnamed_or_gone(tmp_path):
     for name in ("kept", "also", "new"):
         (package / f"{name}.py").write_text('"""A module."""\n')
     assert unnamed_or_gone_modules(tmp_path / "tutorial") == ["things: new not named", "things: gone named, not there"]
+
+
+def test_the_module_map_check_reads_a_package_inside_a_package_too(tmp_path):
+    """As tutorial/tools/bag/ is in tutorial/tools/: its own docstring, with :mod: paths of its full name."""
+    outer = tmp_path / "tutorial" / "tools"
+    inner = outer / "bag"
+    inner.mkdir(parents=True)
+    (outer / "__init__.py").write_text('"""Tools.\n\n``bag/``      recording\n"""\n')
+    (inner / "__init__.py").write_text('"""Bags.\n\n:mod:`tutorial.tools.bag.record` writes.\n"""\n')
+    for name in ("record", "play"):
+        (inner / f"{name}.py").write_text('"""A module."""\n')
+    assert unnamed_or_gone_modules(tmp_path / "tutorial") == ["tools.bag: play not named"]
 
 
 def test_the_exported_controllers_use_no_speed_tricks():

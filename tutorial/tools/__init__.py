@@ -1,7 +1,7 @@
-"""The tooling around the lessons' library: the ``rtt-*`` programs and what only they, or notebooks 07 to 11, use.
+"""The tooling around the lessons' library: the ``rtt-*`` programs and what only they, or notebooks 07 to 09, use.
 
 The lessons' library (``core``, ``interfaces``, ``ros``, ``view``, ``app``,
-``joystick``, ``notebook``, ``exercises``) never imports this package
+``joystick``, ``notebook``, ``controllers``, ``exercises``) never imports this package
 (``make lint``'s import contract ``tooling``).  Three of the later notebooks
 teach a tool here: 07 recording (``bag``), 08 the network lab (``network``),
 09 the URDF (``urdf``); their modules are the contract's stated exceptions.

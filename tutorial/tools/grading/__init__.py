@@ -10,5 +10,5 @@ module              job
 ``sealed_kernel``   the kernel the sandbox starts, sealed before any cell runs
 ==================  ================================================================
 
-``course/grade.py`` and ``course/nbgrader_config.py`` use them.
+``course/grade.py``, ``course/sandboxing.py`` and ``course/nbgrader_config.py`` use them.
 """
