@@ -14,7 +14,7 @@ Its flags say why not, or what else was seen:
   passing verdict (a check or the grader replaced, a verdict not the check's,
   a refused operation);
 - ``timeout``: a cell of the exercise ran past the cell timeout;
-- ``crash``: the kernel died;
+- ``crash``: the kernel died in or before the exercise (or nbgrader failed);
 - ``over a limit``: memory, processes or CPU time ran out (``MemoryError``, ...);
 - ``network``, ``processes``, ``outside its folder``: what the seal noted the answer doing;
 - ``grader-aware``: the answer looks for nbgrader (``NBGRADER_...``).
@@ -245,7 +245,7 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
             mine.append("timeout")
         if LIMIT_ERRORS.search(text):
             mine.append("over a limit")
-        if died:
+        if died or "DeadKernelError" in text:  # nbgrader failed, or the kernel died in or before this exercise
             mine.append("crash")
         if "showtraceback was disabled" in json.dumps(found["cells"]):  # nbgrader's words for a hidden error
             mine.append("tampering")

@@ -29,8 +29,10 @@ is not a notebook is named as ungradable while the others are graded.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import csv
+import io
 import json
 import os
 import re
@@ -269,6 +271,24 @@ def test_grading_takes_only_domains_no_learner_was_given(tmp_path):
     assert (tmp_path / "kept.json").stat().st_mode & 0o777 == 0o644
 
 
+def test_the_hidden_cases_seed_is_the_teachers_alone_and_the_same_on_a_regrade(tmp_path):
+    """course/.grading_seed: made once, 0600; each learner's seed of an assignment the same every time it is
+    asked, another for another learner, another assignment or another course."""
+    import stat
+
+    import sandboxing
+
+    (tmp_path / "a").mkdir()
+    first = sandboxing.learner_seed(tmp_path / "a", "01", "ada")
+    assert stat.S_IMODE((tmp_path / "a" / ".grading_seed").stat().st_mode) == 0o600
+    assert sandboxing.learner_seed(tmp_path / "a", "01", "ada") == first  # a regrade draws the same cases
+    assert sandboxing.learner_seed(tmp_path / "a", "01", "bob") != first
+    assert sandboxing.learner_seed(tmp_path / "a", "02", "ada") != first
+    (tmp_path / "b").mkdir()
+    assert sandboxing.learner_seed(tmp_path / "b", "01", "ada") != first  # another course, another seed
+    assert len(first) == 16 and int(first, 16) >= 0
+
+
 def test_grading_domains_named_by_hand_are_ones_fast_dds_can_use():
     """--domains: 1 to 101 and 215 to 232; 0 is everyone's default, 102 to 214 have no ports on Linux."""
     assert grade.domains("215-217,5") == [215, 216, 217, 5]
@@ -503,22 +523,26 @@ CHEATS = {
     ),
     "read-solutions": (
         "1.1",
+        "found = 0\n"
         "for path in ('{root}/notebooks/01_step1_tank_controller.ipynb',\n"
         "             '{course}/source/01_step1_tank_controller/01_step1_tank_controller.ipynb'):\n"
         "    try:\n        exec(open(path).read().split('Worked solution to Exercise 1.1.')[1].split('check_')[0])\n"
-        "    except (OSError, IndexError, SyntaxError):\n        pass\n",
+        "        found += 1\n"
+        "    except (OSError, IndexError, SyntaxError):\n        pass\n"
+        "print('solutions found:', found)\n",
         "outside its folder",
     ),
     "read-another-learner": (
         "1.1",
         "try:\n    open('{course}/submitted/cheat-endless/01_step1_tank_controller/01_step1_tank_controller.ipynb')\n"
-        "except OSError:\n    pass\n" + STUB_1_1,
+        "    print('read another learner: yes')\n"
+        "except OSError:\n    print('read another learner: no')\n" + STUB_1_1,
         "outside its folder",
     ),
-    "write-home-and-gradebook": (
+    "write-home-and-gradebook": (  # and a note for the next submission, where anyone may write on this machine
         "1.1",
-        "for path in ('{home}/rtt-cheat', '{course}/gradebook.db'):\n"
-        "    try:\n        open(path, 'a').write('cheat')\n    except OSError:\n        pass\n" + STUB_1_1,
+        "for path in ('{home}/rtt-cheat', '{course}/gradebook.db', '/run/lock/rtt-cheat', '/var/lock/rtt-cheat'):\n"
+        "    try:\n        open(path, 'a').write('rtt-cheat-mark')\n    except OSError:\n        pass\n" + STUB_1_1,
         "outside its folder",
     ),
     "network": (
@@ -540,6 +564,7 @@ CHEATS = {
         "over a limit",
     ),
     "endless": ("1.1", "while True:\n    pass\n", "timeout"),
+    "crash": ("1.2", "import os\nos.kill(os.getpid(), 9)\n", "crash"),  # 1.1, before it, keeps its points
     "memory-through-a-link": (  # the seal's key is in the kernel's memory
         "1.1",
         "import os\ntry:\n    os.symlink('/proc/self/mem', 'memory')\n    open('memory', 'rb').read(1)\n"
@@ -558,14 +583,21 @@ CHEATS = {
     # cases fail (no flag)
     "visible-only-1.1": ("1.1", VISIBLE_ONLY["1.1"], ""),
     "visible-only-1.2": ("1.2", VISIBLE_ONLY["1.2"], ""),
-    "grader-aware": (
+    "grader-aware": (  # a payload that would win if it ran: the kernel's environment never says it is graded
         "1.1",
-        "import os\nif os.environ.get('NBGRADER_EXECUTION'):\n"
-        + "    "
-        + GRADER
-        + "    grader.Result.__bool__ = lambda s: True\n",
+        "import os\nprint('graded, says the environment:', 'NBGRADER_EXECUTION' in os.environ)\n"
+        "if os.environ.get('NBGRADER_EXECUTION'):\n"
+        "    import tutorial.exercises.step1_tank_controller as m\n"
+        "    m.check_dpad_steering = lambda f: m.grade('Exercise 1.1, steer with the D-pad', [])\n",
         "grader-aware",
     ),
+}
+# What a cheat's own output must say in the graded notebook: what it tried really failed.
+CHEATS_SAY = {
+    "read-solutions": "solutions found: 0",
+    "read-another-learner": "read another learner: no",
+    "grader-aware": "graded, says the environment: False",
+    "memory-from-a-child": "the kernel memory refused to a child: True",
 }
 IN_MAKE_TEST_CHEATS = ["rebind-check"]  # graded among make test's submissions of notebook 01
 # where the cheats that read, write or connect point: none of it may be reached
@@ -607,7 +639,10 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
             folder.mkdir(parents=True)
             (folder / f"{name}.ipynb").write_text(json.dumps(nb))
         gradebook_before = (course / "gradebook.db").read_bytes()
-        csv_path = grade.grade(course, [name], collect=False, jobs=2, ids=DOMAINS)
+        said = io.StringIO()
+        with contextlib.redirect_stdout(said):  # make grade's summary of the flagged submissions
+            csv_path = grade.grade(course, [name], collect=False, jobs=2, ids=DOMAINS)
+        print(said.getvalue())
         with pytest.raises(TimeoutError):
             listener.accept()  # nobody connected
     finally:
@@ -626,11 +661,21 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
             wrong.append(f"{cheat}: flags {row['flags']!r}, expected {flag!r} on {target}")
         if flags.get(other):
             wrong.append(f"{cheat}: the honest exercise {other} was flagged {flags[other]!r}")
-    if "memory-from-a-child" in which:  # the child really was refused (not merely failing otherwise)
-        graded = course / "autograded" / "cheat-memory-from-a-child" / name / f"{name}.ipynb"
-        assert "the kernel memory refused to a child: True" in graded.read_text()
+    summary = said.getvalue()
+    for cheat in which:  # make grade names every flagged submission with its flag, and no other
+        target, _, flag = CHEATS[cheat]
+        listed = f"{name}, cheat-{cheat}: {target}: " in summary
+        if listed != bool(flag) or (flag and flag not in summary.split(f"cheat-{cheat}: ")[1].splitlines()[0]):
+            wrong.append(f"{cheat}: make grade's summary {'leaves it out' if flag else 'lists it'}")
+    for cheat in set(which) & set(CHEATS_SAY):  # what it tried really failed (not merely flagged)
+        graded = course / "autograded" / f"cheat-{cheat}" / name / f"{name}.ipynb"
+        if CHEATS_SAY[cheat] not in graded.read_text():
+            wrong.append(f"{cheat}: its output does not say {CHEATS_SAY[cheat]!r}")
     assert not wrong, "\n".join(wrong)
-    assert (course / "gradebook.db").read_bytes() != gradebook_before  # the grader wrote it, nobody else could
+    gradebook = (course / "gradebook.db").read_bytes()
+    assert gradebook != gradebook_before  # the grader wrote it
+    assert b"rtt-cheat-mark" not in gradebook, "a cheat wrote into the gradebook"
+    assert not Path("/run/lock/rtt-cheat").exists(), "a cheat left a note where the next submission could read it"
     feedback = (course / "feedback" / f"cheat-{which[0]}" / name / f"{name}.html").read_text()
     assert f"The grader flagged exercise {CHEATS[which[0]][0]}" in feedback
 

@@ -454,6 +454,40 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
     script = command[7]
     assert f"mount -t tmpfs -o mode=755,size=1m tmpfs {root / 'course'}" in script, script
     assert "ip link set lo up" in script and "mount -t tmpfs -o mode=1777,size=2g tmpfs /dev/shm" in script
+    # the rest read-only, but the job's folder (bound onto itself first) and the private folders
+    bound = script.index("mount --bind /var/lib/rtt-grading/x/u /var/lib/rtt-grading/x/u")
+    assert bound < script.index("remount,bind,ro")
+    assert 'mount -o remount,bind,ro "$mp"' in script and "|/var/lib/rtt-grading/x/u|/tmp|/var/tmp|/dev/shm)" in script
+
+
+def test_the_sandbox_leaves_nothing_writable_but_its_own_folders():
+    """The sandbox's mounts, run for real (root): a file in /run/lock or the root folder is refused, the job's
+    folder and the private /tmp take one, and nothing written there reaches this machine's own folders."""
+    import secrets
+    import shutil
+    from pathlib import Path
+
+    from tutorial.tools.grading.sandbox import Job, sandbox_command
+
+    if os.geteuid() != 0 or not shutil.which("unshare"):
+        pytest.skip("the sandbox's namespaces need root")
+    folder = Path("/var/lib/rtt-grading") / f"probe-{secrets.token_hex(4)}"  # where grading's jobs are (not /tmp)
+    (folder / "k").mkdir(parents=True)
+    try:
+        os.chown(folder / "k", 65534, 65534)
+        job = Job("nobody", 65534, 65534, str(folder), "/v", [], ["c(a).require()"])
+        tries = {"/run/lock": "refused", "/": "refused", str(folder / "k"): "written", "/tmp": "written"}
+        probe = "; ".join(f"(touch {p}/rtt-probe 2>/dev/null && echo {p}=written || echo {p}=refused)" for p in tries)
+        done = subprocess.run(
+            sandbox_command(job, ["sh", "-c", probe], []), capture_output=True, text=True, timeout=60, check=False
+        )
+        assert done.returncode == 0, done.stderr
+        said = dict(line.split("=") for line in done.stdout.split())
+        assert said == tries, (said, done.stderr)
+        assert not Path("/run/lock/rtt-probe").exists() and not Path("/tmp/rtt-probe").exists()
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+        Path("/run/lock/rtt-probe").unlink(missing_ok=True)  # a sandbox that let it through
 
 
 ATTACKS = textwrap.dedent(

@@ -10,8 +10,8 @@ kernel:
   nothing leaves it) and a mount namespace of its own, where the course
   folder, the repository's teacher-only folders (``notebooks``, ``course``,
   ``book``, ``.git``), ``/home``, ``/root`` (but the Python installation)
-  and ``/srv`` are empty, and ``/tmp``, ``/var/tmp`` and ``/dev/shm`` are
-  the kernel's own;
+  and ``/srv`` are empty, ``/tmp``, ``/var/tmp`` and ``/dev/shm`` are the
+  kernel's own, and every other mount is read-only (``/run/lock`` too);
 * as the job's user, with no privileges (``setpriv --no-new-privs``), in a
   working folder of its own (a copy of the submission's folder), with a
   scrubbed environment (no ``NBGRADER_EXECUTION``);
@@ -133,8 +133,22 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[P
         script.append(f"if [ -d {q(path)} ]; then mount -t tmpfs -o mode=755,size=1m tmpfs {q(path)}; fi")
     for path in PRIVATE:
         script.append(f"mount -t tmpfs -o mode=1777,size=2g tmpfs {path}")
-    for k, path in enumerate(keep):  # last: a clone under /tmp keeps its library and environment
+    for k, path in enumerate(keep):  # a clone under /tmp keeps its library and environment
         script += [f"mkdir -p {q(path)}", f"mount --move {q(f'{held}/{k}')} {q(path)}"]
+    # Last, every other mount read-only, world-writable folders such as /run/lock included (a note left there
+    # would reach the next submission): the job's folder (its kernels' working folders, the user's alone) and
+    # the private folders stay writable; /proc, /sys and /dev are the kernel's own or root's.  A mount that
+    # cannot be made read-only stops the kernel (fail closed).
+    script.append(f"mount --bind {q(job.folder)} {q(job.folder)}")
+    skipped = "|".join(q(p) for p in (job.folder, *PRIVATE))
+    script += [
+        "for mp in $(cut -d' ' -f5 /proc/self/mountinfo); do",
+        "  mp=$(printf '%b' \"$mp\")",  # mountinfo writes a space as \040
+        f'  case "$mp" in /proc|/proc/*|/sys|/sys/*|/dev|/dev/*|{skipped}) continue;; esac',
+        '  mountpoint -q "$mp" || continue',  # a mount hidden under another (a hidden folder under /tmp)
+        '  mount -o remount,bind,ro "$mp"',
+        "done",
+    ]
     for group in groups:
         script.append(f"echo $$ > {q(str(group / 'cgroup.procs'))}")
     script.append('exec "$@"')
@@ -256,9 +270,39 @@ class SandboxedKernelManager(AsyncKernelManager):
                 out.flush()
 
 
+KERNEL_DIED = "the kernel died while this cell ran"
+NOT_RUN = "not run: the kernel died in an earlier cell"
+
+
 class SandboxedExecute(Execute):
-    """nbgrader's Execute, with each kernel in the sandbox (:class:`SandboxedKernelManager`)."""
+    """nbgrader's Execute, with each kernel in the sandbox (:class:`SandboxedKernelManager`).
+
+    A kernel that dies (an answer that kills it, a crash in a library) ends the run, not the grading of the
+    submission: the cell that was running gets an error (``DeadKernelError``, :data:`KERNEL_DIED`), every
+    code cell after it one that says it did not run (:data:`NOT_RUN`, so nbgrader gives its check no
+    points: an empty check cell would pass), and the exercises before it keep what they earned.  nbgrader's
+    event loop's thread.
+    """
 
     def __init__(self, *args, **kwargs):
         kwargs["kernel_manager_class"] = SandboxedKernelManager
         super().__init__(*args, **kwargs)
+        self._died = False
+
+    def preprocess_cell(self, cell, resources, index):
+        from nbclient.exceptions import DeadKernelError
+        from nbformat.notebooknode import NotebookNode
+
+        def error(text):
+            return NotebookNode(output_type="error", ename="DeadKernelError", evalue=text, traceback=[text])
+
+        if self._died:
+            if cell.cell_type == "code":
+                cell.outputs = [error(NOT_RUN)]
+            return cell, resources
+        try:
+            return super().preprocess_cell(cell, resources, index)
+        except DeadKernelError:
+            self._died = True
+            cell.outputs.append(error(KERNEL_DIED))
+            return cell, resources
