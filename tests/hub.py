@@ -106,7 +106,9 @@ class Hub:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
-                raise RuntimeError(f"the hub exited: {self.log()[-2000:]}")
+                log = self.log()
+                errors = [line for line in log.splitlines() if line.startswith(("[E ", "[C "))]  # its reasons
+                raise RuntimeError("the hub exited: " + "\n".join(errors) + f"\n...\n{log[-2000:]}")
             try:
                 if requests.get(self.url + "/hub/login", timeout=2).status_code == 200:
                     return

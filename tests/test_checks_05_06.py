@@ -399,6 +399,31 @@ def test_6_1_a_camera_publishing_no_image_on_its_topic_is_told_so(monkeypatch):
     assert "RttGrayCameraPublisher publishes CompressedImage on /Tank/camera/image, expected an Image." in str(result)
 
 
+def test_6_the_rig_finds_the_image_publisher_among_others_and_names_what_was_made_without_one():
+    """The rig's Image publisher is the one of the camera's image topic, whatever was made before it (a
+    CameraInfo publisher made first); without one, the line names the topic, what was made, and the hint."""
+    from types import SimpleNamespace
+
+    from tutorial.exercises.camera_rig import Camera, Rig
+    from tutorial.exercises.grader import CaseFailed
+
+    info, image = (SimpleNamespace(topic=f"/Eye/camera/{k}") for k in ("camera_info", "image"))
+
+    def rig(publishers):
+        made = Rig.__new__(Rig)  # its images() alone: no simulation, no node
+        made.name, made.camera = "RttGrayCameraPublisher", Camera(body="Eye")
+        made.node = SimpleNamespace(published=lambda topic=None: [p for p in publishers if topic in (None, p.topic)])
+        return made
+
+    assert rig([info, image]).images() is image
+    with pytest.raises(CaseFailed) as failed:
+        rig([info]).images()
+    assert (failed.value.what, failed.value.hint) == (
+        "RttGrayCameraPublisher made no publisher of /Eye/camera/image (it made ['/Eye/camera/camera_info']).",
+        "let RttCameraImagePublisher.configure create it: call super().configure(config).",
+    )
+
+
 def test_6_1_hidden_poses_are_three_with_the_yaw_anywhere_and_the_pitch_within_the_turrets_range():
     from tutorial.exercises import step6_camera as step6
 
