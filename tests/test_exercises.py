@@ -1203,6 +1203,42 @@ def test_a_count_changed_in_place_outside_the_lock_fails_the_lock_check(ros):
     assert not result.passed and "outside `with self._lock:`" in str(result), str(result)
 
 
+def test_6_1_a_picture_never_published_a_failing_render_thread_and_a_control_that_gives_nothing_back(ros, monkeypatch):
+    """What the camera rig says when a picture never comes (after its wait, shortened here), when the render
+    thread fails, and when control() gives back nothing: each the learner's class, the time, the hint."""
+    from tutorial.app.reference.camera_image_publisher import RttCameraImagePublisher
+    from tutorial.exercises import camera_rig
+    from tutorial.exercises import step6_camera as step6
+
+    monkeypatch.setattr(camera_rig, "WAIT", 1.0)
+    monkeypatch.setattr(step6, "hidden_random", lambda exercise: None)
+
+    class Silent(RttCameraImagePublisher):
+        def publish_image(self, pixels, time_s):
+            pass  # fills nothing, publishes nothing
+
+    class Failing(RttCameraImagePublisher):
+        def publish_image(self, pixels, time_s):
+            raise ValueError("no gray today")
+
+    class Forgetful(RttCameraImagePublisher):
+        def control(self):
+            super().control()  # its answer not given back: None
+
+    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (Silent, Failing, Forgetful)}
+    assert (
+        "Silent: the picture due at t = 0.000 s was not published within 1 s. "
+        "Hint: publish_image must publish the message it fills."
+    ) in said["Silent"], said
+    assert ("Failing: the render thread failed: rendering or publishing failed: ValueError: no gray today.") in said[
+        "Failing"
+    ], said
+    assert (
+        "Forgetful.control() returned None at t = 0.000 s: no error was set. "
+        "Hint: return what super().control() returns: True while all is well."
+    ) in said["Forgetful"], said
+
+
 def test_every_exercise_has_six_wrong_answers():
     counts = {number: sum(m[0] == number for m in MISTAKES) for number in EXERCISES}
     assert all(n >= 6 for n in counts.values()), counts

@@ -129,9 +129,12 @@ class Rig:
         steps = 1 if self.steps == 0 else round(1 / (RATE * STEP))  # due at the start, then every 0.1 s
         for _ in range(steps):
             t = self.data.time
-            if not self.controller.control():
+            went_on = self.controller.control()
+            if not went_on:
                 raise CaseFailed(
-                    f"{self.name}.control() returned False at t = {t:.3f} s: {self._error() or 'no error was set'}."
+                    f"{self.name}.control() returned {went_on!r} at t = {t:.3f} s: "
+                    f"{self._error() or 'no error was set'}.",
+                    "return what super().control() returns: True while all is well.",
                 )
             self.steps += 1
             self.data.time = self.camera.start + self.steps * STEP
