@@ -46,7 +46,10 @@ from tutorial.tools.grading.sandbox import Job
 ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")
 TEACHERS_ONLY = ("notebooks", "course", "book", ".git")  # the repository's folders with worked solutions
-LIMIT_ERRORS = re.compile(r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory")
+LIMIT_ERRORS = re.compile(
+    r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory|its CPU time ran out"
+)
+CPU_SECONDS = "RTT_GRADING_CPU_SECONDS"  # a kernel's CPU time, s (RLIMIT_CPU; default 600)
 
 
 class SandboxError(RuntimeError):
@@ -96,7 +99,16 @@ class Sandboxes:
             folder = self.folder / name
             folder.mkdir(mode=0o711)
             self.users.append(
-                Job(name, entry.pw_uid, entry.pw_gid, str(folder), str(folder / "verdicts"), hide, test_calls=[])
+                Job(
+                    name,
+                    entry.pw_uid,
+                    entry.pw_gid,
+                    str(folder),
+                    str(folder / "verdicts"),
+                    hide,
+                    test_calls=[],
+                    cpu_seconds=int(os.environ.get(CPU_SECONDS, "600")),
+                )
             )
         return self
 

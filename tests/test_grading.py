@@ -565,6 +565,8 @@ CHEATS = {
     ),
     "endless": ("1.1", "while True:\n    pass\n", "timeout"),
     "crash": ("1.2", "import os\nos.kill(os.getpid(), 9)\n", "crash"),  # 1.1, before it, keeps its points
+    # graded alone, with the CPU time limit below the cell timeout (test_a_kernel_over_its_cpu_time_...)
+    "cpu-time": ("1.2", "while True:\n    pass\n", "over a limit"),
     "memory-through-a-link": (  # the seal's key is in the kernel's memory
         "1.1",
         "import os\ntry:\n    os.symlink('/proc/self/mem', 'memory')\n    open('memory', 'rb').read(1)\n"
@@ -684,7 +686,17 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
 @pytest.mark.timeout(1200)
 def test_every_cheat_gets_0_and_is_flagged(tmp_path, monkeypatch):
     monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))
-    grade_cheats(tmp_path, sorted(CHEATS))
+    grade_cheats(tmp_path, sorted(set(CHEATS) - {"cpu-time"}))  # an endless loop meets the cell timeout first
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(600)
+def test_a_kernel_over_its_cpu_time_is_stopped_and_flagged(tmp_path, monkeypatch):
+    """RLIMIT_CPU, lowered to 20 s (RTT_GRADING_CPU_SECONDS) under a cell timeout of 90 s, stops a busy answer:
+    over a limit, and the exercise before it keeps its points."""
+    monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", "90")
+    monkeypatch.setenv("RTT_GRADING_CPU_SECONDS", "20")
+    grade_cheats(tmp_path, ["cpu-time"])
 
 
 def rebound_check(course: Path, name: str, number: str) -> str:

@@ -450,7 +450,7 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
     command = sandbox_command(job, ["python", "-m", "k"], kept)
     assert command[:5] == ["unshare", "--mount", "--net", "--ipc", "--"], command
     assert "--no-new-privs" in command and "--reuid=1234" in command and command[-3:] == ["python", "-m", "k"]
-    assert f"--as={4 << 30}" in command and "--nproc=256" in command and "--cpu=600" in command
+    assert f"--as={4 << 30}" in command and "--nproc=256" in command and "--cpu=600:605" in command
     script = command[7]
     assert f"mount -t tmpfs -o mode=755,size=1m tmpfs {root / 'course'}" in script, script
     assert "ip link set lo up" in script and "mount -t tmpfs -o mode=1777,size=2g tmpfs /dev/shm" in script

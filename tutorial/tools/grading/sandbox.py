@@ -38,6 +38,7 @@ import os
 import secrets
 import shlex
 import shutil
+import signal
 import sys
 import threading
 from pathlib import Path
@@ -171,7 +172,7 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[P
         "prlimit",
         f"--as={job.memory_bytes}",
         f"--nproc={job.processes}",
-        f"--cpu={job.cpu_seconds}",
+        f"--cpu={job.cpu_seconds}:{job.cpu_seconds + 5}",  # SIGXCPU, then SIGKILL 5 s later (said apart)
         "--core=0",
         "--",
         *kernel,
@@ -271,6 +272,7 @@ class SandboxedKernelManager(AsyncKernelManager):
 
 
 KERNEL_DIED = "the kernel died while this cell ran"
+CPU_TIME_RAN_OUT = "its CPU time ran out"  # RLIMIT_CPU's SIGXCPU
 NOT_RUN = "not run: the kernel died in an earlier cell"
 
 
@@ -278,7 +280,8 @@ class SandboxedExecute(Execute):
     """nbgrader's Execute, with each kernel in the sandbox (:class:`SandboxedKernelManager`).
 
     A kernel that dies (an answer that kills it, a crash in a library) ends the run, not the grading of the
-    submission: the cell that was running gets an error (``DeadKernelError``, :data:`KERNEL_DIED`), every
+    submission: the cell that was running gets an error (``DeadKernelError``, :data:`KERNEL_DIED`, and
+    :data:`CPU_TIME_RAN_OUT` where the CPU time limit stopped it), every
     code cell after it one that says it did not run (:data:`NOT_RUN`, so nbgrader gives its check no
     points: an empty check cell would pass), and the exercises before it keep what they earned.  nbgrader's
     event loop's thread.
@@ -304,5 +307,8 @@ class SandboxedExecute(Execute):
             return super().preprocess_cell(cell, resources, index)
         except DeadKernelError:
             self._died = True
-            cell.outputs.append(error(KERNEL_DIED))
+            process = getattr(getattr(self.km, "provisioner", None), "process", None)  # the kernel's own: prlimit,
+            ended = process.poll() if process is not None else None  # setpriv and unshare exec it, none forks
+            over = f" ({CPU_TIME_RAN_OUT})" if ended == -signal.SIGXCPU else ""
+            cell.outputs.append(error(KERNEL_DIED + over))
             return cell, resources
