@@ -424,6 +424,21 @@ def test_6_the_rig_finds_the_image_publisher_among_others_and_names_what_was_mad
     )
 
 
+def test_6_a_hidden_cameras_world_is_the_room_and_one_tank_of_its_name_with_that_camera():
+    """camera_rig.world of a camera not the Kinect: the tank renamed, its camera renamed, sized and of its field
+    of view; the room as it is; no second tank."""
+    from tutorial.exercises.camera_rig import STEP, Camera, world
+
+    model, cam = world(Camera(body="Eye", name="Cam", width=64, height=48, fovy=45.0))
+    bodies = [model.body(i).name for i in range(model.nbody)]
+    geoms = [model.geom(i).name for i in range(model.ngeom)]
+    assert model.camera(cam).name == "Eye/Cam" and model.ncam == 1
+    assert tuple(model.cam_resolution[cam]) == (64, 48) and model.cam_fovy[cam] == 45.0
+    assert "Eye/CHASSIS" in bodies and not any(b.startswith("Tank/") for b in bodies), bodies
+    assert any(g.startswith("Room/") for g in geoms), geoms
+    assert model.opt.timestep == STEP
+
+
 def test_6_1_hidden_poses_are_three_with_the_yaw_anywhere_and_the_pitch_within_the_turrets_range():
     from tutorial.exercises import step6_camera as step6
 

@@ -1073,8 +1073,20 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
         ),
         ("8.2", "return 15.0, 70", "return 10.0, 70"),  # the slowest watchable rate, 10 pictures/s, is watchable
         ("8.2", "return 15.0, 70", "return 15.0, 30"),  # the lowest recognisable quality, 30, is recognisable
+        (  # another default rate: the check drives every camera at its own rate
+            "6.1",
+            '    """RttCameraImagePublisher publishing gray (mono8) pictures."""\n',
+            '    """RttCameraImagePublisher publishing gray (mono8) pictures."""\n\n'
+            '    PARAMETERS = {**RttCameraImagePublisher.PARAMETERS, "rate": (float, 3.0, "pictures/s")}\n',
+        ),
     ],
-    ids=["2.2-another-publisher", "2.1-another-publisher", "8.2-the-slowest-rate", "8.2-the-lowest-quality"],
+    ids=[
+        "2.2-another-publisher",
+        "2.1-another-publisher",
+        "8.2-the-slowest-rate",
+        "8.2-the-lowest-quality",
+        "6.1-another-default-rate",
+    ],
 )
 def test_a_right_answer_written_otherwise_passes(ros, number, right, other):
     """What a statement leaves free is left free by its check (found by make mutate: a mutant failed it)."""
@@ -1237,6 +1249,35 @@ def test_6_1_a_picture_never_published_a_failing_render_thread_and_a_control_tha
         "Forgetful.control() returned None at t = 0.000 s: no error was set. "
         "Hint: return what super().control() returns: True while all is well."
     ) in said["Forgetful"], said
+
+
+def test_6_1_a_configure_that_gives_back_nothing_or_raises_is_told_and_leaves_no_render_thread(ros, monkeypatch):
+    """configure() without its answer given back is told what it gave; one that raises after super() is told
+    so; either way the rig ends the render thread super().configure() started."""
+    from tutorial.app.reference.camera_image_publisher import RttCameraImagePublisher
+    from tutorial.exercises import step6_camera as step6
+
+    monkeypatch.setattr(step6, "hidden_random", lambda exercise: None)
+    made = []
+
+    class NoAnswer(RttCameraImagePublisher):
+        def configure(self, config):
+            made.append(self)
+            super().configure(config)  # its True not given back
+
+    class Raising(RttCameraImagePublisher):
+        def configure(self, config):
+            made.append(self)
+            super().configure(config)
+            raise ValueError("no camera today")
+
+    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (NoAnswer, Raising)}
+    assert (
+        "NoAnswer.configure returned None. "
+        "Hint: return what RttCameraImagePublisher.configure returned, and True after your own setup."
+    ) in said["NoAnswer"], said
+    assert "ValueError: no camera today" in said["Raising"], said
+    assert [c.thread.is_alive() for c in made] == [False, False]  # both render threads ended
 
 
 def test_every_exercise_has_six_wrong_answers():

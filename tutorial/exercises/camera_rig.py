@@ -92,14 +92,16 @@ class Rig:
         parameters["rate"] = RATE
         main_body = Body(self.model, mujoco.MjData(self.model), camera.body)
         config = ControllerConfig(name=self.name, body=main_body, node=self.node, parameters=parameters)
+        answer = None
         try:
-            self.configured = bool(self.controller.configure(config))
+            answer = self.controller.configure(config)
+            self.configured = bool(answer)
         finally:
-            if not self.configured:
+            if not self.configured:  # refused or raised: its render thread ended, the node removed
                 self.close()
         if not self.configured:
             raise CaseFailed(
-                f"{self.name}.configure returned False.",
+                f"{self.name}.configure returned {answer!r}.",
                 "return what RttCameraImagePublisher.configure returned, and True after your own setup.",
             )
         self.data = mujoco.MjData(self.model)  # the simulation's
