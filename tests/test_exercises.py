@@ -1251,9 +1251,11 @@ def test_6_1_a_picture_never_published_a_failing_render_thread_and_a_control_tha
     ) in said["Forgetful"], said
 
 
-def test_6_1_a_configure_that_gives_back_nothing_or_raises_is_told_and_leaves_no_render_thread(ros, monkeypatch):
-    """configure() without its answer given back is told what it gave; one that raises after super() is told
-    so; either way the rig ends the render thread super().configure() started."""
+def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_leaves_no_render_thread(
+    ros, monkeypatch
+):
+    """configure() or start() without its answer given back is told what it gave; a configure() that raises
+    after super() is told so; each time the rig ends the render thread super().configure() started."""
     from tutorial.app.reference.camera_image_publisher import RttCameraImagePublisher
     from tutorial.exercises import step6_camera as step6
 
@@ -1271,13 +1273,21 @@ def test_6_1_a_configure_that_gives_back_nothing_or_raises_is_told_and_leaves_no
             super().configure(config)
             raise ValueError("no camera today")
 
-    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (NoAnswer, Raising)}
+    class NotStarted(RttCameraImagePublisher):
+        def start(self):
+            made.append(self)
+            super().start()  # its True not given back
+
+    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (NoAnswer, Raising, NotStarted)}
     assert (
         "NoAnswer.configure returned None. "
         "Hint: return what RttCameraImagePublisher.configure returned, and True after your own setup."
     ) in said["NoAnswer"], said
     assert "ValueError: no camera today" in said["Raising"], said
-    assert [c.thread.is_alive() for c in made] == [False, False]  # both render threads ended
+    assert (
+        "NotStarted.start returned None. Hint: return what super().start() returns: True when all is well."
+    ) in said["NotStarted"], said
+    assert [c.thread.is_alive() for c in made] == [False, False, False]  # every render thread ended
 
 
 def test_every_exercise_has_six_wrong_answers():

@@ -107,9 +107,14 @@ class Rig:
         self.data = mujoco.MjData(self.model)  # the simulation's
         self.data.time = camera.start
         io = ControllerIO(body=Body(self.model, self.data, camera.body), time_step=STEP, node=self.node, data=self.data)
-        if not self.controller.initialize(io) or not self.controller.start():
-            self.close()
-            raise CaseFailed(f"{self.name}.initialize or start returned False.")
+        for step, call in (("initialize", lambda: self.controller.initialize(io)), ("start", self.controller.start)):
+            answer = call()
+            if not answer:
+                self.close()
+                raise CaseFailed(
+                    f"{self.name}.{step} returned {answer!r}.",
+                    f"return what super().{step}() returns: True when all is well.",
+                )
         self.turret = [self.model.joint(f"{camera.body}/{j}").qposadr[0] for j in ("TURRET_Y", "TURRET_P")]
         self.steps = 0
         self.poses: list[tuple[float, np.ndarray]] = []  # (time, qpos) of each picture due
