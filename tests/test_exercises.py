@@ -1255,7 +1255,8 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
     ros, monkeypatch
 ):
     """configure() or start() without its answer given back is told what it gave; a configure() that raises
-    after super() is told so; each time the rig ends the render thread super().configure() started."""
+    after super() is told so; each time, and after an unconfigure() that leaves super()'s out, the rig ends the
+    render thread super().configure() started."""
     from tutorial.app.reference.camera_image_publisher import RttCameraImagePublisher
     from tutorial.exercises import step6_camera as step6
 
@@ -1278,7 +1279,11 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
             made.append(self)
             super().start()  # its True not given back
 
-    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (NoAnswer, Raising, NotStarted)}
+    class KeptRunning(RttCameraImagePublisher):
+        def unconfigure(self):
+            made.append(self)  # super().unconfigure() left out: the render thread is never told to end
+
+    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (NoAnswer, Raising, NotStarted, KeptRunning)}
     assert (
         "NoAnswer.configure returned None. "
         "Hint: return what RttCameraImagePublisher.configure returned, and True after your own setup."
@@ -1287,7 +1292,7 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
     assert (
         "NotStarted.start returned None. Hint: return what super().start() returns: True when all is well."
     ) in said["NotStarted"], said
-    assert [c.thread.is_alive() for c in made] == [False, False, False]  # every render thread ended
+    assert [c.thread.is_alive() for c in made] == [False, False, False, False]  # every render thread ended
 
 
 def test_every_exercise_has_six_wrong_answers():
