@@ -21,6 +21,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import textwrap
 from pathlib import Path
 
 import mutation_report  # this folder's: how make mutate's report names a mutant's module
@@ -62,6 +63,15 @@ def recheck(mutmut_dir: Path, name: str, pytest_args: list[str], work: Path) -> 
         os.symlink(ROOT / folder, work / folder)
     path = work / module_path(name)
     source = path.read_text(encoding="utf-8")
+    # mutmut shows a method dedented: as in its class, one level in
+    before, after = next(
+        (
+            (textwrap.indent(before, i), textwrap.indent(after, i))
+            for i in ("", "    ")
+            if textwrap.indent(before, i) in source
+        ),
+        (before, after),
+    )
     if source.count(before) != 1:
         return "cannot apply (the function has changed here since the run)"
     path.write_text(source.replace(before, after), encoding="utf-8")

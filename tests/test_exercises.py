@@ -1279,16 +1279,22 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
             made.append(self)
             super().start()  # its True not given back
 
+    class RaisingFirst(RttCameraImagePublisher):
+        def configure(self, config):
+            raise KeyError("gray")  # before super().configure(): no render thread was made
+
     class KeptRunning(RttCameraImagePublisher):
         def unconfigure(self):
             made.append(self)  # super().unconfigure() left out: the render thread is never told to end
 
-    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in (NoAnswer, Raising, NotStarted, KeptRunning)}
+    answers = (NoAnswer, Raising, RaisingFirst, NotStarted, KeptRunning)
+    said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in answers}
     assert (
         "NoAnswer.configure returned None. "
         "Hint: return what RttCameraImagePublisher.configure returned, and True after your own setup."
     ) in said["NoAnswer"], said
     assert "ValueError: no camera today" in said["Raising"], said
+    assert "KeyError: 'gray'" in said["RaisingFirst"], said  # its own error, not the rig's
     assert (
         "NotStarted.start returned None. Hint: return what super().start() returns: True when all is well."
     ) in said["NotStarted"], said
