@@ -292,6 +292,10 @@ class SandboxedExecute(Execute):
         super().__init__(*args, **kwargs)
         self._died = False
 
+    def preprocess(self, nb, resources=None, km=None):
+        self._died = False  # each notebook with a kernel of its own (one instance may run several)
+        return super().preprocess(nb, resources, km)
+
     def preprocess_cell(self, cell, resources, index):
         from nbclient.exceptions import DeadKernelError
         from nbformat.notebooknode import NotebookNode
