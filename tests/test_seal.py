@@ -457,6 +457,7 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
     # the rest read-only, but the job's folder (bound onto itself first) and the private folders
     bound = script.index("mount --bind /var/lib/rtt-grading/x/u /var/lib/rtt-grading/x/u")
     assert bound < script.index("remount,bind,ro")
+    assert "mount -t mqueue mqueue /dev/mqueue" in script  # the new IPC namespace's queues, not the host's
     assert 'mount -o remount,bind,ro "$mp"' in script and "|/var/lib/rtt-grading/x/u|/tmp|/var/tmp|/dev/shm)" in script
 
 

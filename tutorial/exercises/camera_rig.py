@@ -108,7 +108,11 @@ class Rig:
         self.data.time = camera.start
         io = ControllerIO(body=Body(self.model, self.data, camera.body), time_step=STEP, node=self.node, data=self.data)
         for step, call in (("initialize", lambda: self.controller.initialize(io)), ("start", self.controller.start)):
-            answer = call()
+            try:
+                answer = call()
+            except BaseException:
+                self.close()  # its render thread ended, the node removed, the error the learner's to see
+                raise
             if not answer:
                 self.close()
                 raise CaseFailed(

@@ -134,17 +134,22 @@ def sandbox_command(job: Job, kernel: list[str], keep: list[str], groups: list[P
         script.append(f"if [ -d {q(path)} ]; then mount -t tmpfs -o mode=755,size=1m tmpfs {q(path)}; fi")
     for path in PRIVATE:
         script.append(f"mount -t tmpfs -o mode=1777,size=2g tmpfs {path}")
+    # POSIX message queues: the new IPC namespace's own (the host's mount, 1777, would outlast the kernel)
+    script.append("if [ -d /dev/mqueue ]; then mount -t mqueue mqueue /dev/mqueue; fi")
     for k, path in enumerate(keep):  # a clone under /tmp keeps its library and environment
         script += [f"mkdir -p {q(path)}", f"mount --move {q(f'{held}/{k}')} {q(path)}"]
     # Last, every other mount read-only, world-writable folders such as /run/lock included (a note left there
     # would reach the next submission): the job's folder (its kernels' working folders, the user's alone) and
     # the private folders stay writable; /proc, /sys and /dev are the kernel's own or root's.  A mount that
     # cannot be made read-only stops the kernel (fail closed).
-    script.append(f"mount --bind {q(job.folder)} {q(job.folder)}")
-    skipped = "|".join(q(p) for p in (job.folder, *PRIVATE))
+    folder = os.path.realpath(job.folder)  # as mountinfo names it
+    script.append(f"mount --bind {q(folder)} {q(folder)}")
+    skipped = "|".join(q(p) for p in (folder, *PRIVATE))
     script += [
+        "set -f",  # the mount points below are words, never patterns
         "for mp in $(cut -d' ' -f5 /proc/self/mountinfo); do",
-        "  mp=$(printf '%b' \"$mp\")",  # mountinfo writes a space as \040
+        # mountinfo writes a space as \040: %b reads an octal escape as \0NNN
+        "  mp=$(printf '%b' \"$(printf '%s' \"$mp\" | sed 's/\\\\\\([0-7][0-7][0-7]\\)/\\\\0\\1/g')\")",
         f'  case "$mp" in /proc|/proc/*|/sys|/sys/*|/dev|/dev/*|{skipped}) continue;; esac',
         '  mountpoint -q "$mp" || continue',  # a mount hidden under another (a hidden folder under /tmp)
         '  mount -o remount,bind,ro "$mp"',
