@@ -92,36 +92,41 @@ class Rig:
         parameters["rate"] = RATE
         main_body = Body(self.model, mujoco.MjData(self.model), camera.body)
         config = ControllerConfig(name=self.name, body=main_body, node=self.node, parameters=parameters)
-        answer = None
-        try:
-            answer = self.controller.configure(config)
-            self.configured = bool(answer)
-        finally:
-            if not self.configured:  # refused or raised: its render thread ended, the node removed
-                self.close()
-        if not self.configured:
-            raise CaseFailed(
-                f"{self.name}.configure returned {answer!r}.",
-                "return what RttCameraImagePublisher.configure returned, and True after your own setup.",
-            )
+        self._step(
+            "configure",
+            lambda: self.controller.configure(config),
+            "return what RttCameraImagePublisher.configure returned, and True after your own setup.",
+        )
+        self.configured = True
         self.data = mujoco.MjData(self.model)  # the simulation's
         self.data.time = camera.start
         io = ControllerIO(body=Body(self.model, self.data, camera.body), time_step=STEP, node=self.node, data=self.data)
-        for step, call in (("initialize", lambda: self.controller.initialize(io)), ("start", self.controller.start)):
-            try:
-                answer = call()
-            except BaseException:
-                self.close()  # its render thread ended, the node removed, the error the learner's to see
-                raise
-            if not answer:
-                self.close()
-                raise CaseFailed(
-                    f"{self.name}.{step} returned {answer!r}.",
-                    f"return what super().{step}() returns: True when all is well.",
-                )
+        self._step("initialize", lambda: self.controller.initialize(io))
+        self._step("start", self.controller.start)
         self.turret = [self.model.joint(f"{camera.body}/{j}").qposadr[0] for j in ("TURRET_Y", "TURRET_P")]
         self.steps = 0
         self.poses: list[tuple[float, np.ndarray]] = []  # (time, qpos) of each picture due
+
+    def _step(self, step: str, call, hint: str = "") -> None:
+        """One step of the controller's lifecycle, ``call()``; on a refusal or an error the rig is closed (its
+        render thread ended, the node removed), so nothing the learner's class started is left running.
+
+        Raises:
+            CaseFailed: ``call()`` gave back something false (named, with ``hint``, by default to return
+                what ``super()``'s step returns).
+            BaseException: what ``call()`` raised, as it was.
+        """
+        answer = None
+        try:
+            answer = call()
+        finally:
+            if not answer:
+                self.close()
+        if not answer:
+            raise CaseFailed(
+                f"{self.name}.{step} returned {answer!r}.",
+                hint or f"return what super().{step}() returns: True when all is well.",
+            )
 
     def images(self):
         """The capturing publisher of the camera's Image topic (the first one made)."""
