@@ -14,7 +14,8 @@ Its flags say why not, or what else was seen:
   passing verdict (a check or the grader replaced, a verdict not the check's,
   a refused operation);
 - ``timeout``: a cell of the exercise ran past the cell timeout;
-- ``crash``: the kernel died in or before the exercise (or nbgrader failed);
+- ``crash``: the kernel died while a cell of the exercise ran (or nbgrader failed);
+- ``not run``: the kernel had died in an earlier cell, so no cell of the exercise ran;
 - ``over a limit``: memory, processes or CPU time ran out (``MemoryError``, ...);
 - ``network``, ``processes``, ``outside its folder``: what the seal noted the answer doing;
 - ``grader-aware``: the answer looks for nbgrader (``NBGRADER_...``).
@@ -41,14 +42,12 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tutorial.tools.grading.sandbox import Job
+from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
 
 ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")
 TEACHERS_ONLY = ("notebooks", "course", "book", ".git")  # the repository's folders with worked solutions
-LIMIT_ERRORS = re.compile(
-    r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory|its CPU time ran out"
-)
+LIMIT_ERRORS = re.compile(r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory")
 CPU_SECONDS = "RTT_GRADING_CPU_SECONDS"  # a kernel's CPU time, s (RLIMIT_CPU; default 600)
 
 
@@ -255,10 +254,15 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
         mine = flags.setdefault(ex, [])
         if "CellTimeoutError" in text or "KeyboardInterrupt" in text:
             mine.append("timeout")
-        if LIMIT_ERRORS.search(text):
+        # what became of the kernel, from the cells' metadata, which only the sandbox's executor writes (an
+        # answer can raise an error of any name and text)
+        kernel = {c["metadata"].get(KERNEL_MARK) for c in found["cells"]}
+        if LIMIT_ERRORS.search(text) or OUT_OF_CPU_TIME in kernel:
             mine.append("over a limit")
-        if died or "DeadKernelError" in text:  # nbgrader failed, or the kernel died in or before this exercise
+        if died or DIED in kernel:  # nbgrader failed, or the kernel died while a cell of this exercise ran
             mine.append("crash")
+        elif kernel == {NOT_RUN_MARK}:  # it had died before
+            mine.append("not run")
         if "showtraceback was disabled" in json.dumps(found["cells"]):  # nbgrader's words for a hidden error
             mine.append("tampering")
         if "NBGRADER" in found["source"]:

@@ -478,6 +478,92 @@ def test_a_notebook_without_points_for_an_exercise_is_refused():
         assignments.POINTS.update(saved)
 
 
+def test_a_dead_kernel_is_flagged_where_it_died_and_an_answer_cannot_say_so_itself(tmp_path, monkeypatch):
+    """What the sandbox's executor marks in a cell's metadata, and what judge reads from it: a crash on the exercise
+    whose cell was running, `not run` on the ones after it, `over a limit` (and no crash) for the CPU time; an
+    answer's own error named DeadKernelError, or a mark the submission brought, flags nothing."""
+    import sandboxing
+    from nbclient.exceptions import DeadKernelError
+    from nbformat.v4 import new_code_cell, new_notebook, new_output
+    from nbgrader.preprocessors import Execute
+
+    from tutorial.tools.grading import sandbox
+
+    def cells(number, marks, check_error=None):  # an exercise's answer and check cells, each with its mark
+        out = []
+        for kind, mark in zip(("exercise", "check"), marks):
+            cell = new_code_cell("", metadata={"nbgrader": {"grade_id": f"{kind}_{number}", "grade": kind == "check"}})
+            if mark:  # as the executor leaves it
+                cell.metadata[sandbox.KERNEL_MARK] = mark
+                cell.outputs = [new_output("error", ename="DeadKernelError", evalue=mark, traceback=[])]
+            out.append(cell)
+        if check_error:
+            out[1].outputs = [new_output("error", ename=check_error[0], evalue=check_error[1], traceback=[])]
+        return out
+
+    nb = new_notebook(
+        cells=[
+            *cells("1_1", (None, None), ("DeadKernelError", "the kernel died while this cell ran")),  # the answer's
+            *cells("1_2", (None, None), ("SystemExit", "its CPU time ran out")),  # the answer's words, no limit
+            *cells("1_3", (None, sandbox.DIED)),
+            *cells("1_4", (sandbox.NOT_RUN_MARK, sandbox.NOT_RUN_MARK)),
+        ]
+    )
+    path = tmp_path / "graded.ipynb"
+    path.write_text(json.dumps(nb))
+    judged = sandboxing.judge(path, tmp_path / "no-verdicts", "")
+    assert {ex: flags for ex, (_, flags) in judged.items()} == {
+        "1.1": [],
+        "1.2": [],
+        "1.3": ["crash"],
+        "1.4": ["not run"],
+    }
+    nb.cells[4].metadata[sandbox.KERNEL_MARK] = nb.cells[5].metadata[sandbox.KERNEL_MARK] = sandbox.OUT_OF_CPU_TIME
+    path.write_text(json.dumps(nb))
+    assert sandboxing.judge(path, tmp_path / "no-verdicts", "")["1.3"] == (False, ["over a limit"])
+
+    # the executor: a submission's own marks taken off before the run, its marks written as the kernel fares
+    ran = []
+    monkeypatch.setattr(Execute, "preprocess", lambda self, nb, resources=None, km=None: (nb, resources))
+
+    def run(self, cell, resources, index):
+        ran.append(index)
+        if index == 1:
+            raise DeadKernelError("died")
+        return cell, resources
+
+    monkeypatch.setattr(Execute, "preprocess_cell", run)
+    executor = sandbox.SandboxedExecute()
+    executor.preprocess(nb, {})
+    assert not any(sandbox.KERNEL_MARK in c.metadata for c in nb.cells)
+    for index, cell in enumerate(nb.cells):
+        executor.preprocess_cell(cell, {}, index)
+    assert ran == [0, 1]  # none after the kernel died
+    marks = [c.metadata.get(sandbox.KERNEL_MARK) for c in nb.cells]
+    assert marks == [None, sandbox.DIED] + [sandbox.NOT_RUN_MARK] * 6
+    assert nb.cells[1].outputs[-1]["evalue"] == sandbox.KERNEL_DIED
+    not_run = dict(output_type="error", ename="DeadKernelError", evalue=sandbox.NOT_RUN, traceback=[sandbox.NOT_RUN])
+    assert all(c.outputs == [not_run] for c in nb.cells[2:])
+    executor.preprocess(nb, {})  # the next notebook: a kernel of its own
+    assert not executor._died and not any(sandbox.KERNEL_MARK in c.metadata for c in nb.cells)
+
+
+def test_the_seals_lines_are_all_read_before_nbgrader_goes_on_after_a_kernel_died():
+    """nbclient only cleans up after a dead kernel (it shuts down a live one): that, too, waits for the verdict
+    reader, which ends when the pipe's last writer is gone."""
+    import asyncio
+    import threading
+
+    from tutorial.tools.grading import sandbox
+
+    manager = sandbox.SandboxedKernelManager()
+    drained = threading.Event()
+    manager._reader = threading.Thread(target=lambda: drained.wait(0.5) or drained.set(), daemon=True)
+    manager._reader.start()
+    asyncio.run(manager.cleanup_resources())  # what nbclient's _async_cleanup_kernel calls for a dead kernel
+    assert drained.is_set() and not manager._reader.is_alive()
+
+
 def test_grading_notebook_01s_assignment(tmp_path, monkeypatch):
     """Graded sandboxed (as root), with one cheat among the submissions: 0 for its target, flagged."""
     monkeypatch.setenv("RTT_GRADING_CELL_TIMEOUT", str(CELL_TIMEOUT_S))  # read by the course's nbgrader_config.py
@@ -601,6 +687,8 @@ CHEATS_SAY = {
     "grader-aware": "graded, says the environment: False",
     "memory-from-a-child": "the kernel memory refused to a child: True",
 }
+# A flag a cheat must not get: a kernel killed is not one over a limit, and one stopped at its limit did not crash.
+CHEATS_NOT = {"crash": "over a limit", "cpu-time": "crash"}
 IN_MAKE_TEST_CHEATS = ["rebind-check"]  # graded among make test's submissions of notebook 01
 # where the cheats that read, write or connect point: none of it may be reached
 CHEAT_FILL = {"root": ROOT, "course": "/nonexistent-course", "home": "/nonexistent-home", "port": 9}
@@ -661,6 +749,8 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
         flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
         if flag not in flags.get(target, "") or (not flag and flags.get(target)):
             wrong.append(f"{cheat}: flags {row['flags']!r}, expected {flag!r} on {target}")
+        if cheat in CHEATS_NOT and CHEATS_NOT[cheat] in flags.get(target, ""):
+            wrong.append(f"{cheat}: flags {row['flags']!r}, never {CHEATS_NOT[cheat]!r}")
         if flags.get(other):
             wrong.append(f"{cheat}: the honest exercise {other} was flagged {flags[other]!r}")
     summary = said.getvalue()

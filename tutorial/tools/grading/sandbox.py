@@ -251,13 +251,16 @@ class SandboxedKernelManager(AsyncKernelManager):
         self._reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
         self._reader.start()
 
-    async def _async_shutdown_kernel(self, now: bool = False, restart: bool = False):
-        await super()._async_shutdown_kernel(now=now, restart=restart)
+    async def _async_cleanup_resources(self, restart: bool = False):
+        """After the kernel ended, shut down or dead (nbclient then only cleans up): every line it wrote is in
+        the verdict file before nbgrader goes on."""
+        await super()._async_cleanup_resources(restart=restart)
         reader = getattr(self, "_reader", None)
-        if reader is not None:  # every line the kernel wrote is in the verdict file before nbgrader goes on
+        if reader is not None:
             await asyncio.get_running_loop().run_in_executor(None, reader.join, 10.0)
 
-    shutdown_kernel = _async_shutdown_kernel  # what nbclient calls (the base class binds its own function)
+    # what nbclient calls (the base class binds its own function); shutdown_kernel calls the method above itself
+    cleanup_resources = _async_cleanup_resources
 
     def _read_verdicts(self) -> None:
         """The seal's pipe, line by line, to the job's verdict file (its reader thread, until the pipe closes).
@@ -279,6 +282,10 @@ class SandboxedKernelManager(AsyncKernelManager):
 KERNEL_DIED = "the kernel died while this cell ran"
 CPU_TIME_RAN_OUT = "its CPU time ran out"  # RLIMIT_CPU's SIGXCPU
 NOT_RUN = "not run: the kernel died in an earlier cell"
+# What became of the kernel in a cell, in the cell's metadata: written by SandboxedExecute alone (a kernel writes
+# outputs, never a cell's metadata; a submission's own is taken off first), read by course/sandboxing.py's judge.
+KERNEL_MARK = "rtt_grading_kernel"
+DIED, OUT_OF_CPU_TIME, NOT_RUN_MARK = "died", "out of CPU time", "not run"
 
 
 class SandboxedExecute(Execute):
@@ -288,8 +295,10 @@ class SandboxedExecute(Execute):
     submission: the cell that was running gets an error (``DeadKernelError``, :data:`KERNEL_DIED`, and
     :data:`CPU_TIME_RAN_OUT` where the CPU time limit stopped it), every
     code cell after it one that says it did not run (:data:`NOT_RUN`, so nbgrader gives its check no
-    points: an empty check cell would pass), and the exercises before it keep what they earned.  nbgrader's
-    event loop's thread.
+    points: an empty check cell would pass), and the exercises before it keep what they earned.  Each of
+    those cells also gets :data:`KERNEL_MARK` in its metadata (:data:`DIED`, :data:`OUT_OF_CPU_TIME` or
+    :data:`NOT_RUN_MARK`), which the flags are read from: an answer can raise an error of any name and
+    text, but it cannot write a cell's metadata.  nbgrader's event loop's thread.
     """
 
     def __init__(self, *args, **kwargs):
@@ -299,6 +308,8 @@ class SandboxedExecute(Execute):
 
     def preprocess(self, nb, resources=None, km=None):
         self._died = False  # each notebook with a kernel of its own (one instance may run several)
+        for cell in nb.cells:  # a mark the submission brought with it says nothing of this run
+            cell.metadata.pop(KERNEL_MARK, None)
         return super().preprocess(nb, resources, km)
 
     def preprocess_cell(self, cell, resources, index):
@@ -311,6 +322,7 @@ class SandboxedExecute(Execute):
         if self._died:
             if cell.cell_type == "code":
                 cell.outputs = [error(NOT_RUN)]
+                cell.metadata[KERNEL_MARK] = NOT_RUN_MARK
             return cell, resources
         try:
             return super().preprocess_cell(cell, resources, index)
@@ -318,6 +330,7 @@ class SandboxedExecute(Execute):
             self._died = True
             process = getattr(getattr(self.km, "provisioner", None), "process", None)  # the kernel's own: prlimit,
             ended = process.poll() if process is not None else None  # setpriv and unshare exec it, none forks
-            over = f" ({CPU_TIME_RAN_OUT})" if ended == -signal.SIGXCPU else ""
-            cell.outputs.append(error(KERNEL_DIED + over))
+            out_of_time = ended == -signal.SIGXCPU
+            cell.outputs.append(error(KERNEL_DIED + (f" ({CPU_TIME_RAN_OUT})" if out_of_time else "")))
+            cell.metadata[KERNEL_MARK] = OUT_OF_CPU_TIME if out_of_time else DIED
             return cell, resources
