@@ -38,11 +38,20 @@ import re
 import secrets
 import shutil
 import subprocess
+import sys
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
+from tutorial.tools.grading.sandbox import (
+    DIED,
+    KERNEL_MARK,
+    NOT_RUN_MARK,
+    OUT_OF_CPU_TIME,
+    Job,
+    kept_paths,
+    sandbox_command,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")
@@ -117,6 +126,7 @@ class Sandboxes:
     def close(self) -> None:
         for job in self.users:
             clear(job)
+            empty_keyrings(job)
             subprocess.run(["userdel", job.user], capture_output=True, timeout=30, check=False)
             for controller in ("memory", "pids"):
                 with contextlib.suppress(OSError):
@@ -149,6 +159,24 @@ def clear(job: Job) -> None:
     for kernel in Path(job.folder).iterdir():
         if kernel.is_dir():
             shutil.rmtree(kernel, ignore_errors=True)
+
+
+def empty_keyrings(job: Job) -> None:
+    """The job's user's kernel keyrings emptied, as that user, in the sandbox (where its Python can run): a later
+    user given the same ID finds no key a submission left (:mod:`tutorial.tools.grading.keyrings`).  Each
+    grading kernel empties them at its start, too.  A failure is printed, not raised: it comes while the job is
+    removed, after the grades."""
+    command = [sys.executable, "-I", "-m", "tutorial.tools.grading.keyrings"]
+    done = subprocess.run(
+        sandbox_command(job, command, kept_paths(job.hide)),
+        env={"PATH": os.environ.get("PATH", "/usr/bin:/bin")},
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    if done.returncode != 0:
+        print(f"grading: the keyrings of {job.user} were not emptied: {done.stderr.strip()[-500:]}", file=sys.stderr)
 
 
 def test_calls(course: Path, assignment: str) -> tuple[list[str], list[str]]:

@@ -48,6 +48,7 @@ sys.path.insert(0, str(ROOT / "course"))
 
 import assignments  # noqa: E402 - course/ is not a package
 import grade  # noqa: E402
+import sandboxing  # noqa: E402
 
 pytestmark = pytest.mark.cross_process
 
@@ -276,8 +277,6 @@ def test_the_hidden_cases_seed_is_the_teachers_alone_and_the_same_on_a_regrade(t
     asked, another for another learner, another assignment or another course."""
     import stat
 
-    import sandboxing
-
     (tmp_path / "a").mkdir()
     first = sandboxing.learner_seed(tmp_path / "a", "01", "ada")
     assert stat.S_IMODE((tmp_path / "a" / ".grading_seed").stat().st_mode) == 0o600
@@ -482,7 +481,6 @@ def test_a_dead_kernel_is_flagged_where_it_died_and_an_answer_cannot_say_so_itse
     """What the sandbox's executor marks in a cell's metadata, and what judge reads from it: a crash on the exercise
     whose cell was running, `not run` on the ones after it, `over a limit` (and no crash) for the CPU time; an
     answer's own error named DeadKernelError, or a mark the submission brought, flags nothing."""
-    import sandboxing
     from nbclient.exceptions import DeadKernelError
     from nbformat.v4 import new_code_cell, new_notebook, new_output
     from nbgrader.preprocessors import Execute
@@ -586,6 +584,19 @@ GRADER = "import tutorial.exercises.grader as grader\n"
 # Each cheat: (the exercise it targets, the code put in that exercise's answer cell after its stub, the flag
 # it must get, or "": none).  The other exercise keeps its worked solution and its points.  A cheat on a
 # global (the grader, IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
+# Python that finds a key named rtt-cheat in its user's keyring, user-session keyring or persistent keyring
+# (keyctl(2) through ctypes: the kernel's seal refuses ctypes to an answer, not to a process it starts), and
+# what it puts there: Linux keeps them by user ID, past the processes that wrote them.
+KEYRINGS = (
+    "import ctypes\n"
+    "libc = ctypes.CDLL(None, use_errno=True)\n"
+    "def keyctl(*a):\n"
+    "    return libc.syscall(250, *(ctypes.c_long(x) if isinstance(x, int) else x for x in a))\n"
+    "rings = (-4, -5, keyctl(22, -1, -3))\n"
+    "found = [r for r in rings if keyctl(10, r, b'user', b'rtt-cheat', 0) >= 0]\n"
+)
+LEAVE_A_KEY = "for r in rings:\n    libc.syscall(248, b'user', b'rtt-cheat', b'answers', 7, ctypes.c_long(r))\n"
+SAY_AND_LEAVE = "print('yes' if found else 'no')\n" + LEAVE_A_KEY
 CHEATS = {
     "rebind-check": (
         "1.1",
@@ -659,6 +670,14 @@ CHEATS = {
         "except Exception:\n    pass\n" + STUB_1_1,
         "tampering",
     ),
+    "keyring-note": (  # a key an earlier submission graded as the same user left (grade_cheats leaves one)
+        "1.1",
+        "import subprocess, sys\n"
+        "said = subprocess.run([sys.executable, '-c', " + repr(KEYRINGS + SAY_AND_LEAVE) + "],\n"
+        "                      capture_output=True, text=True)\n"
+        "print('a note in the keyrings:', said.stdout.strip() or said.stderr[-300:])\n" + STUB_1_1,
+        "processes",
+    ),
     "memory-from-a-child": (  # a process the seal does not watch: the kernel is not dumpable
         "1.1",
         "import subprocess, sys\n"
@@ -686,6 +705,7 @@ CHEATS_SAY = {
     "read-another-learner": "read another learner: no",
     "grader-aware": "graded, says the environment: False",
     "memory-from-a-child": "the kernel memory refused to a child: True",
+    "keyring-note": "a note in the keyrings: no",
 }
 # A flag a cheat must not get: a kernel killed is not one over a limit, and one stopped at its limit did not crash.
 CHEATS_NOT = {"crash": "over a limit", "cpu-time": "crash"}
@@ -709,6 +729,20 @@ def cheating_submissions(course: Path, name: str, which: list[str], fill: dict[s
     return out
 
 
+def keys_of(job, code: str) -> str:
+    """How many of KEYRINGS' keyrings hold the key, after ``code`` ran as ``job``'s user (in the sandbox, where
+    this Python can run)."""
+    import subprocess
+
+    from tutorial.tools.grading.sandbox import kept_paths, sandbox_command
+
+    command = [sys.executable, "-I", "-c", code + "print(len(found))\n"]
+    done = subprocess.run(
+        sandbox_command(job, command, kept_paths(job.hide)), capture_output=True, text=True, timeout=60, check=True
+    )
+    return done.stdout.strip()
+
+
 def grade_cheats(tmp_path: Path, which: list[str]) -> None:
     """Grade the cheats of ``which``, sandboxed; each gets 0 and its flag in its target, full points in the other."""
     import socket
@@ -723,6 +757,17 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
     listener.settimeout(0.1)
     home = Path(os.path.expanduser("~"))
     fill = {"root": ROOT, "course": course, "home": home, "port": listener.getsockname()[1]}
+    made, make = [], sandboxing.Sandboxes._make
+
+    def make_and_leave_keys(boxes):  # as an earlier submission graded as each job's user would have
+        make(boxes)
+        made.extend(boxes.users)
+        for job in boxes.users:
+            assert keys_of(job, KEYRINGS + LEAVE_A_KEY + KEYRINGS) == "3"
+        return boxes
+
+    monkeypatch = pytest.MonkeyPatch()
+    monkeypatch.setattr(sandboxing.Sandboxes, "_make", make_and_leave_keys)
     try:
         for learner, nb in cheating_submissions(course, name, which, fill).items():
             folder = course / "submitted" / learner / name
@@ -737,7 +782,9 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
             listener.accept()  # nobody connected
     finally:
         listener.close()
+        monkeypatch.undo()
     assert not (home / "rtt-cheat").exists(), "a cheat wrote into the grader's home"
+    assert made and all(keys_of(job, KEYRINGS) == "0" for job in made), "a job's user ID kept its keys"
     rows = {r["student_id"]: r for r in csv.DictReader(csv_path.open())}
     wrong = []
     for cheat in which:

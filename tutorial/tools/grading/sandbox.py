@@ -11,7 +11,9 @@ kernel:
   folder, the repository's teacher-only folders (``notebooks``, ``course``,
   ``book``, ``.git``), ``/home``, ``/root`` (but the Python installation)
   and ``/srv`` are empty, ``/tmp``, ``/var/tmp`` and ``/dev/shm`` are the
-  kernel's own, and every other mount is read-only (``/run/lock`` too);
+  kernel's own, and every other mount is read-only (``/run/lock`` too); the
+  user's kernel keyrings emptied by the kernel itself before any answer runs
+  (:mod:`tutorial.tools.grading.keyrings`);
 * as the job's user, with no privileges (``setpriv --no-new-privs``), in a
   working folder of its own (a copy of the submission's folder), with a
   scrubbed environment (no ``NBGRADER_EXECUTION``);
