@@ -732,14 +732,22 @@ def cheating_submissions(course: Path, name: str, which: list[str], fill: dict[s
 def keys_of(job, code: str) -> str:
     """How many of KEYRINGS' keyrings hold the key, after ``code`` ran as ``job``'s user (in the sandbox, where
     this Python can run)."""
+    import dataclasses
     import subprocess
+    import tempfile
 
     from tutorial.tools.grading.sandbox import kept_paths, sandbox_command
 
     command = [sys.executable, "-I", "-c", code + "print(len(found))\n"]
-    done = subprocess.run(
-        sandbox_command(job, command, kept_paths(job.hide)), capture_output=True, text=True, timeout=60, check=True
-    )
+    # the job's own folder may be gone, and the sandbox makes its .keep in it (not under /tmp: hidden there)
+    with tempfile.TemporaryDirectory(dir=sandboxing.JOBS) as folder:
+        done = subprocess.run(
+            sandbox_command(dataclasses.replace(job, folder=folder), command, kept_paths(job.hide)),
+            capture_output=True,
+            text=True,
+            timeout=60,
+            check=True,
+        )
     return done.stdout.strip()
 
 

@@ -462,9 +462,11 @@ def test_the_sandbox_keeps_the_library_and_hides_the_teachers_folders():
 
 
 def test_the_sandbox_leaves_nothing_writable_but_its_own_folders():
-    """The sandbox's mounts, run for real (root): a file in /run/lock or the root folder is refused, the job's
-    folder and the private /tmp take one, and nothing written there reaches this machine's own folders."""
+    """The sandbox's mounts, run for real (root): a file in /run/lock, in a folder anyone may write on the root
+    file system, or on a mount of its own whose name has a space (mountinfo writes it \\040) is refused; the
+    job's folder and the private /tmp take one, and nothing written there reaches this machine's own folders."""
     import secrets
+    import shlex
     import shutil
     from pathlib import Path
 
@@ -474,20 +476,57 @@ def test_the_sandbox_leaves_nothing_writable_but_its_own_folders():
         pytest.skip("the sandbox's namespaces need root")
     folder = Path("/var/lib/rtt-grading") / f"probe-{secrets.token_hex(4)}"  # where grading's jobs are (not /tmp)
     (folder / "k").mkdir(parents=True)
+    outside = folder.with_name(folder.name + "-host")  # this machine's, beside the job's folder
+    open_to_all, spaced = outside / "open", outside / "a mount"
+    open_to_all.mkdir(parents=True)
+    spaced.mkdir()
+    mounted = False
     try:
         os.chown(folder / "k", 65534, 65534)
+        os.chmod(open_to_all, 0o1777)  # writable by anyone, on the file system that holds /var/lib
+        subprocess.run(["mount", "-t", "tmpfs", "-o", "mode=1777,size=1m", "tmpfs", str(spaced)], check=True)
+        mounted = True
         job = Job("nobody", 65534, 65534, str(folder), "/v", [], ["c(a).require()"])
-        tries = {"/run/lock": "refused", "/": "refused", str(folder / "k"): "written", "/tmp": "written"}
-        probe = "; ".join(f"(touch {p}/rtt-probe 2>/dev/null && echo {p}=written || echo {p}=refused)" for p in tries)
+        tries = {
+            "/run/lock": "refused",
+            str(open_to_all): "refused",
+            str(spaced): "refused",
+            str(folder / "k"): "written",
+            "/tmp": "written",
+        }
+        probe = "; ".join(
+            f"(touch {shlex.quote(p + '/rtt-probe')} 2>/dev/null && echo {shlex.quote(p)}=written"
+            f" || echo {shlex.quote(p)}=refused)"
+            for p in tries
+        )
+        # without the sandbox, this user writes each of them
+        assert (
+            subprocess.run(
+                [
+                    "setpriv",
+                    "--reuid=65534",
+                    "--regid=65534",
+                    "--clear-groups",
+                    "sh",
+                    "-c",
+                    f"touch {shlex.quote(str(open_to_all))}/w {shlex.quote(str(spaced))}/w",
+                ]
+            ).returncode
+            == 0
+        )
         done = subprocess.run(
             sandbox_command(job, ["sh", "-c", probe], []), capture_output=True, text=True, timeout=60, check=False
         )
         assert done.returncode == 0, done.stderr
-        said = dict(line.split("=") for line in done.stdout.split())
+        said = dict(line.rsplit("=", 1) for line in done.stdout.splitlines())
         assert said == tries, (said, done.stderr)
         assert not Path("/run/lock/rtt-probe").exists() and not Path("/tmp/rtt-probe").exists()
+        assert not (open_to_all / "rtt-probe").exists() and not (spaced / "rtt-probe").exists()
     finally:
+        if mounted:
+            subprocess.run(["umount", str(spaced)], check=False)
         shutil.rmtree(folder, ignore_errors=True)
+        shutil.rmtree(outside, ignore_errors=True)
         Path("/run/lock/rtt-probe").unlink(missing_ok=True)  # a sandbox that let it through
 
 
