@@ -33,11 +33,13 @@ KEY_SPEC_USER_SESSION_KEYRING = -5
 # container's seccomp profile), or no persistent keyrings (EOPNOTSUPP).  Nothing can be left, nothing to empty.
 NOT_HERE = (errno.ENOSYS, errno.EPERM, errno.EOPNOTSUPP)
 
-_libc = ctypes.CDLL(None, use_errno=True)
+_libc = ctypes.CDLL(None, use_errno=True)  # this module's own: its syscall's result type is set below
+_libc.syscall.restype = ctypes.c_long
 
 
 def _keyctl(operation: int, *args) -> int:
-    result = _libc.syscall(SYS_KEYCTL, ctypes.c_int(operation), *(ctypes.c_long(a) for a in args))
+    # syscall(2) reads every argument as a long: each passed as one (an int's upper half would be undefined)
+    result = _libc.syscall(*(ctypes.c_long(a) for a in (SYS_KEYCTL, operation, *args)))
     if result < 0:
         code = ctypes.get_errno()
         raise OSError(code, f"keyctl({operation}): {os.strerror(code)}")
