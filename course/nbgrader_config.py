@@ -67,7 +67,7 @@ if os.environ.get("RTT_SANDBOX"):
         SaveAutoGrades,
     )
 
-    from tutorial.tools.grading.sandbox import SandboxedExecute
+    from tutorial.tools.grading.sandbox import KERNEL_MARK, SandboxedExecute
 
     # nbgrader's own list (nbgrader.converters.autograde), its Execute sandboxed
     c.Autograde.autograde_preprocessors = [
@@ -79,5 +79,8 @@ if os.environ.get("RTT_SANDBOX"):
         AssignLatePenalties,
         CheckCellMetadata,
     ]
+    # Off unless a course turns it on; then it would take off the mark a dead kernel leaves in a cell, which the
+    # crash, not run and CPU-time flags are read from (course/sandboxing.py), and nbgrader's own metadata.
+    c.ClearMetadataPreprocessor.preserve_cell_metadata_mask = {"nbgrader", KERNEL_MARK}
 c.Execute.raise_on_iopub_timeout = False
 c.Execute.iopub_timeout = 30

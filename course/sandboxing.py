@@ -14,7 +14,8 @@ Its flags say why not, or what else was seen:
   passing verdict (a check or the grader replaced, a verdict not the check's,
   a refused operation);
 - ``timeout``: a cell of the exercise ran past the cell timeout;
-- ``crash``: the kernel died while a cell of the exercise ran (or nbgrader failed);
+- ``crash``: the kernel died while a cell of the exercise ran (a cell before the first exercise counts with
+  the first; or nbgrader failed);
 - ``not run``: the kernel had died in an earlier cell, so no cell of the exercise ran;
 - ``over a limit``: memory, processes or CPU time ran out (``MemoryError``, ...);
 - ``network``, ``processes``, ``outside its folder``: what the seal noted the answer doing;
@@ -38,20 +39,11 @@ import re
 import secrets
 import shutil
 import subprocess
-import sys
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tutorial.tools.grading.sandbox import (
-    DIED,
-    KERNEL_MARK,
-    NOT_RUN_MARK,
-    OUT_OF_CPU_TIME,
-    Job,
-    kept_paths,
-    sandbox_command,
-)
+from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
 
 ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")
@@ -126,7 +118,6 @@ class Sandboxes:
     def close(self) -> None:
         for job in self.users:
             clear(job)
-            empty_keyrings(job)
             subprocess.run(["userdel", job.user], capture_output=True, timeout=30, check=False)
             for controller in ("memory", "pids"):
                 with contextlib.suppress(OSError):
@@ -159,24 +150,6 @@ def clear(job: Job) -> None:
     for kernel in Path(job.folder).iterdir():
         if kernel.is_dir():
             shutil.rmtree(kernel, ignore_errors=True)
-
-
-def empty_keyrings(job: Job) -> None:
-    """The job's user's kernel keyrings emptied, as that user, in the sandbox (where its Python can run): a later
-    user given the same ID finds no key a submission left (:mod:`tutorial.tools.grading.keyrings`).  Each
-    grading kernel empties them at its start, too.  A failure is printed, not raised: it comes while the job is
-    removed, after the grades."""
-    command = [sys.executable, "-I", "-m", "tutorial.tools.grading.keyrings"]
-    done = subprocess.run(
-        sandbox_command(job, command, kept_paths(job.hide)),
-        env={"PATH": os.environ.get("PATH", "/usr/bin:/bin")},
-        capture_output=True,
-        text=True,
-        timeout=60,
-        check=False,
-    )
-    if done.returncode != 0:
-        print(f"grading: the keyrings of {job.user} were not emptied: {done.stderr.strip()[-500:]}", file=sys.stderr)
 
 
 def test_calls(course: Path, assignment: str) -> tuple[list[str], list[str]]:
@@ -238,15 +211,16 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
     notebook = json.loads(autograded.read_text()) if autograded.is_file() else {"cells": []}
     exercises: dict[str, dict] = {}
     current = None
+    before: list[dict] = []  # the code cells before the first exercise: a death there counts with the first
     for cell in notebook["cells"]:
         gid = grade_id(cell)
         if gid.startswith(("exercise_", "check_")):
             current = number(gid)
-            exercises.setdefault(current, {"cells": [], "source": ""})
+            exercises.setdefault(current, {"cells": [*before] if not exercises else [], "source": ""})
             if gid.startswith("exercise_"):
                 exercises[current]["source"] = "".join(cell["source"])
-        if current and cell["cell_type"] == "code":
-            exercises[current]["cells"].append(cell)
+        if cell["cell_type"] == "code":
+            (exercises[current]["cells"] if current else before).append(cell)
     passed: dict[str, bool] = {}
     flags: dict[str, list[str]] = {n: [] for n in exercises}
     pending: list[str] = []  # notes before a check: the answer cell's, which comes before it

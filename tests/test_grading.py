@@ -519,6 +519,22 @@ def test_a_dead_kernel_is_flagged_where_it_died_and_an_answer_cannot_say_so_itse
     nb.cells[4].metadata[sandbox.KERNEL_MARK] = nb.cells[5].metadata[sandbox.KERNEL_MARK] = sandbox.OUT_OF_CPU_TIME
     path.write_text(json.dumps(nb))
     assert sandboxing.judge(path, tmp_path / "no-verdicts", "")["1.3"] == (False, ["over a limit"])
+    # died in a cell before the first exercise (the set-up, or one the learner added at the top): that one's crash
+    setup = new_code_cell("", metadata={sandbox.KERNEL_MARK: sandbox.DIED})
+    setup.outputs = [new_output("error", ename="DeadKernelError", evalue=sandbox.KERNEL_DIED, traceback=[])]
+    for cell in nb.cells:
+        cell.metadata[sandbox.KERNEL_MARK] = sandbox.NOT_RUN_MARK
+        cell.outputs = [new_output("error", ename="DeadKernelError", evalue=sandbox.NOT_RUN, traceback=[])]
+    nb.cells.insert(0, setup)
+    path.write_text(json.dumps(nb))
+    judged = sandboxing.judge(path, tmp_path / "no-verdicts", "")
+    assert {ex: flags for ex, (_, flags) in judged.items()} == {
+        "1.1": ["crash"],
+        "1.2": ["not run"],
+        "1.3": ["not run"],
+        "1.4": ["not run"],
+    }
+    del nb.cells[0]
 
     # the executor: a submission's own marks taken off before the run, its marks written as the kernel fares
     ran = []
@@ -556,7 +572,8 @@ def test_the_seals_lines_are_all_read_before_nbgrader_goes_on_after_a_kernel_die
 
     manager = sandbox.SandboxedKernelManager()
     drained = threading.Event()
-    manager._reader = threading.Thread(target=lambda: drained.wait(0.5) or drained.set(), daemon=True)
+    # a reader that drains for 2 s, far longer than the clean-up itself takes
+    manager._reader = threading.Thread(target=lambda: drained.wait(2.0) or drained.set(), daemon=True)
     manager._reader.start()
     asyncio.run(manager.cleanup_resources())  # what nbclient's _async_cleanup_kernel calls for a dead kernel
     assert drained.is_set() and not manager._reader.is_alive()
@@ -585,18 +602,21 @@ GRADER = "import tutorial.exercises.grader as grader\n"
 # it must get, or "": none).  The other exercise keeps its worked solution and its points.  A cheat on a
 # global (the grader, IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
 # Python that finds a key named rtt-cheat in its user's keyring, user-session keyring or persistent keyring
-# (keyctl(2) through ctypes: the kernel's seal refuses ctypes to an answer, not to a process it starts), and
-# what it puts there: Linux keeps them by user ID, past the processes that wrote them.
+# (keyctl(2) through ctypes, x86_64's numbers: the kernel's seal refuses ctypes to an answer, not to a process it
+# starts), in a session keyring of its own; and what it puts there, and how it empties them.  Linux keeps them by
+# user ID, past the processes that wrote them.
 KEYRINGS = (
     "import ctypes\n"
     "libc = ctypes.CDLL(None, use_errno=True)\n"
     "def keyctl(*a):\n"
     "    return libc.syscall(250, *(ctypes.c_long(x) if isinstance(x, int) else x for x in a))\n"
+    "keyctl(1, 0)\n"
     "rings = (-4, -5, keyctl(22, -1, -3))\n"
     "found = [r for r in rings if keyctl(10, r, b'user', b'rtt-cheat', 0) >= 0]\n"
 )
 LEAVE_A_KEY = "for r in rings:\n    libc.syscall(248, b'user', b'rtt-cheat', b'answers', 7, ctypes.c_long(r))\n"
 SAY_AND_LEAVE = "print('yes' if found else 'no')\n" + LEAVE_A_KEY
+EMPTY_THEM = "for r in rings:\n    keyctl(7, r)\n"
 CHEATS = {
     "rebind-check": (
         "1.1",
@@ -670,7 +690,7 @@ CHEATS = {
         "except Exception:\n    pass\n" + STUB_1_1,
         "tampering",
     ),
-    "keyring-note": (  # a key an earlier submission graded as the same user left (grade_cheats leaves one)
+    "keyring-note": (  # a key left by an earlier submission graded as the same user (grade_cheats leaves one)
         "1.1",
         "import subprocess, sys\n"
         "said = subprocess.run([sys.executable, '-c', " + repr(KEYRINGS + SAY_AND_LEAVE) + "],\n"
@@ -791,8 +811,9 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
     finally:
         listener.close()
         monkeypatch.undo()
+        for job in made:  # what the test left with each job's user ID (an ID a later user may be given)
+            assert keys_of(job, KEYRINGS + EMPTY_THEM + KEYRINGS) == "0"
     assert not (home / "rtt-cheat").exists(), "a cheat wrote into the grader's home"
-    assert made and all(keys_of(job, KEYRINGS) == "0" for job in made), "a job's user ID kept its keys"
     rows = {r["student_id"]: r for r in csv.DictReader(csv_path.open())}
     wrong = []
     for cheat in which:

@@ -530,6 +530,34 @@ def test_the_sandbox_leaves_nothing_writable_but_its_own_folders():
         Path("/run/lock/rtt-probe").unlink(missing_ok=True)  # a sandbox that let it through
 
 
+def test_the_kernel_refuses_the_keyrings_to_itself_and_every_process_it_starts():
+    """keyrings.refuse(), as the sealed kernel calls it (no_new_privs, as setpriv gives it): a key put in the
+    thread's own keyring before is refused after, in the process and in a child; the rest of the system works."""
+    code = textwrap.dedent(
+        """
+        import ctypes, subprocess, sys
+        from tutorial.tools.grading import keyrings
+        libc = ctypes.CDLL(None, use_errno=True)
+        def add_key():  # into the thread's own keyring (-1), which ends with it: nothing is left behind
+            ok = libc.syscall(*(ctypes.c_long(a) if isinstance(a, int) else a
+                                for a in (248, b"user", b"rtt-probe", b"x", 1, -1))) >= 0
+            return "added" if ok else f"refused {ctypes.get_errno()}"
+        print("before", add_key())
+        libc.prctl(38, 1, 0, 0, 0)  # PR_SET_NO_NEW_PRIVS
+        keyrings.refuse()
+        print("after", add_key())
+        print("child", subprocess.run([sys.executable, "-c", CHILD], capture_output=True, text=True).stdout.strip())
+        print("open", open(__import__("os").devnull).read() == "")
+        """
+    )
+    child = "import ctypes\nlibc = ctypes.CDLL(None, use_errno=True)\n"
+    child += "print(libc.syscall(250, 0, -4, 0) < 0 and ctypes.get_errno())\n"
+    code = f"CHILD = {child!r}\n" + code  # the child asks for its user keyring's ID
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:4] == ["before added", "after refused 1", "child 1", "open True"], done.stdout
+
+
 ATTACKS = textwrap.dedent(
     """
     import gc, os, sys, types

@@ -8,8 +8,7 @@ module              job
 ``seal``            the grading kernel's verdicts, signed only when the teacher's own
                     check made them
 ``sealed_kernel``   the kernel the sandbox starts, sealed before any cell runs
-``keyrings``        a grading user's kernel keyrings emptied: no key passed between
-                    two submissions graded as one user
+``keyrings``        the kernel keyrings refused to the kernel and all it starts
 ==================  ================================================================
 
 ``course/grade.py``, ``course/sandboxing.py`` and ``course/nbgrader_config.py`` use them.

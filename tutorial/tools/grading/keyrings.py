@@ -1,72 +1,69 @@
-"""The calling user's kernel keyrings, emptied: a note one graded submission leaves there never reaches the next.
+"""The kernel keyrings out of a graded answer's reach: no note one submission leaves there reaches the next.
 
 Linux keeps a user's keyring (``@u``), user-session keyring (``@us``) and
 persistent keyring by user ID, not by process: they outlive the processes
 that wrote them (the persistent one for days).  Two submissions graded in
 turn as one job's user could pass a key between them, and a user given the
-same ID later would find it.  So the grading kernel empties them, and starts
-a session keyring of its own, before any answer runs
-(:mod:`tutorial.tools.grading.sealed_kernel`), and ``course/sandboxing.py``
-empties them once more, as the job's user, when the job ends:
-
-    python -I -m tutorial.tools.grading.keyrings
-
-Python's standard library has no ``keyctl(2)``: it is called through ctypes
-(the system call's number is x86_64's, the only machine the ROS 2 wheels
-are built for).  Any thread.
+same ID later would find it.  So the grading kernel
+(:mod:`tutorial.tools.grading.sealed_kernel`), before any answer runs, has
+``keyctl(2)``, ``add_key(2)`` and ``request_key(2)`` refused to itself and
+to every process it starts (:func:`refuse`: a seccomp filter made with
+libseccomp, the system's library for them).  With no system call to reach
+them, an answer can neither leave, read nor lock a key, and a key left there
+before cannot be read either.
 """
 
 from __future__ import annotations
 
 import ctypes
+import ctypes.util
 import errno
 import os
 
-SYS_KEYCTL = 250  # x86_64
-KEYCTL_JOIN_SESSION_KEYRING = 1
-KEYCTL_CLEAR = 7
-KEYCTL_GET_PERSISTENT = 22
-KEY_SPEC_SESSION_KEYRING = -3
-KEY_SPEC_USER_KEYRING = -4
-KEY_SPEC_USER_SESSION_KEYRING = -5
-# Keys cannot be kept here at all: no keyrings in the kernel (ENOSYS), keyctl refused wholesale (EPERM: a
-# container's seccomp profile), or no persistent keyrings (EOPNOTSUPP).  Nothing can be left, nothing to empty.
-NOT_HERE = (errno.ENOSYS, errno.EPERM, errno.EOPNOTSUPP)
-
-_libc = ctypes.CDLL(None, use_errno=True)  # this module's own: its syscall's result type is set below
-_libc.syscall.restype = ctypes.c_long
+KEY_SYSCALLS = ("keyctl", "add_key", "request_key")
+SCMP_ACT_ALLOW = 0x7FFF0000
+SCMP_ACT_ERRNO = 0x00050000  # | the errno the call returns
+SCMP_FLTATR_CTL_TSYNC = 4  # the filter on every thread of the process, not only the calling one
 
 
-def _keyctl(operation: int, *args) -> int:
-    # syscall(2) reads every argument as a long: each passed as one (an int's upper half would be undefined)
-    result = _libc.syscall(*(ctypes.c_long(a) for a in (SYS_KEYCTL, operation, *args)))
-    if result < 0:
-        code = ctypes.get_errno()
-        raise OSError(code, f"keyctl({operation}): {os.strerror(code)}")
-    return result
+def _libseccomp():
+    name = ctypes.util.find_library("seccomp") or "libseccomp.so.2"
+    try:
+        lib = ctypes.CDLL(name, use_errno=True)
+    except OSError as exc:
+        raise OSError(f"grading needs libseccomp ({name}; Debian: libseccomp2): {exc}") from exc
+    lib.seccomp_init.restype = ctypes.c_void_p
+    lib.seccomp_init.argtypes = [ctypes.c_uint32]
+    lib.seccomp_attr_set.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_uint32]
+    lib.seccomp_syscall_resolve_name.argtypes = [ctypes.c_char_p]
+    lib.seccomp_rule_add.argtypes = [ctypes.c_void_p, ctypes.c_uint32, ctypes.c_int, ctypes.c_uint]
+    lib.seccomp_load.argtypes = [ctypes.c_void_p]
+    lib.seccomp_release.argtypes = [ctypes.c_void_p]
+    return lib
 
 
-def clear() -> None:
-    """A new, empty session keyring for this process; the user's keyring, user-session keyring and persistent
-    keyring emptied.
+def refuse() -> None:
+    """From now on, :data:`KEY_SYSCALLS` fail with EPERM in every thread of this process and in every process
+    it starts.  For good: meant for the sealed kernel's start, before any answer runs.
+
+    Needs no_new_privs (``setpriv --no-new-privs``, as the sandbox starts the kernel) or CAP_SYS_ADMIN.
 
     Raises:
-        OSError: a keyring could not be emptied (not where keyrings cannot be kept at all: :data:`NOT_HERE`).
+        OSError: the filter could not be made or loaded (libseccomp missing, no no_new_privs).
     """
-    steps = [
-        lambda: _keyctl(KEYCTL_JOIN_SESSION_KEYRING, 0),  # anonymous: not the grader's, inherited across setuid
-        lambda: _keyctl(KEYCTL_CLEAR, KEY_SPEC_USER_KEYRING),
-        lambda: _keyctl(KEYCTL_CLEAR, KEY_SPEC_USER_SESSION_KEYRING),
-        # the persistent keyring, linked into the new session keyring to be found, then emptied
-        lambda: _keyctl(KEYCTL_CLEAR, _keyctl(KEYCTL_GET_PERSISTENT, -1, KEY_SPEC_SESSION_KEYRING)),
-    ]
-    for step in steps:
-        try:
-            step()
-        except OSError as exc:
-            if exc.errno not in NOT_HERE:
-                raise
-
-
-if __name__ == "__main__":
-    clear()
+    lib = _libseccomp()
+    filter_ = lib.seccomp_init(SCMP_ACT_ALLOW)
+    if not filter_:
+        raise OSError("seccomp_init failed")
+    try:
+        rc = lib.seccomp_attr_set(filter_, SCMP_FLTATR_CTL_TSYNC, 1)
+        for name in KEY_SYSCALLS:
+            if rc >= 0:
+                number = lib.seccomp_syscall_resolve_name(name.encode())
+                rc = lib.seccomp_rule_add(filter_, SCMP_ACT_ERRNO | errno.EPERM, number, 0)
+        if rc >= 0:
+            rc = lib.seccomp_load(filter_)
+        if rc < 0:
+            raise OSError(-rc, f"the keyrings' seccomp filter: {os.strerror(-rc)}")
+    finally:
+        lib.seccomp_release(filter_)

@@ -12,7 +12,8 @@ kernel:
   ``book``, ``.git``), ``/home``, ``/root`` (but the Python installation)
   and ``/srv`` are empty, ``/tmp``, ``/var/tmp`` and ``/dev/shm`` are the
   kernel's own, and every other mount is read-only (``/run/lock`` too); the
-  user's kernel keyrings emptied by the kernel itself before any answer runs
+  kernel keyrings (the user ID's, past any process) refused to it and every
+  process it starts, by the kernel itself before any answer runs
   (:mod:`tutorial.tools.grading.keyrings`);
 * as the job's user, with no privileges (``setpriv --no-new-privs``), in a
   working folder of its own (a copy of the submission's folder), with a

@@ -21,9 +21,9 @@ def main() -> None:
     # Not dumpable: another process of the same user (a subprocess of an answer, which the seal does not
     # watch) can then neither ptrace this kernel nor read its memory (/proc/PID/mem), where the key lives.
     ctypes.CDLL(None).prctl(PR_SET_DUMPABLE, 0, 0, 0, 0)
-    # The job's user's keyrings emptied, and a session keyring of the kernel's own: the keyrings are the user
-    # ID's, not this process's, so an earlier submission graded as this user could have left a key there.
-    keyrings.clear()
+    # The keyrings are the user ID's, not this process's: keyctl refused to this kernel and every process it
+    # starts, so no answer leaves, reads or locks a key there (keyrings.py).
+    keyrings.refuse()
     key_fd, verdict_fd = (int(fd) for fd in os.environ.pop("RTT_SEAL_FDS").split(","))
     with os.fdopen(key_fd, "rb") as pipe:
         given = json.loads(pipe.read())
