@@ -31,6 +31,7 @@ from __future__ import annotations
 import ast
 import contextlib
 import csv
+import ctypes.util
 import hmac
 import json
 import os
@@ -78,6 +79,8 @@ class Sandboxes:
                 "run make grade as root (Linux, util-linux), or pass --unsandboxed to grade with your own "
                 "rights (a learner's code then runs as you: not for a real class)"
             )
+        if not ctypes.util.find_library("seccomp"):  # each kernel's keyrings filter (keyrings.py)
+            raise SandboxError("grading needs libseccomp (Debian and Ubuntu: apt install libseccomp2)")
         JOBS.mkdir(parents=True, exist_ok=True)
         os.chmod(JOBS, 0o711)
         remove_stale_users()
