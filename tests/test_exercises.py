@@ -1073,6 +1073,17 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
         ),
         ("8.2", "return 15.0, 70", "return 10.0, 70"),  # the slowest watchable rate, 10 pictures/s, is watchable
         ("8.2", "return 15.0, 70", "return 15.0, 30"),  # the lowest recognisable quality, 30, is recognisable
+        (  # its own set-up, from what configure() and initialize() are given: the rig gives what a project does
+            "6.1",
+            '    """RttCameraImagePublisher publishing gray (mono8) pictures."""\n',
+            '    """RttCameraImagePublisher publishing gray (mono8) pictures."""\n\n'
+            "    def configure(self, config):\n"
+            "        self.label = config.name.removeprefix('Rtt') + ' on ' + config.body.name\n"
+            "        return super().configure(config)\n\n"
+            "    def initialize(self, io):\n"
+            "        io.node.get_logger().debug(f'{self.label}: {len(io.body.joint_names)} joints')\n"
+            "        return super().initialize(io)\n",
+        ),
         (  # another default rate: the check drives every camera at its own rate
             "6.1",
             '    """RttCameraImagePublisher publishing gray (mono8) pictures."""\n',
@@ -1085,6 +1096,7 @@ def test_a_right_answer_written_otherwise_passes_the_lock_check(ros, right, othe
         "2.1-another-publisher",
         "8.2-the-slowest-rate",
         "8.2-the-lowest-quality",
+        "6.1-its-own-setup",
         "6.1-another-default-rate",
     ],
 )
@@ -1254,9 +1266,9 @@ def test_6_1_a_picture_never_published_a_failing_render_thread_and_a_control_tha
 def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_leaves_no_render_thread(
     ros, monkeypatch
 ):
-    """configure() or start() without its answer given back is told what it gave; a configure() that raises
-    after super() is told so; each time, and after an unconfigure() that leaves super()'s out, the rig ends the
-    render thread super().configure() started."""
+    """configure(), initialize() or start() without its answer given back is told what it gave; a configure()
+    that raises after super() is told so; each time, and after an unconfigure() that leaves super()'s out, the
+    rig ends the render thread super().configure() started."""
     from tutorial.app.reference.camera_image_publisher import RttCameraImagePublisher
     from tutorial.exercises import step6_camera as step6
 
@@ -1279,6 +1291,11 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
             made.append(self)
             super().start()  # its True not given back
 
+    class NotInitialized(RttCameraImagePublisher):
+        def initialize(self, io):
+            made.append(self)
+            return super().initialize(io) and io.time_step > 1.0  # refused: no simulation steps a second at a time
+
     class RaisingFirst(RttCameraImagePublisher):
         def configure(self, config):
             raise KeyError("gray")  # before super().configure(): no render thread was made
@@ -1287,7 +1304,7 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
         def unconfigure(self):
             made.append(self)  # super().unconfigure() left out: the render thread is never told to end
 
-    answers = (NoAnswer, Raising, RaisingFirst, NotStarted, KeptRunning)
+    answers = (NoAnswer, Raising, RaisingFirst, NotStarted, NotInitialized, KeptRunning)
     said = {cls.__name__: str(step6.check_gray_camera(cls)) for cls in answers}
     assert (
         "NoAnswer.configure returned None. "
@@ -1298,7 +1315,11 @@ def test_6_1_a_configure_or_start_that_gives_back_nothing_or_raises_is_told_and_
     assert (
         "NotStarted.start returned None. Hint: return what super().start() returns: True when all is well."
     ) in said["NotStarted"], said
-    assert [c.thread.is_alive() for c in made] == [False, False, False, False]  # every render thread ended
+    assert (
+        "NotInitialized.initialize returned False. "
+        "Hint: return what super().initialize() returns: True when all is well."
+    ) in said["NotInitialized"], said
+    assert [c.thread.is_alive() for c in made] == [False, False, False, False, False]  # every render thread ended
 
 
 def test_every_exercise_has_six_wrong_answers():
