@@ -553,9 +553,9 @@ def test_the_kernel_refuses_the_keyrings_to_itself_and_every_process_it_starts()
     child = "import ctypes\nlibc = ctypes.CDLL(None, use_errno=True)\n"
     child += "print(libc.syscall(250, 0, -4, 0) < 0 and ctypes.get_errno())\n"
     code = f"CHILD = {child!r}\n" + code  # the child asks for its user keyring's ID
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=False)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.split("\n")[:4] == ["before added", "after refused 1", "child 1", "open True"], done.stdout
+    ran = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=False)
+    assert ran.returncode == 0, ran.stderr
+    assert ran.stdout.split("\n")[:4] == ["before added", "after refused 1", "child 1", "open True"], ran.stdout
 
 
 ATTACKS = textwrap.dedent(
