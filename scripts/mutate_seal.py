@@ -83,10 +83,10 @@ def patch_mutants(tree: Path) -> None:
     for tests in (tree / "tests" / "test_seal.py", tree / "mutants" / "tests" / "test_seal.py"):  # mutmut copies
         text = tests.read_text()
         if "record_trampoline_hit" not in text:
-            anchor = "    done = subprocess.run("
+            anchor = "\n    done = subprocess.run("  # sealed()'s, at the function's own indent (not a nested one)
             if text.count(anchor) != 1:
                 raise SystemExit(f"{tests}: sealed() no longer runs {anchor.strip()!r} once")
-            tests.write_text(text.replace(anchor, REACHED.format(names=tuple(names)) + anchor))
+            tests.write_text(text.replace(anchor, "\n" + REACHED.format(names=tuple(names)) + anchor[1:]))
 
 
 def main(argv=None) -> int:
