@@ -77,3 +77,24 @@ def test_a_sample_counts_only_the_mutants_it_ran_and_a_list_of_another_runs_modu
     out = capsys.readouterr().out
     assert "1 mutants: 1 caught (100.0%)" in out and "1 more not run (not counted)" in out
     assert "(stale): pkg.mod.x_f__mutmut_9" in out and "other.mod" not in out
+
+
+def test_make_mutate_seal_can_patch_todays_seal_and_its_tests(tmp_path):
+    """scripts/mutate_seal.py patches mutmut's copy of the seal and sealed()'s one subprocess.run in
+    tests/test_seal.py: a test that changes either so that it cannot stops make mutate-seal (it did once)."""
+    import shutil
+
+    spec = importlib.util.spec_from_file_location("mutate_seal", ROOT / "scripts" / "mutate_seal.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    (tmp_path / "mutants" / script.SEAL).parent.mkdir(parents=True)
+    shutil.copy(ROOT / script.SEAL, tmp_path / "mutants" / script.SEAL)
+    for folder in (tmp_path / "tests", tmp_path / "mutants" / "tests"):
+        folder.mkdir()
+        shutil.copy(ROOT / "tests" / "test_seal.py", folder / "test_seal.py")
+    script.patch_mutants(tmp_path)
+    for folder in (tmp_path / "tests", tmp_path / "mutants" / "tests"):
+        patched = (folder / "test_seal.py").read_text()
+        assert patched.count("record_trampoline_hit(") == 1
+        compile(patched, "test_seal.py", "exec")  # still Python
+    assert "_rtt_make_hook_code()" in (tmp_path / "mutants" / script.SEAL).read_text()
