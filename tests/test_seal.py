@@ -98,6 +98,7 @@ def test_the_seal_signs_only_the_teachers_untouched_check():
     lines = signed_lines(done.stdout)
     verdicts = [line for line in lines if line[0] == "verdict"]
     assert [v[1:4] for v in verdicts] == [["1.1", "1", "1"], ["1.1", "1", "0"], ["1.1", "1", "1"], ["1.1", "0", "1"]]
+    assert [line for line in lines if line[0] == "begin"] == [["begin", "1.1"]] * 4  # each check named as it begins
     assert "same_numbers was replaced" in verdicts[1][4]
     notes = [line for line in lines if line[0] == "note"]
     assert notes[0][1] == "tampering" and notes[0][3] == "1.1", notes  # the Result made by hand, named
@@ -261,7 +262,7 @@ def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_
                 return forward - turn, forward + turn
 
             cell("r = check_dpad_steering(dpad_track_velocities).require()")  # not the test cell's statement
-            cell("grader.Result('steer', True, 'ok').require()")  # made by hand, under a name of no exercise
+            cell("grader.Result('steer left', True, 'ok').require()")  # made by hand, under a name of no exercise
             real, calls = grader.same_numbers, []
             grader.same_numbers = lambda *a, **k: True  # replaced before the check, put back during it
 
@@ -528,6 +529,139 @@ def test_the_sandbox_leaves_nothing_writable_but_its_own_folders():
         shutil.rmtree(folder, ignore_errors=True)
         shutil.rmtree(outside, ignore_errors=True)
         Path("/run/lock/rtt-probe").unlink(missing_ok=True)  # a sandbox that let it through
+
+
+def test_a_checks_own_constant_replaced_before_it_and_put_back_while_it_runs_is_tampering():
+    """The check builds its table from the module's DPAD_SPEED as it begins: an answer that changed it before
+    and puts it back from inside the check leaves nothing changed at the end; the change seen at the begin
+    still counts."""
+    script = textwrap.dedent(
+        """
+        import sys
+        from tutorial.tools.grading import seal
+        seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+        from tutorial.exercises.step1_tank_controller import check_dpad_steering
+        import tutorial.exercises.step1_tank_controller as step1
+
+        def cell(text):
+            exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
+
+        real = step1.DPAD_SPEED
+        cell("step1.DPAD_SPEED = 0.0")
+
+        def dpad_track_velocities(axes):
+            step1.DPAD_SPEED = real  # put back while the check runs
+            return 0.0, 0.0
+
+        try:
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+        except AssertionError:
+            pass
+        """
+    )
+    verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
+    assert verdicts == [["1.1", "0", "0", "tutorial.exercises.step1_tank_controller.DPAD_SPEED was replaced"]]
+
+
+def test_a_name_a_check_reads_only_through_what_it_calls_replaced_is_tampering():
+    """What a check uses is the names its code reads and, in turn, the names read by the functions it calls
+    (looked up in its module): step1's own binding of the grader's same_numbers is one, which the check reads
+    only through what it calls.  An answer that rebinds that one (not the grader's) is told."""
+    script = textwrap.dedent(
+        """
+        from tutorial.tools.grading import seal
+        seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+        from tutorial.exercises.step1_tank_controller import check_dpad_steering
+        import tutorial.exercises.step1_tank_controller as step1
+
+        def cell(text):
+            exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
+
+        def dpad_track_velocities(axes):
+            return 0.0, 0.0  # wrong
+
+        cell("step1.same_numbers = lambda *a, **k: True")
+        try:
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+        except AssertionError:
+            pass  # the check itself compared with the grader's own
+        """
+    )
+    verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
+    assert verdicts == [["1.1", "0", "0", "tutorial.exercises.step1_tank_controller.same_numbers was replaced"]]
+
+
+def test_a_check_modules_imports_inside_its_functions_are_found_modules_alone(tmp_path, monkeypatch):
+    """What a check imports inside a function is trusted before any answer runs: a module named by its path,
+    or from its package (``from tutorial.interfaces import joy``); a function or class it imports is no module."""
+    from tutorial.tools.grading.seal import _tutorial_imports
+
+    (tmp_path / "lazy_check.py").write_text(
+        "def check():\n"
+        "    from tutorial.interfaces import joy, imu\n"
+        "    from tutorial.core.world import build_world\n"
+        "    import tutorial.notebook.runs\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import lazy_check
+
+    assert sorted(_tutorial_imports(lazy_check)) == [
+        "tutorial.core.world",
+        "tutorial.interfaces",
+        "tutorial.interfaces.imu",
+        "tutorial.interfaces.joy",
+        "tutorial.notebook.runs",
+    ]
+
+
+def test_the_seals_own_data_replaced_by_an_answer_is_tampering():
+    """The hook keeps its own copies (install rebuilds it with private globals), so an answer that empties the
+    seal's list of noted events changes nothing it does; it is still told as tampering at the next check, as
+    any change to a check module's data is."""
+    script = textwrap.dedent(
+        """
+        from tutorial.tools.grading import seal
+        seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+        from tutorial.exercises.step1_tank_controller import check_dpad_steering
+        from tutorial.interfaces import joy
+
+        def cell(text):
+            exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
+
+        def dpad_track_velocities(axes):
+            forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+            return forward - turn, forward + turn
+
+        cell("import tutorial.tools.grading.seal as s; s.NOTED = frozenset()")
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        """
+    )
+    verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
+    assert verdicts == [["1.1", "1", "0", "tutorial.tools.grading.seal.NOTED was replaced"]], verdicts
+
+
+def test_a_library_uses_ctypes_for_an_answer_and_the_answer_itself_may_not():
+    """Raw memory is refused to an answer's own code, not to the library code it calls (multiprocessing's shared
+    values are ctypes objects): only the caller's file says whose the call is."""
+    script = textwrap.dedent(
+        """
+        from tutorial.tools.grading import seal
+        seal.install(b"k" * 32, 1, [])
+
+        def cell(text):
+            exec(compile(text, "/tmp/ipykernel_0/cell.py", "exec"), globals())
+
+        cell("import multiprocessing\\nprint('a library:', multiprocessing.Value('i', 3).value)")
+        try:
+            cell("import ctypes\\nctypes.c_int.from_buffer(bytearray(4))")
+            print("the answer: allowed")
+        except RuntimeError as e:
+            print("the answer:", "refused" if "sandbox refused" in str(e) else e)
+        """
+    )
+    done = sealed(script)
+    assert "a library: 3" in done.stdout and "the answer: refused" in done.stdout, done.stdout
+    assert [line[1:3] for line in signed_lines(done.stdout)] == [["refused", "ctypes.cdata/buffer"]]
 
 
 def test_the_kernel_refuses_the_keyrings_to_itself_and_every_process_it_starts():
