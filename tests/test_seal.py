@@ -236,6 +236,27 @@ def test_an_answer_cannot_open_a_process_s_memory_directly_or_through_a_chain_of
     assert (tmp_path / "e").is_symlink() and not (tmp_path / "d").exists()
 
 
+# A sealed script's start: the seal installed for exercise 1.1's test cell, its check and module imported, a cell
+# run as IPython runs a test cell's last line, and a right answer.
+SEALED_1_1 = textwrap.dedent(
+    """
+    import sys
+    from tutorial.tools.grading import seal
+    seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
+    from tutorial.exercises.step1_tank_controller import check_dpad_steering
+    import tutorial.exercises.step1_tank_controller as step1
+    from tutorial.interfaces import joy
+
+    def cell(text):
+        exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
+
+    def dpad_track_velocities(axes):
+        forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+        return forward - turn, forward + turn
+    """
+)
+
+
 def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_method_is_not_the_teachers():
     """require() from a statement other than the test cell's is no verdict of the cell; a Result made by hand
     under any name is noted as tampering; a check's function replaced before the check and put back during it
@@ -244,22 +265,12 @@ def test_a_verdict_from_another_statement_a_hand_made_result_or_a_changed_class_
     answer's own class that equals everything is told to the teacher; another thread's frames, and a thread
     started with the answer's tracer, are refused."""
     done = sealed(
-        textwrap.dedent(
+        SEALED_1_1
+        + textwrap.dedent(
             """
-            import os, sys
-            from tutorial.tools.grading import seal
-            seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
-            from tutorial.exercises.step1_tank_controller import check_dpad_steering
+            import os
             from tutorial.core.controller import SimpleController
-            from tutorial.interfaces import joy
             import tutorial.exercises.grader as grader
-
-            def cell(text):
-                exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
-
-            def dpad_track_velocities(axes):
-                forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
-                return forward - turn, forward + turn
 
             cell("r = check_dpad_steering(dpad_track_velocities).require()")  # not the test cell's statement
             cell("grader.Result('steer left', True, 'ok').require()")  # made by hand, under a name of no exercise
@@ -535,17 +546,8 @@ def test_a_checks_own_constant_replaced_before_it_and_put_back_while_it_runs_is_
     """The check builds its table from the module's DPAD_SPEED as it begins: an answer that changed it before
     and puts it back from inside the check leaves nothing changed at the end; the change seen at the begin
     still counts."""
-    script = textwrap.dedent(
+    script = SEALED_1_1 + textwrap.dedent(
         """
-        import sys
-        from tutorial.tools.grading import seal
-        seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
-        from tutorial.exercises.step1_tank_controller import check_dpad_steering
-        import tutorial.exercises.step1_tank_controller as step1
-
-        def cell(text):
-            exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
-
         real = step1.DPAD_SPEED
         cell("step1.DPAD_SPEED = 0.0")
 
@@ -567,16 +569,8 @@ def test_a_name_a_check_reads_only_through_what_it_calls_replaced_is_tampering()
     """What a check uses is the names its code reads and, in turn, the names read by the functions it calls
     (looked up in its module): step1's own binding of the grader's same_numbers is one, which the check reads
     only through what it calls.  An answer that rebinds that one (not the grader's) is told."""
-    script = textwrap.dedent(
+    script = SEALED_1_1 + textwrap.dedent(
         """
-        from tutorial.tools.grading import seal
-        seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
-        from tutorial.exercises.step1_tank_controller import check_dpad_steering
-        import tutorial.exercises.step1_tank_controller as step1
-
-        def cell(text):
-            exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
-
         def dpad_track_velocities(axes):
             return 0.0, 0.0  # wrong
 
@@ -618,20 +612,8 @@ def test_the_seals_own_data_replaced_by_an_answer_is_tampering():
     """The hook keeps its own copies (install rebuilds it with private globals), so an answer that empties the
     seal's list of noted events changes nothing it does; it is still told as tampering at the next check, as
     any change to a check module's data is."""
-    script = textwrap.dedent(
+    script = SEALED_1_1 + textwrap.dedent(
         """
-        from tutorial.tools.grading import seal
-        seal.install(b"k" * 32, 1, ["check_dpad_steering(dpad_track_velocities).require()"])
-        from tutorial.exercises.step1_tank_controller import check_dpad_steering
-        from tutorial.interfaces import joy
-
-        def cell(text):
-            exec(compile(text, "/tmp/ipykernel_0/cell.py", "single"), globals())
-
-        def dpad_track_velocities(axes):
-            forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
-            return forward - turn, forward + turn
-
         cell("import tutorial.tools.grading.seal as s; s.NOTED = frozenset()")
         cell("check_dpad_steering(dpad_track_velocities).require()")
         """
