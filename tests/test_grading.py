@@ -598,9 +598,6 @@ def test_grading_every_assignment(tmp_path, monkeypatch):
 
 STUB_1_1 = "def dpad_track_velocities(axes):\n    raise NotImplementedError\n"
 GRADER = "import tutorial.exercises.grader as grader\n"
-# Each cheat: (the exercise it targets, the code put in that exercise's answer cell after its stub, the flag
-# it must get, or "": none).  The other exercise keeps its worked solution and its points.  A cheat on a
-# global (the grader, IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
 # Python that finds a key named rtt-cheat in its user's keyring, user-session keyring or persistent keyring
 # (keyctl(2) through ctypes, x86_64's numbers: the kernel's seal refuses ctypes to an answer, not to a process it
 # starts), in a session keyring of its own; and what it puts there, and how it empties them.  Linux keeps them by
@@ -617,6 +614,9 @@ KEYRINGS = (
 LEAVE_A_KEY = "for r in rings:\n    libc.syscall(248, b'user', b'rtt-cheat', b'answers', 7, ctypes.c_long(r))\n"
 SAY_AND_LEAVE = "print('yes' if found else 'no')\n" + LEAVE_A_KEY
 EMPTY_THEM = "for r in rings:\n    keyctl(7, r)\n"
+# Each cheat: (the exercise it targets, the code put in that exercise's answer cell after its stub, the flag
+# it must get, or "": none).  The other exercise keeps its worked solution and its points.  A cheat on a
+# global (the grader, IPython) targets 1.2, the later check: a change cannot reach a check that ran before it.
 CHEATS = {
     "rebind-check": (
         "1.1",
