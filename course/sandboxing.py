@@ -31,7 +31,6 @@ from __future__ import annotations
 import ast
 import contextlib
 import csv
-import ctypes.util
 import hmac
 import json
 import os
@@ -44,6 +43,7 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from tutorial.tools.grading import keyrings
 from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -79,8 +79,8 @@ class Sandboxes:
                 "run make grade as root (Linux, util-linux), or pass --unsandboxed to grade with your own "
                 "rights (a learner's code then runs as you: not for a real class)"
             )
-        if not ctypes.util.find_library("seccomp"):  # each kernel's keyrings filter (keyrings.py)
-            raise SandboxError("grading needs libseccomp (Debian and Ubuntu: apt install libseccomp2)")
+        if not keyrings.libseccomp_name():  # each kernel's keyrings filter
+            raise SandboxError(keyrings.MISSING)
         JOBS.mkdir(parents=True, exist_ok=True)
         os.chmod(JOBS, 0o711)
         remove_stale_users()

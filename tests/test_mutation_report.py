@@ -14,11 +14,16 @@ from conftest import ROOT
 pytestmark = pytest.mark.unit
 
 
-def load_report():
-    spec = importlib.util.spec_from_file_location("mutation_report", ROOT / "scripts" / "mutation_report.py")
+def load_script(name: str):
+    """A script of scripts/ as a module (the folder is no package)."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def load_report():
+    return load_script("mutation_report")
 
 
 def test_the_score_leaves_out_the_listed_equivalents_and_fails_on_an_unexplained_survivor(
@@ -84,9 +89,7 @@ def test_make_mutate_seal_can_patch_todays_seal_and_its_tests(tmp_path):
     tests/test_seal.py: a test that changes either so that it cannot stops make mutate-seal (it did once)."""
     import shutil
 
-    spec = importlib.util.spec_from_file_location("mutate_seal", ROOT / "scripts" / "mutate_seal.py")
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+    script = load_script("mutate_seal")
     (tmp_path / "mutants" / script.SEAL).parent.mkdir(parents=True)
     shutil.copy(ROOT / script.SEAL, tmp_path / "mutants" / script.SEAL)
     for folder in (tmp_path / "tests", tmp_path / "mutants" / "tests"):

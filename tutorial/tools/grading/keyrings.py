@@ -26,12 +26,20 @@ SCMP_ACT_ERRNO = 0x00050000  # | the errno the call returns
 SCMP_FLTATR_CTL_TSYNC = 4  # the filter on every thread of the process, not only the calling one
 
 
+MISSING = "grading needs libseccomp (Debian and Ubuntu: apt install libseccomp2)"
+
+
+def libseccomp_name() -> str | None:
+    """The file name of this system's libseccomp, or None where it has none.  Any thread."""
+    return ctypes.util.find_library("seccomp")
+
+
 def _libseccomp():
-    name = ctypes.util.find_library("seccomp") or "libseccomp.so.2"
+    name = libseccomp_name() or "libseccomp.so.2"
     try:
         lib = ctypes.CDLL(name, use_errno=True)
     except OSError as exc:
-        raise OSError(f"grading needs libseccomp ({name}; Debian: libseccomp2): {exc}") from exc
+        raise OSError(f"{MISSING}: {name}: {exc}") from exc
     lib.seccomp_init.restype = ctypes.c_void_p
     lib.seccomp_init.argtypes = [ctypes.c_uint32]
     lib.seccomp_attr_set.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_uint32]
