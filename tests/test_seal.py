@@ -622,6 +622,46 @@ def test_the_seals_own_data_replaced_by_an_answer_is_tampering():
     assert verdicts == [["1.1", "1", "0", "tutorial.tools.grading.seal.NOTED was replaced"]], verdicts
 
 
+def test_a_thread_inside_the_hook_lets_no_other_threads_event_pass():
+    """The hook lets its own events pass, thread by thread: while one thread of an answer is inside it (each of its
+    refusals writes a signed note, and the write lets the other thread run), the other thread's frame reads are
+    still refused, and so are its own.  A guard shared by all threads let one thread's reads through the other's
+    refusals (found by mutation: ``me = None``)."""
+    script = SEALED_1_1 + textwrap.dedent(
+        """
+        import threading
+
+        sys.setswitchinterval(1e-6)  # hand the interpreter lock over as often as it can be
+        read, refused, stop, ready = [], [0, 0], threading.Event(), threading.Event()
+
+        def frames(who, until):
+            while not until():
+                ready.set()
+                try:
+                    read.append((who, sys._getframe().f_code.co_name))
+                except RuntimeError:
+                    refused[who] += 1
+
+        def dpad_track_velocities(axes):
+            if not stop.is_set():  # the first call, during the check
+                other = threading.Thread(target=frames, args=(1, stop.is_set))
+                other.start()
+                ready.wait(10)
+                count = iter(range(3000))
+                frames(0, lambda: next(count, None) is None)
+                stop.set()
+                other.join(10)
+            forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+            return forward - turn, forward + turn
+
+        check_dpad_steering(dpad_track_velocities)
+        print("read", read[:3], "refused", refused[0], refused[1] > 0, file=sys.stderr)
+        """
+    )
+    said = [line for line in sealed(script).stderr.splitlines() if line.startswith("read ")]
+    assert said == ["read [] refused 3000 True"], said
+
+
 def test_a_library_uses_ctypes_for_an_answer_and_the_answer_itself_may_not():
     """Raw memory is refused to an answer's own code, not to the library code it calls (multiprocessing's shared
     values are ctypes objects): only the caller's file says whose the call is."""
