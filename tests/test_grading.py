@@ -684,6 +684,17 @@ CHEATS = {
     "crash": ("1.2", "import os\nos.kill(os.getpid(), 9)\n", "crash"),  # 1.1, before it, keeps its points
     # graded alone, with the CPU time limit below the cell timeout (test_a_kernel_over_its_cpu_time_...)
     "cpu-time": ("1.2", "while True:\n    pass\n", "over a limit"),
+    "stack-walk": (  # the check's own expected values, read down the stack from a frame a library took for it
+        "1.1",
+        "import traceback\n"
+        "def dpad_track_velocities(axes):\n"
+        "    try:\n        1 / 0\n    except ZeroDivisionError as e:\n"
+        "        frame = next(traceback.walk_tb(e.__traceback__))[0]\n"
+        "    while frame is not None and 'expected' not in frame.f_locals:\n"
+        "        frame = frame.f_back\n"
+        "    return frame.f_locals['expected'] if frame is not None else (0.0, 0.0)\n",
+        "tampering",
+    ),
     "memory-through-a-link": (  # the seal's key is in the kernel's memory
         "1.1",
         "import os\ntry:\n    os.symlink('/proc/self/mem', 'memory')\n    open('memory', 'rb').read(1)\n"

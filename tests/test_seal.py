@@ -622,6 +622,125 @@ def test_the_seals_own_data_replaced_by_an_answer_is_tampering():
     assert verdicts == [["1.1", "1", "0", "tutorial.tools.grading.seal.NOTED was replaced"]], verdicts
 
 
+STACK_WALKS = textwrap.dedent(
+    """
+    import collections, inspect, logging, traceback, typing
+
+    def expected_from(frame):  # the check's own expected value, from the frames below this one (f_back: no audit)
+        while frame is not None and "expected" not in frame.f_locals:
+            frame = frame.f_back
+        return frame.f_locals["expected"] if frame is not None else (0.0, 0.0)
+
+    def own_traceback():
+        try:
+            1 / 0
+        except ZeroDivisionError as e:
+            return e.__traceback__
+
+    def deeper(n):  # walk_stack(None) starts four frames up
+        return deeper(n - 1) if n else next(traceback.walk_stack(None))[0]
+
+    WALKS = {
+        "traceback.walk_stack": lambda: deeper(4),
+        "traceback.walk_tb": lambda: next(traceback.walk_tb(own_traceback()))[0],
+        "inspect.stack": lambda: inspect.stack()[0].frame,
+        "inspect.getinnerframes": lambda: inspect.getinnerframes(own_traceback())[0].frame,
+        # the check's locals as text: the answer parses them (here, only tries)
+        "traceback.StackSummary": lambda: traceback.StackSummary.extract(
+            traceback.walk_stack(None), capture_locals=True
+        )
+        and None,
+    }
+    log = logging.getLogger("answer")
+    log.addHandler(logging.NullHandler())
+
+    def honest(axes):  # libraries that take a frame only to read it themselves
+        log.warning("axes %s", axes)
+        try:
+            own_traceback().tb_next.tb_next  # an error of the answer's own, told with its traceback
+        except AttributeError:
+            log.exception("told")
+            traceback.format_exc()
+        traceback.extract_stack()
+        collections.namedtuple("Tracks", "left right")
+        typing.TypeVar("T")
+        forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
+        return forward - turn, forward + turn
+
+    for name, walk in WALKS.items():
+        dpad_track_velocities = lambda axes: expected_from(walk())
+        try:
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            print(name, "passed", file=sys.stderr)
+        except (AssertionError, RuntimeError) as e:
+            print(name, "refused" if "sandbox refused" in str(e) else "failed", file=sys.stderr)
+    dpad_track_velocities = honest
+    cell("check_dpad_steering(dpad_track_velocities).require()")
+    """
+)
+
+
+def test_a_library_that_walks_the_stack_for_an_answer_during_a_check_is_refused_and_one_that_reads_it_is_not():
+    """From any frame, f_back and f_locals (which Python does not audit) lead down to the check's own expected
+    values.  So while an answer runs inside a check, a frame taken for it by a library (traceback's walks,
+    inspect's, a stack summary with its locals) is refused, as its own are; logging, tracebacks told as text,
+    namedtuple and typing, which read their caller's frame themselves, still work there.
+    At b088ed8, walk_stack, walk_tb and getinnerframes gave full marks."""
+    done = sealed(SEALED_1_1 + STACK_WALKS)
+    said = [line for line in done.stderr.splitlines() if line.startswith(("traceback.", "inspect."))]
+    assert said == [
+        "traceback.walk_stack refused",
+        "traceback.walk_tb refused",
+        "inspect.stack refused",
+        "inspect.getinnerframes refused",
+        "traceback.StackSummary refused",
+    ], done.stderr
+    verdicts = [line[1:] for line in signed_lines(done.stdout) if line[0] == "verdict"]
+    refused = ["reading frames during a check", "reading tb_frame during a check"]
+    assert [v[3] for v in verdicts[:5]] == [refused[0], refused[1], refused[0], refused[1], refused[0]], verdicts
+    assert verdicts[5] == ["1.1", "1", "1", ""], verdicts  # the honest answer, logging and tracebacks on the way
+
+
+def test_a_paused_generators_frame_taken_before_a_check_is_tampering():
+    """A generator's frame taken while it is paused (here its own sys._getframe(), outside any check) gets a
+    new f_back each time it is resumed: inside a check, the check's.  The seal looks for such frames of the
+    answer's when a check begins."""
+    script = SEALED_1_1 + textwrap.dedent(
+        """
+        def paused():
+            me = sys._getframe()  # outside a check: allowed
+            yield None
+            while True:
+                frame = me
+                while frame is not None and "expected" not in frame.f_locals:
+                    frame = frame.f_back
+                yield frame.f_locals["expected"] if frame is not None else (0.0, 0.0)
+
+        generator = paused()
+        next(generator)
+        dpad_track_velocities = lambda axes: next(generator)
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        generator.close()
+        dpad_track_velocities = lambda axes: (0.0, 0.0)
+        try:
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+        except AssertionError:
+            pass
+        """
+    )
+    verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
+    assert verdicts == [
+        ["1.1", "1", "0", "an answer's paused generator had its frame taken"],  # it read the answers
+        ["1.1", "0", "1", ""],  # closed: nothing paused is left
+    ], verdicts
+
+
+def test_without_a_seed_a_check_runs_its_visible_cases_alone():
+    """A learner's own run has no seed, so no hidden case: install's default."""
+    done = sealed(SEALED_1_1 + "print(check_dpad_steering(dpad_track_velocities), file=sys.stderr)\n")
+    assert "passed (11 cases)" in done.stderr, done.stderr
+
+
 def test_a_thread_inside_the_hook_lets_no_other_threads_event_pass():
     """The hook lets its own events pass, thread by thread: while one thread of an answer is inside it (each of its
     refusals writes a signed note, and the write lets the other thread run), the other thread's frame reads are

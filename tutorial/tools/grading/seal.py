@@ -20,11 +20,16 @@ comes from the seal's signed verdicts, not from the cell's output:
   ``require`` called by a statement compiled exactly like the test cell's
   call.  Each time the snapshot is compared, object by object.
 * The hook refuses what would let an answer read or change the checks, or
-  the hook, from inside: during a check, frames of the answer's own code;
-  at any time, an answer's ``ctypes`` and ``/proc/*/mem`` (raw memory), the
-  garbage collector's object lists, tracers, other threads' frames, the
-  hook's own frames in a traceback, a second audit hook, and changing the
-  code or defaults of the teacher's functions.  It notes (without refusing)
+  the hook, from inside: during a check, frames taken by the answer's own
+  code, or by a library for it while the answer runs (``traceback.walk_stack``,
+  ``inspect.stack``: from any frame, ``f_back`` and ``f_locals``, which Python
+  does not audit, lead to the check's values), and a check's verdict is not
+  the teacher's if an answer's paused generator had its frame taken before
+  (resumed inside the check, that frame leads there too); at any time, an
+  answer's ``ctypes`` and ``/proc/*/mem`` (raw memory), the garbage
+  collector's object lists, tracers, other threads' frames, the hook's own
+  frames in a traceback, a second audit hook, and changing the code or
+  defaults of the teacher's functions.  It notes (without refusing)
   an answer's connections, processes and files outside its folder.
 * Each verdict (``begin``, ``verdict``, ``note``) goes out as a line signed with
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
@@ -33,8 +38,9 @@ comes from the seal's signed verdicts, not from the cell's output:
 What the seal does not stop: code that changes a check's objects *and*
 puts them back within one call from the check, or from a thread of its
 own while the check runs (the snapshot is compared at the check's start
-and end), and frames reached through a library function that walks the
-stack (``traceback.walk_stack``), which can read a check's expected values.
+and end), and a signal handler of the answer's, to which Python hands the
+running frame with no audit event (one raised by ``_thread.interrupt_main()``
+inside a check reads the check's values).
 The sandbox (:mod:`tutorial.tools.grading.sandbox`) bounds what such code could
 reach.  The hook itself never calls an answer's code (no ``str()``, no
 library function an answer could replace), so nothing runs unwatched inside it.
@@ -49,6 +55,7 @@ from __future__ import annotations
 
 import ast
 import builtins
+import gc
 import importlib
 import importlib.util
 import inspect
@@ -60,6 +67,33 @@ import types
 # What a verdict line carries: the fields below, tab-separated, then the HMAC-SHA256 of the line so far.
 BEGIN, VERDICT, NOTE = "begin", "verdict", "note"
 FRAME_ATTRIBUTES = frozenset({"tb_frame", "gi_frame", "cr_frame", "ag_frame"})
+# While an answer runs inside a check, a library may take a frame only to read it itself (its caller's file, line
+# or module): these functions, each (end of its file's path, qualified name), through the wrappers below.  Any other
+# frame taken then (traceback.walk_stack, walk_tb, inspect.stack, ...) could be handed to the answer, and from it
+# f_back and f_locals, which Python does not audit, lead to the check's own values: refused.
+FRAME_CONSUMERS = frozenset(
+    {
+        ("/logging/__init__.py", "Logger.findCaller"),
+        ("/rclpy/impl/rcutils_logger.py", "CallerId.__new__"),
+        ("/collections/__init__.py", "namedtuple"),
+        ("/typing.py", "_caller"),
+        ("/enum.py", "EnumType._create_"),
+        ("/warnings.py", "warn"),
+        ("/numpy/lib/_index_tricks_impl.py", "AxisConcatenator.__getitem__"),
+        ("/numpy/matrixlib/defmatrix.py", "bmat"),
+        *(("/traceback.py", name) for name in ("print_stack", "extract_stack", "format_stack", "clear_frames")),
+    }
+)
+# traceback's formatting (print_exc, logging's exc_info): its lines, and the frames' locals only if asked for them
+TRACEBACK_LINES = ("/traceback.py", "StackSummary._extract_from_extended_frame_gen")
+FRAME_WRAPPERS = frozenset(
+    {
+        ("/inspect.py", "currentframe"),
+        ("/logging/__init__.py", "<lambda>"),
+        *(("/traceback.py", name) for name in ("walk_stack", "walk_tb", "_walk_tb_with_full_positions")),
+        ("/traceback.py", "StackSummary.extract.<locals>.extended_frame_gen"),
+    }
+)
 NOTED = frozenset({"socket.connect", "socket.sendto", "os.fork", "os.forkpty", "subprocess.Popen", "os.posix_spawn"})
 NOT_COMPARED = frozenset(
     {"_", "input", "exit", "quit", "display", "get_ipython", "__IPYTHON__", "copyright", "credits"}
@@ -144,7 +178,9 @@ def install(
         "readlink": os.readlink,
         "get_ident": _thread.get_ident,
         **{name: globals()[name] for name in ("BEGIN", "VERDICT", "NOTE", "NOT_COMPARED", "NOTED")},
-        "FRAME_ATTRIBUTES": FRAME_ATTRIBUTES,
+        **{n: globals()[n] for n in ("FRAME_ATTRIBUTES", "FRAME_CONSUMERS", "FRAME_WRAPPERS", "TRACEBACK_LINES")},
+        "get_objects": gc.get_objects,
+        "get_referents": gc.get_referents,
         "_make_hook_code": _make_hook.__code__,
         "loaded": sys.modules,  # the import system's own dict (rebinding sys.modules does not change it)
     }
@@ -324,6 +360,48 @@ def _make_hook(
             frame, depth = frame.f_back, depth - 1
         return False
 
+    def answer_running(frame):
+        """Whether an answer's code runs between ``frame`` and the teacher's check below it (or with no check
+        below it at all: a thread of the answer's)."""
+        while frame is not None:
+            if id(frame.f_code) in check_codes:
+                return False
+            if learner(frame):
+                return True
+            frame = frame.f_back
+        return False
+
+    def named(code, names):
+        name = code.co_filename
+        return any(name.endswith(end) and code.co_qualname == qualname for end, qualname in names)
+
+    def consumer(frame):
+        """Whether the library code that took a frame, past its wrappers, is one of :data:`FRAME_CONSUMERS`."""
+        while frame is not None and not learner(frame) and named(frame.f_code, FRAME_WRAPPERS):  # noqa: F821
+            frame = frame.f_back
+        if frame is None or learner(frame):
+            return False
+        if named(frame.f_code, (TRACEBACK_LINES,)):  # noqa: F821 - a private global
+            return dict.get(frame.f_locals, "capture_locals") is False  # never an answer's object's __bool__
+        return named(frame.f_code, FRAME_CONSUMERS)  # noqa: F821
+
+    def frame_taken(caller):
+        """Whether a frame taken by ``caller`` during a check could reach the answer: the answer's own call, or a
+        library's for it (not one that keeps the frame to itself)."""
+        return learner(caller) or (answer_running(caller) and not consumer(caller))
+
+    paused_kinds = {types.GeneratorType: "gi_code", types.CoroutineType: "cr_code", types.AsyncGeneratorType: "ag_code"}
+
+    def paused_frames():
+        """Whether an answer's paused generator or coroutine has had its frame taken: resumed inside a check, that
+        frame's f_back would lead to the check's."""
+        for obj in get_objects():  # noqa: F821 - a private global
+            attribute = paused_kinds.get(type(obj))
+            if attribute is not None and learner_code(getattr(obj, attribute)):
+                if any(type(r) is frame_type for r in get_referents(obj)):  # noqa: F821 - a frame made for it
+                    return True
+        return False
+
     def number_of(exercise):
         if type(exercise) is not str:
             return "?"  # never str() of an answer's own object: its __str__ would run inside the hook
@@ -384,6 +462,8 @@ def _make_hook(
                 state["refused"] = []
                 state["number"] = number_of(args[0])
                 state["begin_changes"] = changed(genuine_check(caller.f_back))
+                if paused_frames():
+                    state["begin_changes"].append("an answer's paused generator had its frame taken")
                 send(BEGIN, number_of(args[0]))
         elif event == "rtt.check_end":
             if caller.f_code is grade_code and ours(caller):
@@ -457,14 +537,14 @@ def _make_hook(
             frame = getattr(args[0], args[1], None)  # read here, where the hook lets its own events pass
             if type(frame) is frame_type and frame.f_code in hook_codes:
                 refuse("reading the grader's own frames")
-            if state["checks"] > 0 and learner(caller):
+            if state["checks"] > 0 and frame_taken(caller):
                 refuse(f"reading {args[1]} during a check")
         elif event in NOTED:
             if learner_near(caller):
                 send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
         elif event == "sys._getframe" and state["checks"] > 0 and type(args[0]) is frame_type:
-            if learner(caller) or (learner(args[0]) and caller.f_back is not None and learner(caller.f_back)):
-                refuse("reading frames during a check")  # the answer's own call, or inspect.currentframe()'s
+            if frame_taken(caller):
+                refuse("reading frames during a check")  # the answer's own call, inspect.currentframe()'s, ...
 
     def genuine_check(frame):
         """The id of the teacher's check whose code ``frame`` runs with its module's real globals, or None."""
