@@ -903,3 +903,132 @@ def test_the_seal_withstands_the_attacks_a_review_found():
     for what in ("gc", "evil", "hook", "traceback", "settrace"):
         assert f"{what} refused" in done.stderr, (what, done.stderr)
     assert "EVIL RAN" not in done.stderr and "SECOND HOOK" not in done.stderr, done.stderr
+    notes = [line[1:3] for line in signed_lines(done.stdout) if line[0] == "note"]
+    assert ["refused", "reading the grader's own frames"] in notes, notes  # the teacher reads why
+
+
+def test_an_answer_that_replaces_a_builtin_during_a_check_does_not_change_the_seals_answers():
+    """The hook runs with a private copy of the builtins: an answer that makes any() say yes to "does this library
+    keep the frame to itself?" while it walks the stack, and puts any() back before the check sees it, is still
+    refused.  With the builtins shared (the mutant install_38), it got full marks, genuine."""
+    script = SEALED_1_1 + textwrap.dedent(
+        """
+        import builtins, traceback
+
+        def own_traceback():
+            try:
+                1 / 0
+            except ZeroDivisionError as e:
+                return e.__traceback__
+
+        def dpad_track_velocities(axes):
+            real = builtins.any
+            builtins.any = lambda names: len(list(names)) == len(seal.FRAME_CONSUMERS)  # only the hook asks that
+            try:
+                frame = next(traceback.walk_tb(own_traceback()))[0]
+            finally:
+                builtins.any = real  # put back within the call: the snapshot at the check's end sees nothing
+            while frame is not None and "expected" not in frame.f_locals:
+                frame = frame.f_back
+            return frame.f_locals["expected"] if frame is not None else (0.0, 0.0)
+
+        try:
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+        except (AssertionError, RuntimeError) as e:
+            print("refused" if "sandbox refused" in str(e) else "failed", file=sys.stderr)
+        """
+    )
+    done = sealed(script)
+    assert "refused" in done.stderr.split(), done.stderr
+    verdicts = [line[1:] for line in signed_lines(done.stdout) if line[0] == "verdict"]
+    assert verdicts == [["1.1", "0", "0", "reading tb_frame during a check"]], verdicts
+
+
+def test_a_check_modules_helper_changed_through_its_closure_is_tampering():
+    """A helper made by a decorator (step5's contextmanager _viewer) holds the function it runs in a closure
+    cell, which an answer can set without any audit event: swapped before the check, it is told at the check's
+    begin, as a changed closure of a function the check uses in its own module."""
+    script = textwrap.dedent(
+        """
+        import sys
+        from tutorial.tools.grading import seal
+        seal.install(b"k" * 32, 1, ["check_horizontal_arrow(HorizontalArrow).require()"],
+                     checks=["tutorial.exercises.step5_imu_viewer"])
+        import tutorial.exercises.step5_imu_viewer as step5
+        from tutorial.exercises.step5_imu_viewer import check_horizontal_arrow
+
+        class HorizontalArrow:
+            pass
+
+        def no_viewer(cls, name):  # the check's viewer, swapped for the answer's
+            raise RuntimeError("the answer's viewer")
+            yield
+
+        step5._viewer.__closure__[0].cell_contents = no_viewer
+        try:
+            exec(compile("check_horizontal_arrow(HorizontalArrow).require()", "/tmp/ipykernel_0/cell.py", "single"))
+        except (AssertionError, RuntimeError):
+            pass
+        """
+    )
+    verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
+    assert verdicts == [["5.1", "0", "0", "tutorial.exercises.step5_imu_viewer._viewer's closure was changed"]]
+
+
+def test_a_paused_coroutines_frame_taken_before_a_check_is_tampering():
+    """As a paused generator's (above): a coroutine's frame, taken while it waits, has the check's below it when
+    the answer resumes it inside the check.  (The mutant that looked up a coroutine's code under another name
+    let it through, and any coroutine in the kernel then stopped the whole scan.)"""
+    script = SEALED_1_1 + textwrap.dedent(
+        """
+        class Pause:
+            def __await__(self):
+                return (yield None)
+
+        found = []
+
+        async def reader():
+            me = sys._getframe()  # outside a check: allowed
+            while True:
+                await Pause()
+                frame = me
+                while frame is not None and "expected" not in frame.f_locals:
+                    frame = frame.f_back
+                found.append(frame.f_locals["expected"] if frame is not None else (0.0, 0.0))
+
+        coroutine = reader()
+        coroutine.send(None)  # paused at its first await
+
+        def dpad_track_velocities(axes):
+            coroutine.send(None)
+            return found[-1]
+
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        """
+    )
+    verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
+    assert verdicts == [["1.1", "1", "0", "an answer's paused generator had its frame taken"]], verdicts
+
+
+def test_a_library_compiled_from_its_source_by_the_import_system_imports_unnoted():
+    """Where no cached code can be read or written (a read-only library, a new pycache_prefix), the import system
+    compiles the library's source: its frames (frozen, "<frozen importlib._bootstrap>") are Python's own, not an
+    answer's claiming the library's file name.  And the compiled code it writes, outside the answer's folder and
+    far below the answer's import, is the import system's file, not one the answer opened: not noted."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(dir="/var/tmp") as cache:  # outside the answer's folder and /tmp/
+        done = sealed(
+            "import sys\n"
+            "from tutorial.tools.grading import seal\n"
+            "seal.install(b'k' * 32, 1, [])\n"
+            f"sys.pycache_prefix = {cache!r}\n"
+            "sys.dont_write_bytecode = False\n"  # whatever PYTHONDONTWRITEBYTECODE says
+            "assert 'colorsys' not in sys.modules\n"  # imported here, not before
+            "import colorsys\n"
+            "print('imported', colorsys.__name__)\n"
+        )
+        written = [p.name for p in __import__("pathlib").Path(cache).rglob("*.pyc")]
+    assert "imported colorsys" in done.stdout, done.stderr
+    assert written and written[0].startswith("colorsys."), written  # it was compiled here, and written
+    assert [line for line in signed_lines(done.stdout) if line[0] == "note"] == [], done.stdout
