@@ -7,7 +7,7 @@
 #       make bench (the benchmark suite; not part of make test; its plots go beside its results),
 #       make bench-figures (the last make bench's plots into the book: the only way they change),
 #       make mutate (mutation testing of the lessons, the library's core and every exercise's check: hours),
-#       make mutate-seal (the same for the grading kernel's seal, in a worktree of its own: two hours, SAMPLE=N),
+#       make mutate-seal (the same for the grading kernel's seal, in a worktree of its own: ten hours or more, SAMPLE=N),
 #       make fuzz (the property-based tests with 100 times the examples, random ones: several minutes),
 #       make test-lab (every notebook's Run All in JupyterLab, in a real browser: make test does 01; and a live
 #       view in Notebook 7 and in JupyterLab as Colab runs it),
@@ -113,7 +113,7 @@ mutate: $(VENV)/.installed
 	$(PY) scripts/mutation_report.py
 
 # The grading kernel's seal, which make mutate cannot reach (its tests run it in a Python of its own), in a git
-# worktree beside this one (scripts/mutate_seal.py says how): about two hours for its 1,025 mutants; SAMPLE=N runs
+# worktree beside this one (scripts/mutate_seal.py says how): about eleven hours for its 1,092 mutants; SAMPLE=N runs
 # N of them drawn at random.
 mutate-seal: $(VENV)/.installed
 	$(PY) scripts/mutate_seal.py $(if $(SAMPLE),--sample $(SAMPLE))

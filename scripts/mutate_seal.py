@@ -22,7 +22,7 @@ seal with ``tests/test_seal.py`` as the tests, and there:
 4. runs mutmut on every mutant, or on a seeded sample of ``N``, then
    ``scripts/mutation_report.py`` there.
 
-About 7 s a mutant on two cores: the seal's 1,025 take about two hours.
+About 35 s a mutant on two cores (2026-11-28, the seal's tests then 17 s): the seal's 1,092 take about eleven hours.
 Remove the worktree with ``git worktree remove --force DIR``.
 """
 
