@@ -721,6 +721,18 @@ def test_a_paused_generators_frame_taken_before_a_check_is_tampering():
         dpad_track_velocities = lambda axes: next(generator)
         cell("check_dpad_steering(dpad_track_velocities).require()")
         generator.close()
+        import warnings
+
+        def honest():  # its frame made by Python alone: an exception caught inside it, a warning
+            while True:
+                try:
+                    1 / 0
+                except ZeroDivisionError:
+                    warnings.warn("divided by zero")
+                yield 0.0
+
+        samples = honest()
+        next(samples)  # paused, with its frame made, across the next check
         dpad_track_velocities = lambda axes: (0.0, 0.0)
         try:
             cell("check_dpad_steering(dpad_track_velocities).require()")
@@ -731,7 +743,7 @@ def test_a_paused_generators_frame_taken_before_a_check_is_tampering():
     verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
     assert verdicts == [
         ["1.1", "1", "0", "an answer's paused generator had its frame taken"],  # it read the answers
-        ["1.1", "0", "1", ""],  # closed: nothing paused is left
+        ["1.1", "0", "1", ""],  # closed; the honest generator paused beside it is no tampering
     ], verdicts
 
 

@@ -25,7 +25,8 @@ comes from the seal's signed verdicts, not from the cell's output:
   ``inspect.stack``: from any frame, ``f_back`` and ``f_locals``, which Python
   does not audit, lead to the check's values), and a check's verdict is not
   the teacher's if an answer's paused generator had its frame taken before
-  (resumed inside the check, that frame leads there too); at any time, an
+  (resumed inside the check, that frame leads there too; one Python made
+  for an exception inside it, held by nothing else, is not); at any time, an
   answer's ``ctypes`` and ``/proc/*/mem`` (raw memory), the garbage
   collector's object lists, tracers, other threads' frames, the hook's own
   frames in a traceback, a second audit hook, and changing the code or
@@ -181,6 +182,7 @@ def install(
         **{n: globals()[n] for n in ("FRAME_ATTRIBUTES", "FRAME_CONSUMERS", "FRAME_WRAPPERS", "TRACEBACK_LINES")},
         "get_objects": gc.get_objects,
         "get_referents": gc.get_referents,
+        "getrefcount": sys.getrefcount,
         "_make_hook_code": _make_hook.__code__,
         "loaded": sys.modules,  # the import system's own dict (rebinding sys.modules does not change it)
     }
@@ -392,13 +394,32 @@ def _make_hook(
 
     paused_kinds = {types.GeneratorType: "gi_code", types.CoroutineType: "cr_code", types.AsyncGeneratorType: "ag_code"}
 
+    def frame_counts(obj):
+        """The reference counts of the frame objects ``obj`` (a generator or coroutine) holds, seen from here."""
+        return [getrefcount(r) for r in get_referents(obj) if type(r) is frame_type]  # noqa: F821 - private globals
+
+    def calibration():  # a paused generator whose frame only an exception made, as an honest answer's may be
+        while True:
+            try:
+                raise ValueError
+            except ValueError:
+                pass
+            yield
+
+    probe = calibration()
+    next(probe)
+    kept_alone = max(frame_counts(probe), default=0)  # the count of a frame its generator alone keeps
+    probe.close()
+
     def paused_frames():
         """Whether an answer's paused generator or coroutine has had its frame taken: resumed inside a check, that
-        frame's f_back would lead to the check's."""
+        frame's f_back would lead to the check's.  A frame that only Python made (an exception caught inside the
+        generator, a warning, a log line) is kept by its generator alone; one the answer took is kept by more (a
+        local of the generator's own, a list; frames take no weak references)."""
         for obj in get_objects():  # noqa: F821 - a private global
             attribute = paused_kinds.get(type(obj))
             if attribute is not None and learner_code(getattr(obj, attribute)):
-                if any(type(r) is frame_type for r in get_referents(obj)):  # noqa: F821 - a frame made for it
+                if any(n > kept_alone for n in frame_counts(obj)):
                     return True
         return False
 
