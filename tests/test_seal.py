@@ -664,6 +664,11 @@ STACK_WALKS = textwrap.dedent(
         traceback.extract_stack()
         collections.namedtuple("Tracks", "left right")
         typing.TypeVar("T")
+        from matplotlib import _api
+        from scipy._lib import _bunch
+
+        _api.warn_external("a plot's warning")  # matplotlib's, for the answer's line
+        _bunch._make_tuple_bunch("Fit", ["slope", "intercept"])  # scipy.stats' result classes
         forward, turn = joy.axis(axes, joy.DPAD_V), 0.5 * joy.axis(axes, joy.DPAD_H)
         return forward - turn, forward + turn
 
@@ -684,7 +689,8 @@ def test_a_library_that_walks_the_stack_for_an_answer_during_a_check_is_refused_
     """From any frame, f_back and f_locals (which Python does not audit) lead down to the check's own expected
     values.  So while an answer runs inside a check, a frame taken for it by a library (traceback's walks,
     inspect's, a stack summary with its locals) is refused, as its own are; logging, tracebacks told as text,
-    namedtuple and typing, which read their caller's frame themselves, still work there.
+    namedtuple, typing, matplotlib's warnings and scipy's result classes, which read their caller's frame
+    themselves, still work there.
     At b088ed8, walk_stack, walk_tb and getinnerframes gave full marks."""
     done = sealed(SEALED_1_1 + STACK_WALKS)
     said = [line for line in done.stderr.splitlines() if line.startswith(("traceback.", "inspect."))]

@@ -82,6 +82,8 @@ FRAME_CONSUMERS = frozenset(
         ("/warnings.py", "warn"),
         ("/numpy/lib/_index_tricks_impl.py", "AxisConcatenator.__getitem__"),
         ("/numpy/matrixlib/defmatrix.py", "bmat"),
+        ("/matplotlib/_api/__init__.py", "warn_external"),  # its warning's stack level, on Python 3.11
+        ("/scipy/_lib/_bunch.py", "_make_tuple_bunch"),  # its class's module, as namedtuple's
         *(("/traceback.py", name) for name in ("print_stack", "extract_stack", "format_stack", "clear_frames")),
     }
 )
