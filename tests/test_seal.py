@@ -622,10 +622,9 @@ def test_the_seals_own_data_replaced_by_an_answer_is_tampering():
     assert verdicts == [["1.1", "1", "0", "tutorial.tools.grading.seal.NOTED was replaced"]], verdicts
 
 
-STACK_WALKS = textwrap.dedent(
+# What a cheating answer does with a frame it got: reads the check's own expected values below it
+READ_EXPECTED = textwrap.dedent(
     """
-    import collections, inspect, logging, traceback, typing
-
     def expected_from(frame):  # the check's own expected value, from the frames below this one (f_back: no audit)
         while frame is not None and "expected" not in frame.f_locals:
             frame = frame.f_back
@@ -636,6 +635,11 @@ STACK_WALKS = textwrap.dedent(
             1 / 0
         except ZeroDivisionError as e:
             return e.__traceback__
+    """
+)
+STACK_WALKS = READ_EXPECTED + textwrap.dedent(
+    """
+    import collections, inspect, logging, traceback, typing
 
     def deeper(n):  # walk_stack(None) starts four frames up
         return deeper(n - 1) if n else next(traceback.walk_stack(None))[0]
@@ -711,16 +715,16 @@ def test_a_paused_generators_frame_taken_before_a_check_is_tampering():
     """A generator's frame taken while it is paused (here its own sys._getframe(), outside any check) gets a
     new f_back each time it is resumed: inside a check, the check's.  The seal looks for such frames of the
     answer's when a check begins."""
-    script = SEALED_1_1 + textwrap.dedent(
-        """
+    script = (
+        SEALED_1_1
+        + READ_EXPECTED
+        + textwrap.dedent(
+            """
         def paused():
             me = sys._getframe()  # outside a check: allowed
             yield None
             while True:
-                frame = me
-                while frame is not None and "expected" not in frame.f_locals:
-                    frame = frame.f_back
-                yield frame.f_locals["expected"] if frame is not None else (0.0, 0.0)
+                yield expected_from(me)
 
         generator = paused()
         next(generator)
@@ -745,6 +749,7 @@ def test_a_paused_generators_frame_taken_before_a_check_is_tampering():
         except AssertionError:
             pass
         """
+        )
     )
     verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
     assert verdicts == [
@@ -929,15 +934,12 @@ def test_an_answer_that_replaces_a_builtin_during_a_check_does_not_change_the_se
     """The hook runs with a private copy of the builtins: an answer that makes any() say yes to "does this library
     keep the frame to itself?" while it walks the stack, and puts any() back before the check sees it, is still
     refused.  With the builtins shared (the mutant install_38), it got full marks, genuine."""
-    script = SEALED_1_1 + textwrap.dedent(
-        """
+    script = (
+        SEALED_1_1
+        + READ_EXPECTED
+        + textwrap.dedent(
+            """
         import builtins, traceback
-
-        def own_traceback():
-            try:
-                1 / 0
-            except ZeroDivisionError as e:
-                return e.__traceback__
 
         def dpad_track_velocities(axes):
             real = builtins.any
@@ -946,15 +948,14 @@ def test_an_answer_that_replaces_a_builtin_during_a_check_does_not_change_the_se
                 frame = next(traceback.walk_tb(own_traceback()))[0]
             finally:
                 builtins.any = real  # put back within the call: the snapshot at the check's end sees nothing
-            while frame is not None and "expected" not in frame.f_locals:
-                frame = frame.f_back
-            return frame.f_locals["expected"] if frame is not None else (0.0, 0.0)
+            return expected_from(frame)
 
         try:
             cell("check_dpad_steering(dpad_track_velocities).require()")
         except (AssertionError, RuntimeError) as e:
             print("refused" if "sandbox refused" in str(e) else "failed", file=sys.stderr)
         """
+        )
     )
     done = sealed(script)
     assert "refused" in done.stderr.split(), done.stderr
@@ -997,8 +998,11 @@ def test_a_paused_coroutines_frame_taken_before_a_check_is_tampering():
     """As a paused generator's (above): a coroutine's frame, taken while it waits, has the check's below it when
     the answer resumes it inside the check.  (The mutant that looked up a coroutine's code under another name
     let it through, and any coroutine in the kernel then stopped the whole scan.)"""
-    script = SEALED_1_1 + textwrap.dedent(
-        """
+    script = (
+        SEALED_1_1
+        + READ_EXPECTED
+        + textwrap.dedent(
+            """
         class Pause:
             def __await__(self):
                 return (yield None)
@@ -1009,10 +1013,7 @@ def test_a_paused_coroutines_frame_taken_before_a_check_is_tampering():
             me = sys._getframe()  # outside a check: allowed
             while True:
                 await Pause()
-                frame = me
-                while frame is not None and "expected" not in frame.f_locals:
-                    frame = frame.f_back
-                found.append(frame.f_locals["expected"] if frame is not None else (0.0, 0.0))
+                found.append(expected_from(me))
 
         coroutine = reader()
         coroutine.send(None)  # paused at its first await
@@ -1023,6 +1024,7 @@ def test_a_paused_coroutines_frame_taken_before_a_check_is_tampering():
 
         cell("check_dpad_steering(dpad_track_velocities).require()")
         """
+        )
     )
     verdicts = [line[1:] for line in signed_lines(sealed(script).stdout) if line[0] == "verdict"]
     assert verdicts == [["1.1", "1", "0", "an answer's paused generator had its frame taken"]], verdicts
