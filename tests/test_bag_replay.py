@@ -17,6 +17,9 @@ def is_stale(line: str) -> bool:
     return '"event": "stale"' in line
 
 
+# make test: notebook 07 (nbval) records a drive and replays it into a Step 3 viewer, which ends on the recording's
+# last joint state; this case does the same with the rtt-bag, rtt-joy and rtt-run programs.
+@pytest.mark.more
 def test_a_replayed_drive_drives_the_viewer_as_the_live_one_did(procs, tmp_path):
     bag = tmp_path / "drive.mcap"
     # 1. Record a demo drive: the recorder first, so it is in the graph when the publishers appear.

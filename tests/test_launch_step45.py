@@ -13,6 +13,7 @@ def launch(procs, step, *args):
     return procs([sys.executable, "-u", str(ROOT / "launch_py" / f"step{step}_launch.py"), *args])
 
 
+@pytest.mark.more  # make test: Step 5's launch starts Step 4's IMU publisher too (below), and stops every node
 def test_step4_launch_publishes_the_imu_for_its_duration(procs):
     run = launch(procs, 4, "--demo", "--headless", "--duration", "3")
     assert run.wait(60) == 0, run.out

@@ -387,6 +387,8 @@ def test_the_page_draws_every_transform_of_a_batch_from_one_websocket_message(se
         assert page.evaluate("window.__messages") - before == 1
 
 
+# make test: the page's other software-renderer setting (fewer triangles, below)
+@pytest.mark.more
 @pytest.mark.browser
 @pytest.mark.skipif(chromium() is None, reason="chromium is not installed (make test installs it)")
 def test_the_page_leaves_out_multisampling_on_a_software_renderer_unless_asked(server_of):
