@@ -146,6 +146,22 @@ def test_7_1_released_joys_come_as_zeros_negative_zeros_fewer_axes_or_none():
     assert shapes == {"none", "negative", "eight", "fewer"} and lengths == set(range(9))
 
 
+def test_7_1_a_long_bags_joys_hold_buttons_now_and_then_and_the_other_kinds_none():
+    """A button held is no push (the rule counts axes): a long bag's Joys hold each of their 8 buttons with a chance
+    of 0.3, so some Joys hold buttons and some do not; the other kinds' Joys hold none."""
+    held = []
+    for seed in SEEDS:
+        for topic, _, msg in step7._random_joy_bag(random.Random(seed), "long"):
+            if topic == step7.JOY:
+                assert len(msg.buttons) == 8
+                held += list(msg.buttons)
+    assert set(held) == {0, 1} and 0.25 < sum(held) / len(held) < 0.35
+    for kind in KINDS[:-1]:
+        for seed in SEEDS[:30]:
+            joys = [msg for topic, _, msg in step7._random_joy_bag(random.Random(seed), kind) if topic == step7.JOY]
+            assert all(list(msg.buttons) == [0] * 8 for msg in joys)
+
+
 @pytest.mark.parametrize("kind", KINDS)
 def test_7_1_a_hidden_bags_joys_are_stamped_by_the_gamepads_clock_1_to_30_ms_before_they_were_logged(kind):
     clocks, leads = [], []
