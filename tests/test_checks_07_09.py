@@ -156,7 +156,7 @@ def test_7_1_a_long_bags_joys_hold_buttons_now_and_then_and_the_other_kinds_none
                 assert len(msg.buttons) == 8
                 held += list(msg.buttons)
     assert set(held) == {0, 1} and 0.25 < sum(held) / len(held) < 0.35
-    for kind in KINDS[:-1]:
+    for kind in (k for k in KINDS if k != "long"):
         for seed in SEEDS[:30]:
             joys = [msg for topic, _, msg in step7._random_joy_bag(random.Random(seed), kind) if topic == step7.JOY]
             assert all(list(msg.buttons) == [0] * 8 for msg in joys)
