@@ -976,6 +976,39 @@ def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wro
     assert str(result) == snapshot  # its case, its values and its hint, word for word
 
 
+@pytest.mark.parametrize("mixin", [False, True], ids=["its own class", "a class after RttTankController"])
+def test_1_2_a_count_kept_in_names_shaped_like_pythons_own_is_still_watched_for_the_lock(ros, mixin):
+    """``self.__shots__`` is not mangled (it ends in two underscores) and is the answer's state like any other
+    name: a red-team submission kept its count there, outside the lock, and passed 1.2 with every hidden case.
+    Its class attributes may also come from a class after ``RttTankController`` in the MRO."""
+    ex = exercise("1.2")
+    wrong = put_in(
+        ex["solution"],
+        (
+            "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
+            "            self.a_down = down\n",
+            "        with self._lock:\n            shots = self.shots\n",
+        ),
+        (
+            "        if down and not self.__down__:\n            self.__shots__ += 1\n        self.__down__ = down\n",
+            "        shots = self.__shots__\n",
+        ),
+    )
+    if mixin:
+        wrong = "class Counts:\n    __shots__ = 0\n    __down__ = False\n\n\n" + wrong.replace(
+            "(RttTankController):", "(RttTankController, Counts):"
+        )
+    else:
+        wrong = wrong.replace("    shots = 0", "    __shots__ = 0").replace(
+            "    a_down = False", "    __down__ = False"
+        )
+    result = grade(ex, ex["stub"], wrong)
+    assert not result.passed, str(result)
+    assert "self.__shots__ outside `with self._lock:`" in str(result) or "self.__down__ outside" in str(result), str(
+        result
+    )
+
+
 @pytest.mark.parametrize(
     "number,right,wrong,function",
     [

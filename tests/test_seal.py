@@ -930,6 +930,61 @@ def test_the_seal_withstands_the_attacks_a_review_found():
     assert ["refused", "reading the grader's own frames"] in notes, notes  # the teacher reads why
 
 
+def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_and_a_failed_cases_frames_go():
+    """Found by a red-team review, each gave full points unflagged: ``random.Random`` replaced (every check ran
+    its visible cases alone), and the check's own frames read from an answer's exception once the check had
+    ended (every case, hidden ones with what they expect).  Now a replaced ``random.Random`` or
+    ``numpy.allclose``, or a method of ``random.Random``, is tampering, the seed goes to no Random an answer
+    changed, and an exception an answer raised in a case has no frames left when the check returns."""
+    script = SEALED_1_1.replace(
+        '["check_dpad_steering(dpad_track_velocities).require()"])',
+        '["check_dpad_steering(dpad_track_velocities).require()"], seed="s")',
+    ) + textwrap.dedent(
+        """
+        import random, numpy
+        real, seen = random.Random, []
+
+        class Spy(real):
+            def __init__(self, x=None):
+                seen.append(x)
+                super().__init__(x)
+
+        random.Random = Spy
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        print("seeds seen:", seen, file=sys.stderr)
+        random.Random, real_allclose = real, numpy.allclose
+        numpy.allclose = lambda *a, **k: True
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        numpy.allclose = real_allclose
+        real_seed = random.Random.seed
+        random.Random.seed = lambda self, *a, **k: seen.append(a) or real_seed(self, *a, **k)
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        print("seeds seen by a method:", seen, file=sys.stderr)
+        random.Random.seed = real_seed
+        kept = []
+
+        def probe(axes):
+            kept.append(ValueError())
+            raise kept[0]
+
+        try:
+            cell("check_dpad_steering(probe).require()")
+        except AssertionError:
+            pass
+        print("frames left:", kept[0].__traceback__, file=sys.stderr)
+        cell("check_dpad_steering(dpad_track_velocities).require()")
+        """
+    )
+    done = sealed(script)
+    verdicts = [line[1:] for line in signed_lines(done.stdout) if line[0] == "verdict"]
+    assert verdicts[0][:3] == ["1.1", "1", "0"] and "random.Random was replaced" in verdicts[0][3], verdicts
+    assert verdicts[1][:3] == ["1.1", "1", "0"] and "numpy.allclose was replaced" in verdicts[1][3], verdicts
+    assert verdicts[2][:3] == ["1.1", "1", "0"] and "random.Random.seed was replaced" in verdicts[2][3], verdicts
+    assert verdicts[3][:2] == ["1.1", "0"] and verdicts[4] == ["1.1", "1", "1", ""], verdicts  # put back: genuine
+    assert "seeds seen: []" in done.stderr and "seeds seen by a method: []" in done.stderr, done.stderr
+    assert "frames left: None" in done.stderr, done.stderr
+
+
 def test_an_answer_that_replaces_a_builtin_during_a_check_does_not_change_the_seals_answers():
     """The hook runs with a private copy of the builtins: an answer that makes any() say yes to "does this library
     keep the frame to itself?" while it walks the stack, and puts any() back before the check sees it, is still

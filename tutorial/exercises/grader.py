@@ -145,16 +145,46 @@ def _run_cases(exercise: str, cases: Iterable[Case]) -> Result:
         try:
             case.run()
         except Exception as exc:  # noqa: BLE001 - a hidden case is told by what it tests
-            if not case.hidden:
-                return _failed(exercise, case, exc)
+            failure = exc
+        else:
+            continue
+        if not case.hidden:
+            result = _failed(exercise, case, failure)
+        else:
             hint = f" Hint: {case.hint}" if case.hint else ""
-            said = "" if isinstance(exc, CaseFailed) else f" ({type(exc).__name__})"
-            return Result(exercise, False, f"a hidden case failed{said}: {case.call}.{hint}", case.call)
+            said = "" if isinstance(failure, CaseFailed) else f" ({type(failure).__name__})"
+            result = Result(exercise, False, f"a hidden case failed{said}: {case.call}.{hint}", case.call)
+        _forget_frames(failure)
+        return result
     if count == 0:
         raise ValueError(f"{exercise}: a check with no cases cannot pass")
     shown = count - hidden
     more = f" and {hidden} hidden one{'s' if hidden != 1 else ''}" if hidden else ""
     return Result(exercise, True, f"passed ({shown} case{'s' if shown != 1 else ''}{more}).")
+
+
+def _forget_frames(exc: BaseException) -> None:
+    """Take the traceback off ``exc`` and every exception it chains (the check's own, and an answer's it raised).
+
+    An answer can keep the exception it raised inside a case; once the check has returned, the frames of its
+    traceback (this function's caller among them) would still hold every case, hidden ones too, with what each
+    expects.  The seal refuses reading them while a check runs; after it, nothing holds them.  Reads the chain
+    through ``BaseException``'s own descriptors, never an answer's class (its ``__context__`` could be a property).
+    """
+    todo, seen = [exc], set()
+    while todo:
+        e = todo.pop()
+        if not isinstance(e, BaseException) or id(e) in seen:
+            continue
+        seen.add(id(e))
+        BaseException.with_traceback(e, None)  # its traceback, and with it the frames, let go (never read here)
+        todo += [_CONTEXT.__get__(e), _CAUSE.__get__(e)]
+        if isinstance(e, BaseExceptionGroup):
+            todo += list(_GROUP.__get__(e))
+
+
+_CONTEXT, _CAUSE = vars(BaseException)["__context__"], vars(BaseException)["__cause__"]
+_GROUP = vars(BaseExceptionGroup)["exceptions"]
 
 
 def _failed(exercise: str, case: Case, exc: Exception) -> Result:
@@ -206,11 +236,20 @@ def raise_run_error(summary: dict) -> None:
         raise CaseFailed("the simulation failed: " + error.strip().splitlines()[-1].rstrip(".") + ".")
 
 
+class _ExactTypes(frozenset):
+    """Types, where ``kind in types`` means one of them itself: compared by identity, never by ``==``, which a
+    class of an answer's could answer through its own metaclass (its ``__eq__`` and ``__hash__`` those of
+    ``float``)."""
+
+    def __contains__(self, kind) -> bool:
+        return any(kind is t for t in frozenset.__iter__(self))
+
+
 def _number_types() -> frozenset[type]:
     import numpy
 
     scalars = {t for t in numpy.sctypeDict.values() if issubclass(t, (numpy.integer, numpy.floating))}
-    return frozenset({int, float} | scalars)
+    return _ExactTypes({int, float} | scalars)
 
 
 # The types of number an answer may return, exactly: a subclass of float could compare equal to anything.
@@ -254,7 +293,8 @@ def same_value(got, expected) -> bool:
 def _suspect(got) -> None:
     """Tell the grading kernel's seal when a value's class is an answer's own and could compare as it likes."""
     kind = type(got)
-    if isinstance(got, (int, float, str)) or any("__eq__" in vars(k) for k in kind.__mro__[:-1]):
+    classes = [*kind.__mro__[:-1], *type(kind).__mro__[:-1]]  # its own, and its metaclass's
+    if isinstance(got, (int, float, str)) or any("__eq__" in vars(k) for k in classes):
         if kind.__module__ not in ("builtins", "numpy"):
             sys.audit("rtt.suspect", f"a {kind.__name__!s:.40}, a class of its own that compares as it likes")
 

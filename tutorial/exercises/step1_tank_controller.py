@@ -297,8 +297,10 @@ def _watched(cls):
 
     def note(obj, what: str, name: str) -> None:
         d = object.__getattribute__(obj, "__dict__")
-        if d.get("_phase") is None or name.startswith("__"):  # the check's own _phase and _watch: never through here
+        if d.get("_phase") is None:  # the check's own _phase and _watch: never through here
             return
+        if what == "read" and name[:2] == name[-2:] == "__" and name not in d and not _answers_own(type(obj), name):
+            return  # Python's own (__class__, __dict__); state named like them (self.__shots__) is noted
         if hasattr(type(getattr(type(obj), name, None)), "__get__"):
             return  # a method or a property: what it touches is noted when it runs
         d["_watch"].append((d["_phase"], what, name, d["_lock"].held))
@@ -314,3 +316,13 @@ def _watched(cls):
 
     Watched.__name__ = Watched.__qualname__ = cls.__name__
     return Watched
+
+
+def _answers_own(kind: type, name: str) -> bool:
+    """Whether a class of the answer's (below ``RttTankController`` in ``kind``'s MRO) defines ``name`` itself."""
+    for k in kind.__mro__[1:]:  # [0] is the check's Watched
+        if k.__name__ == "RttTankController":
+            return False
+        if name in vars(k):
+            return True
+    return False
