@@ -935,7 +935,8 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
     its visible cases alone), and the check's own frames read from an answer's exception once the check had
     ended (every case, hidden ones with what they expect).  Now a replaced ``random.Random`` or
     ``numpy.allclose``, or a method of ``random.Random``, is tampering, the seed goes to no Random an answer
-    changed, and an exception an answer raised in a case has no frames left when the check returns."""
+    changed, an exception an answer raised in a case has no frames left when the check returns, and the
+    check's frames that one it caught itself leads to (``f_back``) hold nothing once the check has ended."""
     script = SEALED_1_1.replace(
         '["check_dpad_steering(dpad_track_velocities).require()"])',
         '["check_dpad_steering(dpad_track_velocities).require()"], seed="s")',
@@ -972,6 +973,21 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
         except AssertionError:
             pass
         print("frames left:", kept[0].__traceback__, file=sys.stderr)
+
+        def caught(axes):  # its own exception, caught inside the case: its frame's f_back is the check's
+            try:
+                raise ValueError
+            except ValueError as e:
+                kept.append(e)
+            return 0.0, 0.0
+
+        try:
+            cell("check_dpad_steering(caught).require()")
+        except AssertionError:
+            pass
+        back = kept[-1].__traceback__.tb_frame.f_back
+        locals_now = back.f_code.co_name, dict(back.f_locals), dict(back.f_back.f_locals)
+        print("the check's locals:", *locals_now, file=sys.stderr)
         cell("check_dpad_steering(dpad_track_velocities).require()")
         """
     )
@@ -980,9 +996,11 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
     assert verdicts[0][:3] == ["1.1", "1", "0"] and "random.Random was replaced" in verdicts[0][3], verdicts
     assert verdicts[1][:3] == ["1.1", "1", "0"] and "numpy.allclose was replaced" in verdicts[1][3], verdicts
     assert verdicts[2][:3] == ["1.1", "1", "0"] and "random.Random.seed was replaced" in verdicts[2][3], verdicts
-    assert verdicts[3][:2] == ["1.1", "0"] and verdicts[4] == ["1.1", "1", "1", ""], verdicts  # put back: genuine
+    assert verdicts[3][:2] == verdicts[4][:2] == ["1.1", "0"], verdicts  # the probes: wrong answers
+    assert verdicts[5] == ["1.1", "1", "1", ""], verdicts  # all put back: genuine
     assert "seeds seen: []" in done.stderr and "seeds seen by a method: []" in done.stderr, done.stderr
     assert "frames left: None" in done.stderr, done.stderr
+    assert "the check's locals: <lambda> {} {}" in done.stderr, done.stderr  # the case's, then _run_cases'
 
 
 def test_an_answer_that_replaces_a_builtin_during_a_check_does_not_change_the_seals_answers():

@@ -20,7 +20,9 @@ comes from the seal's signed verdicts, not from the cell's output:
   ``require`` called by a statement compiled exactly like the test cell's
   call.  Each time the snapshot is compared, object by object.
 * The hook refuses what would let an answer read or change the checks, or
-  the hook, from inside: during a check, frames taken by the answer's own
+  the hook, from inside: after a check, the first frame an answer reads
+  clears every ended frame of the checks' code (one kept from the check
+  leads there through ``f_back``); during a check, frames taken by the answer's own
   code, or by a library for it while the answer runs (``traceback.walk_stack``,
   ``inspect.stack``: from any frame, ``f_back`` and ``f_locals``, which Python
   does not audit, lead to the check's values), and a check's verdict is not
@@ -295,6 +297,12 @@ def _make_hook(
         code = stack.pop()
         hook_codes.add(code)
         stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
+    checks_codes = set()  # every code object of the checks' package (checks, grader, their helpers), nested ones too
+    stack = [f.__code__ for _, f, *_ in function_parts if f.__module__.startswith("tutorial.exercises")]
+    while stack:
+        code = stack.pop()
+        checks_codes.add(code)
+        stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
     modules_now = [(m.__name__, m) for m in modules]
     frame_holders = (types.TracebackType, types.GeneratorType, types.CoroutineType, types.AsyncGeneratorType)
     result_type = grader.Result
@@ -477,6 +485,18 @@ def _make_hook(
         if why is not None:  # raised here, its traceback holds no frame of act(); the hook's own is refused
             raise RuntimeError(f"the grader's sandbox refused: {why}")
 
+    def forget_checks_frames():
+        """Clear every frame of the checks' code that has ended (its locals: cases, what each expects, the seed's
+        random source): a frame made during a check (a traceback's, of an exception an answer raised and kept)
+        outlives it, and ``f_back`` from it, which Python does not audit, leads to the check's frames."""
+        state["frames_left"] = False  # until the next check: no frame of the checks' is made outside one
+        for obj in get_objects():  # noqa: F821 - a private global
+            if type(obj) is frame_type and obj.f_code in checks_codes:
+                try:
+                    frame_type.clear(obj)
+                except RuntimeError:
+                    pass  # still running (a thread of a check's): not the answer's to read either
+
     def ours(frame):
         """Whether ``frame`` runs with the grader module's real globals (not a copy an answer made)."""
         return frame is not None and frame.f_globals is grader_globals
@@ -490,6 +510,7 @@ def _make_hook(
             if caller.f_code is grade_code and ours(caller):
                 state["checks"] += 1
                 state["refused"] = []
+                state["frames_left"] = True
                 state["number"] = number_of(args[0])
                 state["begin_changes"] = changed(genuine_check(caller.f_back))
                 if paused_frames():
@@ -570,6 +591,9 @@ def _make_hook(
                 refuse("reading the grader's own frames")
             if state["checks"] > 0 and frame_taken(caller):
                 refuse(f"reading {args[1]} during a check")
+            if state["checks"] == 0 and state.get("frames_left") and learner_near(caller):
+                forget_checks_frames()  # f_back of an answer's own frame, kept from a check, leads to the check's
+
         elif event in NOTED:
             if learner_near(caller):
                 send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
