@@ -988,6 +988,25 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
         back = kept[-1].__traceback__.tb_frame.f_back
         locals_now = back.f_code.co_name, dict(back.f_locals), dict(back.f_back.f_locals)
         print("the check's locals:", *locals_now, file=sys.stderr)
+        # a second review: a thread of the answer's whose target is a C callable has no answer frame on its stack
+        import _thread, gc, operator, threading, time
+
+        try:
+            cell("check_dpad_steering(caught).require()")
+        except AssertionError:
+            pass
+        out = []
+        t = threading.Thread(target=out.extend, args=(map(operator.attrgetter("tb_frame"), [kept[-1].__traceback__]),))
+        t.start()
+        t.join()
+        back = out[0].f_back
+        print("from a thread, the check's locals:", back.f_code.co_name, dict(back.f_locals), file=sys.stderr)
+        t = threading.Thread(target=out.extend, args=(map(gc.get_objects, [None]),))
+        t.start()
+        t.join()
+        _thread.start_new_thread(out.extend, (map(gc.get_objects, [None]),))  # a raw thread: no Python frame at all
+        time.sleep(1.0)
+        print("objects got:", len(out), file=sys.stderr)
         cell("check_dpad_steering(dpad_track_velocities).require()")
         """
     )
@@ -996,11 +1015,16 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
     assert verdicts[0][:3] == ["1.1", "1", "0"] and "random.Random was replaced" in verdicts[0][3], verdicts
     assert verdicts[1][:3] == ["1.1", "1", "0"] and "numpy.allclose was replaced" in verdicts[1][3], verdicts
     assert verdicts[2][:3] == ["1.1", "1", "0"] and "random.Random.seed was replaced" in verdicts[2][3], verdicts
-    assert verdicts[3][:2] == verdicts[4][:2] == ["1.1", "0"], verdicts  # the probes: wrong answers
-    assert verdicts[5] == ["1.1", "1", "1", ""], verdicts  # all put back: genuine
+    assert len(verdicts) == 7 and all(v[:2] == ["1.1", "0"] for v in verdicts[3:6]), verdicts  # the probes: wrong
+    assert verdicts[6] == ["1.1", "1", "1", ""], verdicts  # all put back: genuine
     assert "seeds seen: []" in done.stderr and "seeds seen by a method: []" in done.stderr, done.stderr
     assert "frames left: None" in done.stderr, done.stderr
     assert "the check's locals: <lambda> {} {}" in done.stderr, done.stderr  # the case's, then _run_cases'
+    assert "from a thread, the check's locals: <lambda> {}" in done.stderr, done.stderr
+    assert "objects got: 1" in done.stderr, done.stderr  # the frame alone: both lists of every object refused
+    notes = [line[1:3] for line in signed_lines(done.stdout) if line[0] == "note"]
+    assert ["refused", "gc.get_objects in a thread other than the kernel's main thread"] in notes, notes
+    assert ["refused", "gc.get_objects from a thread with no Python code"] in notes, notes
 
 
 def test_an_answer_that_replaces_a_builtin_during_a_check_does_not_change_the_seals_answers():

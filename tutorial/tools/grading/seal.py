@@ -22,7 +22,9 @@ comes from the seal's signed verdicts, not from the cell's output:
 * The hook refuses what would let an answer read or change the checks, or
   the hook, from inside: after a check, the first frame an answer reads
   clears every ended frame of the checks' code (one kept from the check
-  leads there through ``f_back``); during a check, frames taken by the answer's own
+  leads there through ``f_back``); in any thread but the kernel's main one (an answer's thread may run a C
+  callable, leaving no answer frame on its stack), the lists of every object and of every thread's frames,
+  and a running check's frames; during a check, frames taken by the answer's own
   code, or by a library for it while the answer runs (``traceback.walk_stack``,
   ``inspect.stack``: from any frame, ``f_back`` and ``f_locals``, which Python
   does not audit, lead to the check's values), and a check's verdict is not
@@ -187,6 +189,7 @@ def install(
         "lstat": os.lstat,
         "readlink": os.readlink,
         "get_ident": _thread.get_ident,
+        "main_thread": _thread.get_ident(),  # install runs on the kernel's main thread
         **{name: globals()[name] for name in ("BEGIN", "VERDICT", "NOTE", "NOT_COMPARED", "NOTED", "STANDARD_MODULES")},
         **{n: globals()[n] for n in ("FRAME_ATTRIBUTES", "FRAME_CONSUMERS", "FRAME_WRAPPERS", "TRACEBACK_LINES")},
         "get_objects": gc.get_objects,
@@ -485,6 +488,14 @@ def _make_hook(
         if why is not None:  # raised here, its traceback holds no frame of act(); the hook's own is refused
             raise RuntimeError(f"the grader's sandbox refused: {why}")
 
+    def leads_to_a_check(frame):
+        """Whether ``frame`` is, or is called by, the checks' code."""
+        while frame is not None:
+            if frame.f_code in checks_codes:
+                return True
+            frame = frame.f_back
+        return False
+
     def forget_checks_frames():
         """Clear every frame of the checks' code that has ended (its locals: cases, what each expects, the seed's
         random source): a frame made during a check (a traceback's, of an exception an answer raised and kept)
@@ -504,8 +515,15 @@ def _make_hook(
     def act(event, args):  # noqa: C901 - one branch per event
         try:
             caller = getframe(2)  # 0: act, 1: hook, 2: the code that raised the event
-        except ValueError:
-            return  # raised from no Python code at all: nobody's answer
+        except ValueError:  # no Python code at all: a C callable an answer's raw _thread runs
+            if event in FRAMELESS_REFUSED or event.startswith("ctypes."):
+                refuse(f"{event} from a thread with no Python code")
+            return
+        if get_ident() != main_thread and event in OTHER_THREADS_REFUSED:  # noqa: F821 - a private global
+            # Another thread's stack may hold no answer frame even when the answer started it (its target a C
+            # callable: list.extend fed a map of gc.get_objects); nothing the kernel's or a check's threads do
+            # needs these
+            refuse(f"{event} in a thread other than the kernel's main thread")
         if event == "rtt.check_begin":
             if caller.f_code is grade_code and ours(caller):
                 state["checks"] += 1
@@ -591,8 +609,13 @@ def _make_hook(
                 refuse("reading the grader's own frames")
             if state["checks"] > 0 and frame_taken(caller):
                 refuse(f"reading {args[1]} during a check")
-            if state["checks"] == 0 and state.get("frames_left") and learner_near(caller):
-                forget_checks_frames()  # f_back of an answer's own frame, kept from a check, leads to the check's
+            # f_back of an answer's own frame, kept from a check, leads to the check's; another thread's stack may
+            # hold no answer frame even when the answer started it
+            elsewhere = get_ident() != main_thread  # noqa: F821 - a private global
+            if state["checks"] == 0 and state.get("frames_left") and (elsewhere or learner_near(caller)):
+                forget_checks_frames()
+            if state["checks"] > 0 and elsewhere and type(frame) is frame_type and leads_to_a_check(frame):
+                refuse(f"reading {args[1]} of a check's from another thread")
 
         elif event in NOTED:
             if learner_near(caller):
@@ -607,6 +630,15 @@ def _make_hook(
             return None
         return id(frame.f_code) if frame.f_globals is check_codes[id(frame.f_code)][3] else None
 
+    OTHER_THREADS_REFUSED = {"gc.get_objects", "gc.get_referrers", "gc.get_referents", "sys._current_frames"}
+    FRAMELESS_REFUSED = {"gc.get_objects", "gc.get_referrers", "gc.get_referents", "sys._current_frames"} | {
+        "object.__getattr__",
+        "object.__setattr__",
+        "object.__delattr__",
+        "sys.settrace",
+        "sys.setprofile",
+        "sys.addaudithook",
+    }
     WATCHED = (
         NOTED
         | {"sys.addaudithook", "sys._current_frames", "sys.settrace", "sys.setprofile"}
