@@ -294,18 +294,21 @@ def _make_hook(
     grade_code, require_code = grader.grade.__code__, grader.Result.require.__code__
     grader_globals = grader.__dict__
     frame_type = type(getframe(0))
-    hook_codes = set()  # every code object of this function's: the hook's frames, never an answer's to read
-    stack = [_make_hook_code]  # noqa: F821 - a private global
-    while stack:
-        code = stack.pop()
-        hook_codes.add(code)
-        stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
-    checks_codes = set()  # every code object of the checks' package (checks, grader, their helpers), nested ones too
-    stack = [f.__code__ for _, f, *_ in function_parts if f.__module__.startswith("tutorial.exercises")]
-    while stack:
-        code = stack.pop()
-        checks_codes.add(code)
-        stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
+
+    def with_nested(codes):
+        """``codes`` and every code object defined inside them (functions, lambdas, comprehensions), at any depth."""
+        found, stack = set(), list(codes)
+        while stack:
+            code = stack.pop()
+            found.add(code)
+            stack.extend(k for k in code.co_consts if isinstance(k, types.CodeType))
+        return found
+
+    hook_codes = with_nested([_make_hook_code])  # noqa: F821 - this function's: the hook's frames, never an answer's
+    # the checks' package (checks, grader, their helpers): frames that hold cases and what each expects
+    checks_codes = with_nested(
+        f.__code__ for _, f, *_ in function_parts if f.__module__.startswith("tutorial.exercises")
+    )
     modules_now = [(m.__name__, m) for m in modules]
     frame_holders = (types.TracebackType, types.GeneratorType, types.CoroutineType, types.AsyncGeneratorType)
     result_type = grader.Result
@@ -519,7 +522,8 @@ def _make_hook(
             if event in FRAMELESS_REFUSED or event.startswith("ctypes."):
                 refuse(f"{event} from a thread with no Python code")
             return
-        if get_ident() != main_thread and event in OTHER_THREADS_REFUSED:  # noqa: F821 - a private global
+        elsewhere = get_ident() != main_thread  # noqa: F821 - a private global
+        if elsewhere and event in OTHER_THREADS_REFUSED:
             # Another thread's stack may hold no answer frame even when the answer started it (its target a C
             # callable: list.extend fed a map of gc.get_objects); nothing the kernel's or a check's threads do
             # needs these
@@ -611,12 +615,10 @@ def _make_hook(
                 refuse(f"reading {args[1]} during a check")
             # f_back of an answer's own frame, kept from a check, leads to the check's; another thread's stack may
             # hold no answer frame even when the answer started it
-            elsewhere = get_ident() != main_thread  # noqa: F821 - a private global
             if state["checks"] == 0 and state.get("frames_left") and (elsewhere or learner_near(caller)):
                 forget_checks_frames()
             if state["checks"] > 0 and elsewhere and type(frame) is frame_type and leads_to_a_check(frame):
                 refuse(f"reading {args[1]} of a check's from another thread")
-
         elif event in NOTED:
             if learner_near(caller):
                 send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
@@ -631,7 +633,7 @@ def _make_hook(
         return id(frame.f_code) if frame.f_globals is check_codes[id(frame.f_code)][3] else None
 
     OTHER_THREADS_REFUSED = {"gc.get_objects", "gc.get_referrers", "gc.get_referents", "sys._current_frames"}
-    FRAMELESS_REFUSED = {"gc.get_objects", "gc.get_referrers", "gc.get_referents", "sys._current_frames"} | {
+    FRAMELESS_REFUSED = OTHER_THREADS_REFUSED | {
         "object.__getattr__",
         "object.__setattr__",
         "object.__delattr__",
