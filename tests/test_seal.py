@@ -1004,8 +1004,12 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
         t = threading.Thread(target=out.extend, args=(map(gc.get_objects, [None]),))
         t.start()
         t.join()
+        running = _thread._count()
         _thread.start_new_thread(out.extend, (map(gc.get_objects, [None]),))  # a raw thread: no Python frame at all
-        time.sleep(1.0)
+        deadline = time.monotonic() + 30.0
+        while _thread._count() > running and time.monotonic() < deadline:  # until the raw thread has ended
+            time.sleep(0.01)
+        print("raw thread ended:", _thread._count() == running, file=sys.stderr)
         print("objects got:", len(out), file=sys.stderr)
         cell("check_dpad_steering(dpad_track_velocities).require()")
         """
@@ -1021,6 +1025,7 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
     assert "frames left: None" in done.stderr, done.stderr
     assert "the check's locals: <lambda> {} {}" in done.stderr, done.stderr  # the case's, then _run_cases'
     assert "from a thread, the check's locals: <lambda> {}" in done.stderr, done.stderr
+    assert "raw thread ended: True" in done.stderr, done.stderr
     assert "objects got: 1" in done.stderr, done.stderr  # the frame alone: both lists of every object refused
     notes = [line[1:3] for line in signed_lines(done.stdout) if line[0] == "note"]
     assert ["refused", "gc.get_objects in a thread other than the kernel's main thread"] in notes, notes
