@@ -1,6 +1,6 @@
 """``make mutate-seal``: mutation testing of the grading kernel's seal, which ``make mutate`` cannot reach.
 
-    python scripts/mutate_seal.py [--dir DIR] [--sample N] [--seed S]
+    python scripts/mutate_seal.py [--dir DIR] [--sample N] [--seed S] [--changed-since REV]
 
 The seal (``tutorial/tools/grading/seal.py``) is tested in a Python of its own
 (``tests/test_seal.py``: a sealed process stays sealed), where mutmut sees
@@ -19,8 +19,9 @@ seal with ``tests/test_seal.py`` as the tests, and there:
 3. tells mutmut, in its copy of ``tests/test_seal.py``, that the seal's tests
    reach every function of the seal (mutmut counts calls in its own process,
    and the sealed Python of that count runs the original);
-4. runs mutmut on every mutant, or on a seeded sample of ``N``, then
-   ``scripts/mutation_report.py`` there.
+4. runs mutmut on every mutant, on a seeded sample of ``N``, or on those that
+   change a line ``git diff REV`` shows changed in the seal (``--changed-since``:
+   a round on what changed since the last), then ``scripts/mutation_report.py`` there.
 
 About 35 s a mutant on two cores (2026-11-28, the seal's tests then 17 s): the seal's 1,092 take about eleven hours.
 Remove the worktree with ``git worktree remove --force DIR``.
@@ -29,6 +30,8 @@ Remove the worktree with ``git worktree remove --force DIR``.
 from __future__ import annotations
 
 import argparse
+import ast
+import difflib
 import os
 import random
 import re
@@ -89,11 +92,49 @@ def patch_mutants(tree: Path) -> None:
             tests.write_text(text.replace(anchor, "\n" + REACHED.format(names=tuple(names)) + anchor[1:]))
 
 
+def changed_lines(rev: str) -> set[int]:
+    """The seal's lines (1-based) that ``git diff REV`` shows added or changed in this repository's HEAD."""
+    diff = subprocess.run(
+        ["git", "diff", "-U0", rev, "HEAD", "--", SEAL], cwd=ROOT, capture_output=True, text=True, check=True
+    ).stdout
+    lines = set()
+    for start, count in re.findall(r"^@@ -\S+ \+(\d+)(?:,(\d+))? @@", diff, flags=re.M):
+        lines.update(range(int(start), int(start) + (1 if count == "" else int(count))))
+    return lines
+
+
+def mutants_on(tree: Path, lines: set[int]) -> list[str]:
+    """The mutants, in mutmut's copy of the seal, that change one of the seal's ``lines`` (its own numbering)."""
+    source = (ROOT / SEAL).read_text().splitlines()
+    copy = (tree / "mutants" / SEAL).read_text()
+    functions = {
+        node.name: copy.splitlines()[node.lineno - 1 : node.end_lineno]
+        for node in ast.walk(ast.parse(copy))
+        if isinstance(node, ast.FunctionDef) and "__mutmut_" in node.name
+    }
+    found = []
+    for name, body in functions.items():
+        stem, _, number = name.rpartition("__mutmut_")
+        if number == "orig" or f"{stem}__mutmut_orig" not in functions:
+            continue
+        original = functions[f"{stem}__mutmut_orig"]
+        first = next((i + 1 for i, line in enumerate(source) if line.startswith(f"def {stem[2:]}(")), None)
+        if first is None:
+            continue
+        body = [line.replace(name, f"{stem}__mutmut_orig") for line in body]
+        for tag, i1, i2, _, _ in difflib.SequenceMatcher(a=original, b=body, autojunk=False).get_opcodes():
+            if tag != "equal" and any(first + i in lines for i in range(i1, max(i2, i1 + 1))):
+                found.append(f"tutorial.tools.grading.seal.{name}")
+                break
+    return sorted(found)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--dir", type=Path, default=ROOT.parent / f"{ROOT.name}-mutate-seal")
     p.add_argument("--sample", type=int, default=None, help="run only N mutants, drawn at random (default all)")
     p.add_argument("--seed", type=int, default=20261128, help="the sample's seed")
+    p.add_argument("--changed-since", metavar="REV", help="run only the mutants of lines changed since REV")
     args = p.parse_args(argv)
     tree = args.dir.resolve()
     if str(tree).startswith("/tmp/"):
@@ -114,7 +155,12 @@ def main(argv=None) -> int:
         subprocess.run([*mutmut, "run"], cwd=tree, env=env, check=False)  # stops at its clean tests: step 1
     patch_mutants(tree)
     names = []
-    if args.sample is not None:
+    if args.changed_since is not None:
+        names = mutants_on(tree, changed_lines(args.changed_since))
+        print(f"{len(names)} mutants change a line changed since {args.changed_since}", flush=True)
+        if not names:
+            return 0
+    elif args.sample is not None:
         listed = subprocess.run([*mutmut, "results", "--all", "true"], cwd=tree, capture_output=True, text=True)
         every = sorted(line.split(":")[0].strip() for line in listed.stdout.splitlines() if "__mutmut_" in line)
         names = sorted(random.Random(args.seed).sample(every, min(args.sample, len(every))))

@@ -717,6 +717,25 @@ CHEATS = {
         "print('the kernel memory refused to a child:', 'Permission denied' in said.stderr)\n" + STUB_1_1,
         "processes",
     ),
+    "signal-handler": (  # Python hands a handler the running frame: the case's own expected value, down the stack
+        "1.1",
+        "import signal\nseen = {}\n"
+        "def spy(signum, frame):\n"
+        "    while frame is not None and 'expected' not in frame.f_locals:\n"
+        "        frame = frame.f_back\n"
+        "    seen['expected'] = frame.f_locals['expected'] if frame is not None else None\n"
+        "signal.signal(signal.SIGUSR2, signal.SIG_IGN)\n"
+        "try:\n    signal.signal(signal.SIGUSR2, spy)\nexcept RuntimeError as e:\n    print(e)\n"
+        "def dpad_track_velocities(axes):\n"
+        "    signal.raise_signal(signal.SIGUSR2)\n"
+        "    return seen.get('expected') or (0.0, 0.0)\n",
+        "tampering",
+    ),
+    "random-replaced": (  # no Random, no hidden cases: an answer for the visible cases alone would pass
+        "1.2",
+        "import random\nrandom.Random = lambda *a, **k: None\n" + VISIBLE_ONLY["1.2"],
+        "tampering",
+    ),
     # not cheats: answers written for the visible cases alone (tests/test_exercises.py), which the hidden
     # cases fail (no flag)
     "visible-only-1.1": ("1.1", VISIBLE_ONLY["1.1"], ""),

@@ -989,7 +989,7 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
         locals_now = back.f_code.co_name, dict(back.f_locals), dict(back.f_back.f_locals)
         print("the check's locals:", *locals_now, file=sys.stderr)
         # a second review: a thread of the answer's whose target is a C callable has no answer frame on its stack
-        import _thread, gc, operator, threading, time
+        import _thread, gc, operator, threading
 
         try:
             cell("check_dpad_steering(caught).require()")
@@ -1004,12 +1004,10 @@ def test_the_libraries_a_check_draws_and_compares_with_replaced_are_tampering_an
         t = threading.Thread(target=out.extend, args=(map(gc.get_objects, [None]),))
         t.start()
         t.join()
-        running = _thread._count()
+        ended = threading.Event()  # a raw thread's exception goes to sys.unraisablehook, once it is refused
+        sys.unraisablehook = lambda unraisable: ended.set()
         _thread.start_new_thread(out.extend, (map(gc.get_objects, [None]),))  # a raw thread: no Python frame at all
-        deadline = time.monotonic() + 30.0
-        while _thread._count() > running and time.monotonic() < deadline:  # until the raw thread has ended
-            time.sleep(0.01)
-        print("raw thread ended:", _thread._count() == running, file=sys.stderr)
+        print("raw thread ended:", ended.wait(30.0), file=sys.stderr)
         print("objects got:", len(out), file=sys.stderr)
         cell("check_dpad_steering(dpad_track_velocities).require()")
         """
@@ -1154,3 +1152,97 @@ def test_a_library_compiled_from_its_source_by_the_import_system_imports_unnoted
     assert "imported colorsys" in done.stdout, done.stderr
     assert written and written[0].startswith("colorsys."), written  # it was compiled here, and written
     assert [line for line in signed_lines(done.stdout) if line[0] == "note"] == [], done.stdout
+
+
+def test_only_the_kernels_signal_handlers_are_set_and_no_second_signal_module_is_made():
+    """Python hands a signal handler the running frame with no audit event: an answer's handler, raised inside a
+    case (``signal.raise_signal``), read every local of the check (``expected``, ``cases``) through ``f_back``.
+    Now ``signal.signal`` sets only SIG_DFL, SIG_IGN, ``default_int_handler`` and the kernel's own handlers;
+    a second ``_signal`` module (whose ``signal()`` would be real), by import or by ``_imp.create_builtin``, is
+    refused; another built-in module is made as before.  A handler set past the gate (with the real function
+    kept from before the seal) makes the next verdict not the teacher's."""
+    script = (
+        "import _signal\nbefore_the_seal = _signal.signal\n"
+        + SEALED_1_1
+        + textwrap.dedent(
+            """
+            import asyncio, functools, importlib.util, signal, _imp
+            seen, kept = {}, _signal
+
+            def spy(signum, frame):
+                while frame is not None:
+                    seen.update(frame.f_locals)
+                    frame = frame.f_back
+
+            def attempt(label, set_it):
+                try:
+                    set_it()
+                    print(label, "set", file=sys.stderr)
+                except RuntimeError as e:
+                    print(label, "refused", file=sys.stderr)
+
+            attempt("spy", lambda: signal.signal(signal.SIGUSR2, spy))
+            attempt("partial", lambda: signal.signal(signal.SIGUSR2, functools.partial(dict.__setitem__, seen)))
+            attempt("method", lambda: signal.signal(signal.SIGUSR2, seen.__setitem__))
+            attempt("default", lambda: signal.signal(signal.SIGUSR1, signal.SIG_DFL))
+            attempt("ignore", lambda: signal.signal(signal.SIGUSR2, signal.SIG_IGN))
+            attempt("interrupt", lambda: signal.signal(signal.SIGINT, signal.default_int_handler))
+            attempt("asyncio", lambda: signal.signal(signal.SIGUSR1, asyncio.unix_events._sighandler_noop))
+            runner = functools.partial(asyncio.Runner()._on_sigint, main_task=None)  # as asyncio.run() sets it
+            attempt("runner", lambda: signal.signal(signal.SIGUSR1, runner))
+
+            def reimported():
+                del sys.modules["_signal"]
+                try:
+                    import _signal as fresh
+                finally:
+                    sys.modules["_signal"] = kept
+                fresh.signal(signal.SIGUSR2, spy)
+
+            attempt("import", reimported)
+            attempt("create", lambda: _imp.create_builtin(importlib.util.find_spec("_signal")).signal(12, spy))
+            attempt("create _imp", lambda: _imp.create_builtin(importlib.util.find_spec("_imp")))
+            print("another built-in:", __import__("_symtable").__name__, file=sys.stderr)
+
+            honest = dpad_track_velocities
+
+            def dpad_track_velocities(axes):
+                signal.raise_signal(signal.SIGUSR2)  # ignored: the spy was never set
+                return honest(axes)
+
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            dpad_track_velocities = honest
+            print("seen:", sorted(seen), file=sys.stderr)
+            def dpad_track_velocities(axes):  # the handler put back during the check, once it has been used
+                before_the_seal(signal.SIGUSR2, kept.SIG_IGN)
+                return honest(axes)
+
+            before_the_seal(signal.SIGUSR2, spy)  # past the gate, as a hole in it would, before the check
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            dpad_track_velocities = honest
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+
+            def dpad_track_velocities(axes):  # past the gate during the check, after its start
+                before_the_seal(signal.SIGUSR2, spy)
+                return honest(axes)
+
+            cell("check_dpad_steering(dpad_track_velocities).require()")
+            """
+        )
+    )
+    done = sealed(script)
+    for label, said in [("spy", "refused"), ("partial", "refused"), ("method", "refused"), ("default", "set")]:
+        assert f"{label} {said}" in done.stderr, done.stderr
+    for label, said in [("ignore", "set"), ("interrupt", "set"), ("asyncio", "set"), ("runner", "set")]:
+        assert f"{label} {said}" in done.stderr, done.stderr
+    for said in ("import refused", "create refused", "create _imp refused", "another built-in: _symtable"):
+        assert said in done.stderr, done.stderr
+    assert "seen: []" in done.stderr, done.stderr  # the case's locals: none reached the spy
+    verdicts = [line[1:] for line in signed_lines(done.stdout) if line[0] == "verdict"]
+    assert verdicts[0] == ["1.1", "1", "1", ""], verdicts  # the check itself: passed, the teacher's
+    assert verdicts[1][:3] == ["1.1", "1", "0"] and "a signal handler not the kernel's" in verdicts[1][3], verdicts
+    assert verdicts[2] == ["1.1", "1", "1", ""], verdicts  # put back: the teacher's again
+    assert verdicts[3][:3] == ["1.1", "1", "0"] and "a signal handler not the kernel's" in verdicts[3][3], verdicts
+    notes = [line[2] for line in signed_lines(done.stdout) if line[:2] == ["note", "refused"]]
+    assert sum("a signal handler of the answer's" in n for n in notes) == 3, notes
+    assert sum("a second _signal or _imp module" in n for n in notes) == 3, notes

@@ -36,6 +36,13 @@ comes from the seal's signed verdicts, not from the cell's output:
   frames in a traceback, a second audit hook, and changing the code or
   defaults of the teacher's functions.  It notes (without refusing)
   an answer's connections, processes and files outside its folder.
+* Signal handlers: Python hands a handler the running frame with no audit
+  event.  :func:`install` replaces ``_signal.signal`` and
+  ``_imp.create_builtin`` with gates to the hook, which alone holds the real
+  functions: it sets SIG_DFL, SIG_IGN, ``default_int_handler`` and the
+  kernel's own handlers (:data:`SIGNAL_HANDLERS`), and refuses any other and
+  a second ``_signal`` or ``_imp`` module.  A handler that is not the
+  kernel's at a check's start or end makes its verdict not the teacher's.
 * Each verdict (``begin``, ``verdict``, ``note``) goes out as a line signed with
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
   grader's; :mod:`tutorial.tools.grading.sandbox` reads and checks it.
@@ -43,9 +50,7 @@ comes from the seal's signed verdicts, not from the cell's output:
 What the seal does not stop: code that changes a check's objects *and*
 puts them back within one call from the check, or from a thread of its
 own while the check runs (the snapshot is compared at the check's start
-and end), and a signal handler of the answer's, to which Python hands the
-running frame with no audit event (one raised by ``_thread.interrupt_main()``
-inside a check reads the check's values).
+and end).
 The sandbox (:mod:`tutorial.tools.grading.sandbox`) bounds what such code could
 reach.  The hook itself never calls an answer's code (no ``str()``, no
 library function an answer could replace), so nothing runs unwatched inside it.
@@ -106,6 +111,16 @@ NOTED = frozenset({"socket.connect", "socket.sendto", "os.fork", "os.forkpty", "
 # snapshotted too (``random.Random = ...`` once left every check with no hidden case; ``numpy.allclose = ...``
 # would make a comparison say yes).  Other libraries the lessons run (rclpy, MuJoCo) are not.
 STANDARD_MODULES = ("math", "random", "numpy", "numpy.linalg")
+# The Python signal handlers the kernel itself sets while it runs (ipykernel around a cell, asyncio's): none of
+# them hands its frame argument on, whatever its closure holds.  Any other handler is refused: Python gives a
+# handler the running frame with no audit event, and from it f_back leads to a check's values.
+SIGNAL_HANDLERS = frozenset(
+    {
+        ("/ipykernel/ipkernel.py", "IPythonKernel._cancel_on_sigint.<locals>.handle_sigint"),
+        ("/asyncio/unix_events.py", "_sighandler_noop"),
+        ("/asyncio/runners.py", "Runner._on_sigint"),
+    }
+)
 NOT_COMPARED = frozenset(
     {"_", "input", "exit", "quit", "display", "get_ipython", "__IPYTHON__", "copyright", "credits"}
 )
@@ -151,6 +166,22 @@ def _find(name: str) -> bool:
         return False
 
 
+def _gated_signal(signalnum, handler, /):
+    """``_signal.signal`` in a sealed process: the hook sets ``handler`` if it is the kernel's (the real function
+    is the hook's alone).  Raises RuntimeError when the seal refuses it, else as ``signal.signal``."""
+    previous = []
+    sys.audit("rtt.signal", signalnum, handler, previous)
+    return previous[0]
+
+
+def _gated_create_builtin(spec, /):
+    """``_imp.create_builtin`` in a sealed process: a new ``_signal`` (with a real ``signal()`` of its own) or
+    ``_imp`` is refused, any other built-in module made as before."""
+    made = []
+    sys.audit("rtt.create_builtin", spec, made)
+    return made[0]
+
+
 def install(
     key: bytes,
     fd: int,
@@ -171,7 +202,11 @@ def install(
         RuntimeError: called twice in one process (the second audit hook is refused).
     """
     import _hashlib
+    import _imp
+    import _signal
     import _thread
+    import functools
+    from importlib.machinery import ModuleSpec
 
     from tutorial.exercises import grader
 
@@ -197,6 +232,10 @@ def install(
         "getrefcount": sys.getrefcount,
         "_make_hook_code": _make_hook.__code__,
         "loaded": sys.modules,  # the import system's own dict (rebinding sys.modules does not change it)
+        "partial_type": functools.partial,
+        "spec_type": ModuleSpec,
+        "namespace": types.SimpleNamespace,
+        "SIGNAL_HANDLERS": SIGNAL_HANDLERS,
     }
     make = types.FunctionType(_make_hook.__code__, private, "_make_hook")
     hidden = tuple(h.rstrip("/") + "/" for h in hidden)
@@ -214,12 +253,31 @@ def install(
         _hashlib.hmac_digest,
         os.write,
         sys._getframe,
+        # the real functions that set a Python signal handler or make a built-in module anew: in the hook's
+        # closures alone, their modules' names gated from here on
+        (_signal.signal, _signal.getsignal, _signal.valid_signals, _signal.default_int_handler),
+        _imp.create_builtin,
     )
     sys.addaudithook(hook)
+    _signal.signal, _imp.create_builtin = _gated_signal, _gated_create_builtin
 
 
 def _make_hook(
-    key, fd, modules, roots, readable, hidden, seed, calls, grader, builtin_names, hmac_digest, write, getframe
+    key,
+    fd,
+    modules,
+    roots,
+    readable,
+    hidden,
+    seed,
+    calls,
+    grader,
+    builtin_names,
+    hmac_digest,
+    write,
+    getframe,
+    signals,
+    create_builtin,
 ):  # noqa: C901
     """The audit hook, its state in closures only (made with private globals by :func:`install`)."""
     trusted: dict[int, object] = {}  # id -> object (kept alive, so an id is never reused)
@@ -479,17 +537,34 @@ def _make_hook(
         if me in busy:
             return
         busy.add(me)
-        why = None
+        why = pending = None
         try:
-            act(event, args)
+            pending = act(event, args)
         except Refused as refused:
             why = refused.args[0]
         except Exception:  # noqa: BLE001, S110 - an event raised by hand with odd arguments: nothing to do
             pass
         finally:
             busy.discard(me)
+        if pending is not None:
+            # A gated real function, run past the guard: what it runs in turn (a pending signal's handler, an
+            # attribute of an answer's spec) is watched as any code is.
+            function, arguments, out = pending
+            made = function(*arguments)
+            if function is create_builtin and not a_new_module(made):
+                try:
+                    refuse("a second _signal or _imp module (its own signal(), set past the seal)")
+                except Refused as refused:
+                    why = refused.args[0]
+            else:
+                list.append(out, made)
         if why is not None:  # raised here, its traceback holds no frame of act(); the hook's own is refused
             raise RuntimeError(f"the grader's sandbox refused: {why}")
+
+    def a_new_module(module):
+        """Whether ``module``, just made by the real ``_imp.create_builtin``, is neither ``_signal`` nor ``_imp``."""
+        name = dict.get(module.__dict__, "__name__") if type(module) is types.ModuleType else None
+        return type(name) is str and name not in ("_signal", "_imp")
 
     def leads_to_a_check(frame):
         """Whether ``frame`` is, or is called by, the checks' code."""
@@ -537,6 +612,8 @@ def _make_hook(
                 state["begin_changes"] = changed(genuine_check(caller.f_back))
                 if paused_frames():
                     state["begin_changes"].append("an answer's paused generator had its frame taken")
+                if answers_handlers():
+                    state["begin_changes"].append("a signal handler not the kernel's")
                 send(BEGIN, number_of(args[0]))
         elif event == "rtt.check_end":
             if caller.f_code is grade_code and ours(caller):
@@ -546,6 +623,8 @@ def _make_hook(
             if caller.f_code is grade_code and ours(caller) and type(result) is result_type:
                 check = genuine_check(caller.f_back)
                 reasons = list(state.get("begin_changes", [])) + changed(check) + list(state["refused"])
+                if answers_handlers():
+                    reasons.append("a signal handler not the kernel's")
                 if check is None:
                     reasons.append("grade() was not called by one of the teacher's checks")
                 fields = result.__dict__
@@ -574,6 +653,18 @@ def _make_hook(
         elif event == "rtt.suspect":
             if caller.f_code in suspecting and ours(caller) and type(args[0]) is str:
                 send(NOTE, "tampering", "an answer returned " + args[0], here())
+        elif event == "rtt.signal":  # signal.signal(), through _gated_signal
+            number, handler, out = args
+            if type(number) is not int or type(out) is not list:
+                refuse("a signal handler set with odd arguments")
+            if not kernels_handler(handler):
+                refuse(f"a signal handler of the answer's (signal {number}): Python hands it the running frame")
+            return set_signal, (number, handler), out
+        elif event == "rtt.create_builtin":  # _imp.create_builtin(), through _gated_create_builtin
+            spec, out = args
+            if type(out) is not list:
+                refuse("a built-in module made with odd arguments")
+            return create_builtin, (spec,), out
         elif event == "sys.addaudithook":
             refuse(event)
         elif event in ("sys._current_frames", "sys.settrace", "sys.setprofile"):
@@ -625,6 +716,30 @@ def _make_hook(
         elif event == "sys._getframe" and state["checks"] > 0 and type(args[0]) is frame_type:
             if frame_taken(caller):
                 refuse("reading frames during a check")  # the answer's own call, inspect.currentframe()'s, ...
+
+    set_signal, get_signal, valid_signals, default_int_handler = signals
+    handlers_before = {id(h): h for h in map(get_signal, valid_signals()) if h is not None and type(h) is not int}
+    handlers_before[id(default_int_handler)] = default_int_handler  # kept alive: an id is never reused
+
+    def kernels_handler(handler):
+        """Whether ``handler`` is SIG_DFL, SIG_IGN, none (a C handler), one set before any answer ran, or one of
+        :data:`SIGNAL_HANDLERS` (through a bound method or a partial)."""
+        if handler is None or type(handler) is int or id(handler) in handlers_before:
+            return True
+        for _ in range(4):  # attributes of Python's own types, read without an answer's code
+            if type(handler) is partial_type:  # noqa: F821 - a private global
+                handler = handler.func
+            elif type(handler) is types.MethodType:
+                handler = handler.__func__
+            else:
+                break
+        if type(handler) is not types.FunctionType:
+            return False
+        return not learner_code(handler.__code__) and named(handler.__code__, SIGNAL_HANDLERS)  # noqa: F821
+
+    def answers_handlers():
+        """The signals whose Python handler is not the kernel's (set past the gate, which nothing should allow)."""
+        return [n for n in valid_signals() if not kernels_handler(get_signal(n))]
 
     def genuine_check(frame):
         """The id of the teacher's check whose code ``frame`` runs with its module's real globals, or None."""
