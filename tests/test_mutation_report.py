@@ -101,3 +101,30 @@ def test_make_mutate_seal_can_patch_todays_seal_and_its_tests(tmp_path):
         assert patched.count("record_trampoline_hit(") == 1
         compile(patched, "test_seal.py", "exec")  # still Python
     assert "_rtt_make_hook_code()" in (tmp_path / "mutants" / script.SEAL).read_text()
+
+
+def test_a_round_on_what_changed_runs_the_seals_mutants_of_those_lines_alone(tmp_path):
+    """``mutate_seal.py --changed-since REV``: of mutmut's copies of a seal function, those whose change falls on
+    a line the diff names, and no other (a mutant of another line, the original itself)."""
+    import ast
+
+    script = load_script("mutate_seal")
+    source = (ROOT / script.SEAL).read_text()
+    node = next(n for n in ast.parse(source).body if isinstance(n, ast.FunctionDef) and n.name == "_gated_signal")
+    body = source.splitlines()[node.lineno - 1 : node.end_lineno]
+    audit = next(i for i, line in enumerate(body) if "sys.audit(" in line)
+    returned = next(i for i, line in enumerate(body) if "return previous[0]" in line)
+
+    def copy(number: str, changed_at: int | None) -> str:
+        lines = [line.replace("def _gated_signal(", f"def x__gated_signal__mutmut_{number}(", 1) for line in body]
+        if changed_at is not None:
+            lines[changed_at] = lines[changed_at].replace("previous", "None", 1)
+        return "\n".join(lines)
+
+    copied = "\n\n".join([copy("orig", None), copy("1", audit), copy("2", returned)])
+    (tmp_path / "mutants" / script.SEAL).parent.mkdir(parents=True)
+    (tmp_path / "mutants" / script.SEAL).write_text(copied + "\n")
+    prefix = "tutorial.tools.grading.seal.x__gated_signal__mutmut_"
+    assert script.mutants_on(tmp_path, {node.lineno + audit}) == [prefix + "1"]
+    assert script.mutants_on(tmp_path, {node.lineno + returned, 1}) == [prefix + "2"]
+    assert script.mutants_on(tmp_path, {1}) == []
