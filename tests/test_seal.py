@@ -1157,10 +1157,15 @@ def test_a_library_compiled_from_its_source_by_the_import_system_imports_unnoted
 def test_only_the_kernels_signal_handlers_are_set_and_no_second_signal_module_is_made():
     """Python hands a signal handler the running frame with no audit event: an answer's handler, raised inside a
     case (``signal.raise_signal``), read every local of the check (``expected``, ``cases``) through ``f_back``.
-    Now ``signal.signal`` sets only SIG_DFL, SIG_IGN, ``default_int_handler`` and the kernel's own handlers;
-    a second ``_signal`` module (whose ``signal()`` would be real), by import or by ``_imp.create_builtin``, is
-    refused; another built-in module is made as before.  A handler set past the gate (with the real function
-    kept from before the seal) makes the next verdict not the teacher's."""
+    Now ``signal.signal`` sets only SIG_DFL, SIG_IGN, ``default_int_handler`` and the kernel's own handler, by
+    its code object; a second ``_signal`` module (whose ``signal()`` would be real), by import or by
+    ``_imp.create_builtin``, is refused; another built-in module is made as before.  A handler set past the
+    gate (with the real function kept from before the seal) makes the next verdict not the teacher's.  A third
+    review's wins are refused: a handler compiled by the import system's loader under a library's file name and
+    function name (its own code, with the answer's globals), a library's real handler behind a partial whose
+    arguments move the frame to a parameter whose error hands it back (``AttributeError.obj``), and an answer's
+    code run inside the hook (there a finalizer, run when the hook clears a check's ended frames), where its
+    events once passed unwatched: from there the hook's frames lead to its key."""
     script = (
         "import _signal\nbefore_the_seal = _signal.signal\n"
         + SEALED_1_1
@@ -1188,8 +1193,15 @@ def test_only_the_kernels_signal_handlers_are_set_and_no_second_signal_module_is
             attempt("ignore", lambda: signal.signal(signal.SIGUSR2, signal.SIG_IGN))
             attempt("interrupt", lambda: signal.signal(signal.SIGINT, signal.default_int_handler))
             attempt("asyncio", lambda: signal.signal(signal.SIGUSR1, asyncio.unix_events._sighandler_noop))
-            runner = functools.partial(asyncio.Runner()._on_sigint, main_task=None)  # as asyncio.run() sets it
-            attempt("runner", lambda: signal.signal(signal.SIGUSR1, runner))
+            shifted = functools.partial(asyncio.runners.Runner._on_sigint, object(), 0)
+            attempt("shifted", lambda: signal.signal(signal.SIGUSR1, shifted))
+            import importlib.machinery, types
+            source, path = b"def _sighandler_noop(signum, frame):\\n    spy(signum, frame)\\n", "<frozen asyncio>"
+            try:
+                forged = importlib.machinery.SourceFileLoader("x", path).source_to_code(source, path)
+                print("forged compiled", file=sys.stderr)
+            except RuntimeError:
+                print("forged refused", file=sys.stderr)
 
             def reimported():
                 del sys.modules["_signal"]
@@ -1233,9 +1245,15 @@ def test_only_the_kernels_signal_handlers_are_set_and_no_second_signal_module_is
     done = sealed(script)
     for label, said in [("spy", "refused"), ("partial", "refused"), ("method", "refused"), ("default", "set")]:
         assert f"{label} {said}" in done.stderr, done.stderr
-    for label, said in [("ignore", "set"), ("interrupt", "set"), ("asyncio", "set"), ("runner", "set")]:
+    for label, said in [("ignore", "set"), ("interrupt", "set"), ("asyncio", "refused"), ("shifted", "refused")]:
         assert f"{label} {said}" in done.stderr, done.stderr
-    for said in ("import refused", "create refused", "create _imp refused", "another built-in: _symtable"):
+    for said in (
+        "import refused",
+        "create refused",
+        "create _imp refused",
+        "another built-in: _symtable",
+        "forged refused",
+    ):
         assert said in done.stderr, done.stderr
     assert "seen: []" in done.stderr, done.stderr  # the case's locals: none reached the spy
     verdicts = [line[1:] for line in signed_lines(done.stdout) if line[0] == "verdict"]
@@ -1244,5 +1262,58 @@ def test_only_the_kernels_signal_handlers_are_set_and_no_second_signal_module_is
     assert verdicts[2] == ["1.1", "1", "1", ""], verdicts  # put back: the teacher's again
     assert verdicts[3][:3] == ["1.1", "1", "0"] and "a signal handler not the kernel's" in verdicts[3][3], verdicts
     notes = [line[2] for line in signed_lines(done.stdout) if line[:2] == ["note", "refused"]]
-    assert sum("a signal handler of the answer's" in n for n in notes) == 3, notes
+    assert sum("a signal handler of the answer's" in n for n in notes) == 5, notes
+    assert "code claiming to be the library's (<frozen asyncio>)" in notes, notes
     assert sum("a second _signal or _imp module" in n for n in notes) == 3, notes
+
+
+def test_an_answers_code_run_inside_the_hook_is_refused_what_the_hook_may_do_there():
+    """The hook lets pass the events of its own work (its frame reads, gc); code of an answer's that ran inside it
+    once had the same pass.  A third review ran one there, a signal's handler on an interval timer, and read
+    the hook's frames, and from them its key.  Here the same handler, set past the gate with the real function
+    kept from before the seal (as a hole in the gate would), fires until 200 land inside the hook (a deadline
+    loop of compile() calls, each an event the hook works on).  Inside its guard, its frame read is refused as
+    code run there; around its guard, as a frame that leads to the hook's.  Not closed, and said in seal.py: the
+    few lines where the hook asks who raised an event (about one landing in five here)."""
+    script = (
+        "import _signal\nbefore_the_seal = _signal.signal\n"
+        + SEALED_1_1
+        + textwrap.dedent(
+            """
+        import signal, time
+        from collections import Counter
+        inside, outside = [], []
+
+        def spy(signum, frame):
+            try:
+                taken = sys._getframe(1)
+            except RuntimeError as e:
+                inside.append(str(e))
+                return
+            if "seal.py" in taken.f_code.co_filename:
+                inside.append("took the hook's frame in " + taken.f_code.co_name)
+            else:
+                outside.append(taken.f_code.co_name)
+
+        before_the_seal(signal.SIGALRM, spy)
+        signal.setitimer(signal.ITIMER_REAL, 0.0003, 0.0003)
+        deadline = time.monotonic() + 60.0
+        while len(inside) < 200 and time.monotonic() < deadline:
+            compile("1", "<probe>", "eval")
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        for said, count in Counter(inside).items():
+            print(count, said, file=sys.stderr)
+        print("landings:", len(inside), "outside:", len(outside) > 0, file=sys.stderr)
+        """
+        )
+    )
+    done = sealed(script)
+    assert "outside: True" in done.stderr and "landings: 20" in done.stderr, done.stderr
+    counts = {
+        line.split(" ", 1)[1]: int(line.split(" ", 1)[0]) for line in done.stderr.splitlines() if line[0].isdigit()
+    }
+    inside_the_guard = counts.get("the grader's sandbox refused: code run inside the seal's hook", 0)
+    around_it = counts.get("the grader's sandbox refused: reading the grader's own frames", 0)
+    taken = sum(n for said, n in counts.items() if said.startswith("took the hook's frame in "))
+    assert inside_the_guard > 0 and around_it > 0, done.stderr
+    assert inside_the_guard + around_it > 2 * taken, done.stderr  # most landings refused

@@ -40,7 +40,7 @@ comes from the seal's signed verdicts, not from the cell's output:
   event.  :func:`install` replaces ``_signal.signal`` and
   ``_imp.create_builtin`` with gates to the hook, which alone holds the real
   functions: it sets SIG_DFL, SIG_IGN, ``default_int_handler`` and the
-  kernel's own handlers (:data:`SIGNAL_HANDLERS`), and refuses any other and
+  kernel's own handler (ipykernel's ``handle_sigint``, by its code object), and refuses any other and
   a second ``_signal`` or ``_imp`` module.  A handler that is not the
   kernel's at a check's start or end makes its verdict not the teacher's.
 * Each verdict (``begin``, ``verdict``, ``note``) goes out as a line signed with
@@ -111,16 +111,6 @@ NOTED = frozenset({"socket.connect", "socket.sendto", "os.fork", "os.forkpty", "
 # snapshotted too (``random.Random = ...`` once left every check with no hidden case; ``numpy.allclose = ...``
 # would make a comparison say yes).  Other libraries the lessons run (rclpy, MuJoCo) are not.
 STANDARD_MODULES = ("math", "random", "numpy", "numpy.linalg")
-# The Python signal handlers the kernel itself sets while it runs (ipykernel around a cell, asyncio's): none of
-# them hands its frame argument on, whatever its closure holds.  Any other handler is refused: Python gives a
-# handler the running frame with no audit event, and from it f_back leads to a check's values.
-SIGNAL_HANDLERS = frozenset(
-    {
-        ("/ipykernel/ipkernel.py", "IPythonKernel._cancel_on_sigint.<locals>.handle_sigint"),
-        ("/asyncio/unix_events.py", "_sighandler_noop"),
-        ("/asyncio/runners.py", "Runner._on_sigint"),
-    }
-)
 NOT_COMPARED = frozenset(
     {"_", "input", "exit", "quit", "display", "get_ipython", "__IPYTHON__", "copyright", "credits"}
 )
@@ -182,6 +172,19 @@ def _gated_create_builtin(spec, /):
     return made[0]
 
 
+def _kernels_handler_codes() -> tuple:
+    """The code of the one Python signal handler the kernel sets while it runs: ipykernel's ``handle_sigint``
+    around an asynchronous cell, which hands its frame argument on to nothing.  Taken from ipykernel's module
+    as imported before the seal (:mod:`~tutorial.tools.grading.sealed_kernel` imports it first); none if it
+    was not."""
+    module = sys.modules.get("ipykernel.ipkernel")
+    method = getattr(getattr(module, "IPythonKernel", None), "_cancel_on_sigint", None)
+    code = getattr(getattr(method, "__wrapped__", None), "__code__", None)
+    return tuple(
+        k for k in getattr(code, "co_consts", ()) if isinstance(k, types.CodeType) and k.co_name == "handle_sigint"
+    )
+
+
 def install(
     key: bytes,
     fd: int,
@@ -205,8 +208,6 @@ def install(
     import _imp
     import _signal
     import _thread
-    import functools
-    from importlib.machinery import ModuleSpec
 
     from tutorial.exercises import grader
 
@@ -232,10 +233,6 @@ def install(
         "getrefcount": sys.getrefcount,
         "_make_hook_code": _make_hook.__code__,
         "loaded": sys.modules,  # the import system's own dict (rebinding sys.modules does not change it)
-        "partial_type": functools.partial,
-        "spec_type": ModuleSpec,
-        "namespace": types.SimpleNamespace,
-        "SIGNAL_HANDLERS": SIGNAL_HANDLERS,
     }
     make = types.FunctionType(_make_hook.__code__, private, "_make_hook")
     hidden = tuple(h.rstrip("/") + "/" for h in hidden)
@@ -255,7 +252,13 @@ def install(
         sys._getframe,
         # the real functions that set a Python signal handler or make a built-in module anew: in the hook's
         # closures alone, their modules' names gated from here on
-        (_signal.signal, _signal.getsignal, _signal.valid_signals, _signal.default_int_handler),
+        (
+            _signal.signal,
+            _signal.getsignal,
+            _signal.valid_signals,
+            _signal.default_int_handler,
+            _kernels_handler_codes(),
+        ),
         _imp.create_builtin,
     )
     sys.addaudithook(hook)
@@ -435,6 +438,17 @@ def _make_hook(
             path = absolute(target if target.startswith("/") else path.rsplit("/", 1)[0] + "/" + target)
         return True  # a chain of links this long is not a file an answer needs
 
+    def same_source(source, filename):
+        """Whether ``source`` (bytes or text) is the file ``filename``'s own source."""
+        if filename.startswith("<frozen") or type(source) not in (bytes, str):
+            return False  # Python's frozen modules are never compiled again; an AST could be anything
+        try:
+            with open(filename, "rb") as file:  # noqa: PTH123 - the hook's private builtins
+                held = file.read()
+        except OSError:
+            return False
+        return held == (source if type(source) is bytes else source.encode("utf-8"))
+
     def learner_near(frame, depth=6):
         """Whether answer code called this within ``depth`` frames (through IPython's open(), socket.py, ...)."""
         while frame is not None and depth > 0:
@@ -529,13 +543,34 @@ def _make_hook(
         raise Refused(what)
 
     busy = set()  # the threads inside the hook: what it does itself raises events, which it lets pass
+    asking = set()  # the threads inside own_event(): its own frame reads pass
+
+    def own_event():
+        """Whether the event this thread raised while inside the hook comes from the hook's own code, not from code
+        that ran there unasked: a signal's handler, a finalizer the garbage collector called, an answer's method."""
+        me = get_ident()  # noqa: F821 - a private global
+        asking.add(me)
+        try:
+            return getframe(2).f_code in hook_codes  # 0: here, 1: hook, 2: the code that raised it
+        except ValueError:
+            return False
+        finally:
+            asking.discard(me)
 
     def hook(event, args):
         if not (event.startswith("rtt.") or event in WATCHED or event.startswith("ctypes.")):
             return
+        if event == "object.__getattr__" and (
+            len(args) < 2 or type(args[1]) is not str or args[1] not in FRAME_ATTRIBUTES  # noqa: F821
+        ):
+            return  # f_code, __code__, ...: the hook's own reads, and nothing it acts on (an odd name: by hand)
         me = get_ident()  # noqa: F821 - a private global
         if me in busy:
-            return
+            if (me in asking and event == "sys._getframe") or own_event():
+                return
+            # Let pass, such code could take the hook's frames and read its closures (the key).  No note: the garbage
+            # collector runs honest finalizers here too (a warning's frame read), which are refused as quietly.
+            raise RuntimeError("the grader's sandbox refused: code run inside the seal's hook")
         busy.add(me)
         why = pending = None
         try:
@@ -566,10 +601,10 @@ def _make_hook(
         name = dict.get(module.__dict__, "__name__") if type(module) is types.ModuleType else None
         return type(name) is str and name not in ("_signal", "_imp")
 
-    def leads_to_a_check(frame):
-        """Whether ``frame`` is, or is called by, the checks' code."""
+    def leads_to(frame, codes):
+        """Whether ``frame`` is, or is called by, code of ``codes`` (the checks', the hook's)."""
         while frame is not None:
-            if frame.f_code in checks_codes:
+            if frame.f_code in codes:
                 return True
             frame = frame.f_back
         return False
@@ -679,8 +714,11 @@ def _make_hook(
                 refuse(f"changing {getattr(args[0], '__qualname__', '?')}.{attribute}")
         elif event in ("compile", "code.__new__"):
             filename = args[1] if type(args[1]) is str else ""
-            if learner(caller) and (filename.startswith(roots) or filename.startswith("<frozen")):
-                refuse(f"code claiming to be the library's ({filename})")
+            if filename.startswith(roots) or filename.startswith("<frozen"):
+                # Library code is known by its file's name: code compiled under that name is the library's only
+                # when it is that file's source (the import system's compile of it), whoever asked for it
+                if learner_near(caller) if event == "code.__new__" else not same_source(args[0], filename):
+                    refuse(f"code claiming to be the library's ({filename})")
         elif event == "open":
             path = args[0]
             if type(path) is not str:
@@ -700,42 +738,41 @@ def _make_hook(
             refuse(event)  # every object, the hook's closures among them
         elif event == "object.__getattr__" and type(args[0]) in frame_holders and args[1] in FRAME_ATTRIBUTES:
             frame = getattr(args[0], args[1], None)  # read here, where the hook lets its own events pass
-            if type(frame) is frame_type and frame.f_code in hook_codes:
-                refuse("reading the grader's own frames")
+            if type(frame) is frame_type and leads_to(frame, hook_codes):
+                refuse("reading the grader's own frames")  # a frame called by the hook's leads there too
             if state["checks"] > 0 and frame_taken(caller):
                 refuse(f"reading {args[1]} during a check")
             # f_back of an answer's own frame, kept from a check, leads to the check's; another thread's stack may
             # hold no answer frame even when the answer started it
             if state["checks"] == 0 and state.get("frames_left") and (elsewhere or learner_near(caller)):
                 forget_checks_frames()
-            if state["checks"] > 0 and elsewhere and type(frame) is frame_type and leads_to_a_check(frame):
+            if state["checks"] > 0 and elsewhere and type(frame) is frame_type and leads_to(frame, checks_codes):
                 refuse(f"reading {args[1]} of a check's from another thread")
         elif event in NOTED:
             if learner_near(caller):
                 send(NOTE, "network" if event.startswith("socket") else "processes", event, here())
-        elif event == "sys._getframe" and state["checks"] > 0 and type(args[0]) is frame_type:
-            if frame_taken(caller):
+        elif event == "sys._getframe" and type(args[0]) is frame_type:
+            # Code the hook ran (a signal's handler, at any of its lines) must not walk down to its frames.  No
+            # note: an honest finalizer the garbage collector runs there (a log line) is refused as quietly.
+            if leads_to(args[0], hook_codes):
+                raise Refused("reading the grader's own frames")
+            if state["checks"] > 0 and frame_taken(caller):
                 refuse("reading frames during a check")  # the answer's own call, inspect.currentframe()'s, ...
 
-    set_signal, get_signal, valid_signals, default_int_handler = signals
+    set_signal, get_signal, valid_signals, default_int_handler, handler_codes = signals
     handlers_before = {id(h): h for h in map(get_signal, valid_signals()) if h is not None and type(h) is not int}
     handlers_before[id(default_int_handler)] = default_int_handler  # kept alive: an id is never reused
 
     def kernels_handler(handler):
-        """Whether ``handler`` is SIG_DFL, SIG_IGN, none (a C handler), one set before any answer ran, or one of
-        :data:`SIGNAL_HANDLERS` (through a bound method or a partial)."""
+        """Whether ``handler`` is SIG_DFL, SIG_IGN, none (a C handler), one set before any answer ran, or a function
+        of ipykernel's ``handle_sigint`` code itself (by identity: its file's name can be forged, a partial's
+        arguments would move the frame to another parameter)."""
         if handler is None or type(handler) is int or id(handler) in handlers_before:
             return True
-        for _ in range(4):  # attributes of Python's own types, read without an answer's code
-            if type(handler) is partial_type:  # noqa: F821 - a private global
-                handler = handler.func
-            elif type(handler) is types.MethodType:
-                handler = handler.__func__
-            else:
-                break
         if type(handler) is not types.FunctionType:
             return False
-        return not learner_code(handler.__code__) and named(handler.__code__, SIGNAL_HANDLERS)  # noqa: F821
+        code = handler.__code__
+        return any(code is k for k in handler_codes)
 
     def answers_handlers():
         """The signals whose Python handler is not the kernel's (set past the gate, which nothing should allow)."""

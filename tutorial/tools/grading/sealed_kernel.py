@@ -27,12 +27,13 @@ def main() -> None:
     key_fd, verdict_fd = (int(fd) for fd in os.environ.pop("RTT_SEAL_FDS").split(","))
     with os.fdopen(key_fd, "rb") as pipe:
         given = json.loads(pipe.read())
+    # Imported before the seal: the seal takes the code of ipykernel's own signal handler from it, as it was
+    from ipykernel.kernelapp import launch_new_instance
+
     seal.install(
         bytes.fromhex(given["key"]), verdict_fd, given["test_calls"], given["hidden"], given["checks"], given["seed"]
     )
     del given
-    from ipykernel.kernelapp import launch_new_instance
-
     launch_new_instance()
 
 
