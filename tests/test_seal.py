@@ -639,16 +639,29 @@ READ_EXPECTED = textwrap.dedent(
 )
 STACK_WALKS = READ_EXPECTED + textwrap.dedent(
     """
-    import collections, inspect, logging, traceback, typing
+    import collections, inspect, logging, traceback, types, typing
 
     def deeper(n):  # walk_stack(None) starts four frames up
         return deeper(n - 1) if n else next(traceback.walk_stack(None))[0]
+
+    class Frames:  # traceback.extract_stack's real code with globals of the answer's: its StackSummary is this
+        @staticmethod
+        def extract(frames, limit=None):
+            Frames.taken = next(frames)[0]
+
+    own_names = dict(vars(traceback), StackSummary=Frames)
+    extract_stack = types.FunctionType(traceback.extract_stack.__code__, own_names, None, (None, None))
+
+    def through_own_names():
+        extract_stack()
+        return Frames.taken
 
     WALKS = {
         "traceback.walk_stack": lambda: deeper(4),
         "traceback.walk_tb": lambda: next(traceback.walk_tb(own_traceback()))[0],
         "inspect.stack": lambda: inspect.stack()[0].frame,
         "inspect.getinnerframes": lambda: inspect.getinnerframes(own_traceback())[0].frame,
+        "traceback.extract_stack, with the answer's globals": through_own_names,
         # the check's locals as text: the answer parses them (here, only tries)
         "traceback.StackSummary": lambda: traceback.StackSummary.extract(
             traceback.walk_stack(None), capture_locals=True
@@ -695,7 +708,9 @@ def test_a_library_that_walks_the_stack_for_an_answer_during_a_check_is_refused_
     inspect's, a stack summary with its locals) is refused, as its own are; logging, tracebacks told as text,
     namedtuple, typing, matplotlib's warnings and scipy's result classes, which read their caller's frame
     themselves, still work there.
-    At b088ed8, walk_stack, walk_tb and getinnerframes gave full marks."""
+    At b088ed8, walk_stack, walk_tb and getinnerframes gave full marks; until 2026-11-29, so did
+    ``traceback.extract_stack``'s own code made into a function with the answer's globals (a library's code
+    that reads a frame itself is trusted only with its module's own globals)."""
     done = sealed(SEALED_1_1 + STACK_WALKS)
     said = [line for line in done.stderr.splitlines() if line.startswith(("traceback.", "inspect."))]
     assert said == [
@@ -703,12 +718,13 @@ def test_a_library_that_walks_the_stack_for_an_answer_during_a_check_is_refused_
         "traceback.walk_tb refused",
         "inspect.stack refused",
         "inspect.getinnerframes refused",
+        "traceback.extract_stack, with the answer's globals refused",
         "traceback.StackSummary refused",
     ], done.stderr
     verdicts = [line[1:] for line in signed_lines(done.stdout) if line[0] == "verdict"]
-    refused = ["reading frames during a check", "reading tb_frame during a check"]
-    assert [v[3] for v in verdicts[:5]] == [refused[0], refused[1], refused[0], refused[1], refused[0]], verdicts
-    assert verdicts[5] == ["1.1", "1", "1", ""], verdicts  # the honest answer, logging and tracebacks on the way
+    frames, tb_frame = "reading frames during a check", "reading tb_frame during a check"
+    assert [v[3] for v in verdicts[:6]] == [frames, tb_frame, frames, tb_frame, frames, frames], verdicts
+    assert verdicts[6] == ["1.1", "1", "1", ""], verdicts  # the honest answer, logging and tracebacks on the way
 
 
 def test_a_paused_generators_frame_taken_before_a_check_is_tampering():
@@ -806,7 +822,8 @@ def test_a_thread_inside_the_hook_lets_no_other_threads_event_pass():
 
 def test_a_library_uses_ctypes_for_an_answer_and_the_answer_itself_may_not():
     """Raw memory is refused to an answer's own code, not to the library code it calls (multiprocessing's shared
-    values are ctypes objects): only the caller's file says whose the call is."""
+    values are ctypes objects): only the caller's file says whose the call is, past ctypes' own Python
+    (``string_at`` wraps its C function: a review read an object's bytes through it)."""
     script = textwrap.dedent(
         """
         from tutorial.tools.grading import seal
@@ -821,11 +838,18 @@ def test_a_library_uses_ctypes_for_an_answer_and_the_answer_itself_may_not():
             print("the answer: allowed")
         except RuntimeError as e:
             print("the answer:", "refused" if "sandbox refused" in str(e) else e)
+        try:
+            cell("ctypes.string_at(id(b'secret') + 32, 6)")
+            print("through string_at: allowed")
+        except RuntimeError as e:
+            print("through string_at:", "refused" if "sandbox refused" in str(e) else e)
         """
     )
     done = sealed(script)
     assert "a library: 3" in done.stdout and "the answer: refused" in done.stdout, done.stdout
-    assert [line[1:3] for line in signed_lines(done.stdout)] == [["refused", "ctypes.cdata/buffer"]]
+    assert "through string_at: refused" in done.stdout, done.stdout
+    notes = [line[1:3] for line in signed_lines(done.stdout)]
+    assert notes == [["refused", "ctypes.cdata/buffer"], ["refused", "ctypes.string_at"]], notes
 
 
 def test_the_kernel_refuses_the_keyrings_to_itself_and_every_process_it_starts():

@@ -47,13 +47,26 @@ comes from the seal's signed verdicts, not from the cell's output:
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
   grader's; :mod:`tutorial.tools.grading.sandbox` reads and checks it.
 
-What the seal does not stop: code that changes a check's objects *and*
-puts them back within one call from the check, or from a thread of its
-own while the check runs (the snapshot is compared at the check's start
-and end).
-The sandbox (:mod:`tutorial.tools.grading.sandbox`) bounds what such code could
-reach.  The hook itself never calls an answer's code (no ``str()``, no
-library function an answer could replace), so nothing runs unwatched inside it.
+What the seal does not stop (one process is no wall; only the checks in a
+process of their own, exchanging data with the answer's, would be):
+
+* reading or writing the process's memory without an audit event: NumPy's
+  array interface (``__array_interface__`` with any address) and
+  ``ctypes.cast`` of an address reach every byte, the key's among them;
+* code that changes a check's objects *and* puts them back within one call
+  from the check, or from a thread of its own while the check runs (the
+  snapshot is compared at the check's start and end);
+* the few lines where the hook asks who raised an event inside it: code
+  run there (the kernel's own SIGINT handler, during an asynchronous cell,
+  which an answer can lead into its code through the kernel's attributes)
+  can read the hook's frames (about one landing in five in
+  ``tests/test_seal.py``'s timer).
+
+The sandbox (:mod:`tutorial.tools.grading.sandbox`) bounds what such code
+could reach outside the kernel.  The hook itself calls no answer's code (no
+``str()``, no library function an answer could replace); code that runs
+inside it unasked (a signal's handler, a finalizer) may do none of what it
+watches.
 
 The module is over 400 lines and still one job: the hook and all it keeps
 are closures of one function (:func:`_make_hook`), which no other module,
@@ -472,15 +485,36 @@ def _make_hook(
         name = code.co_filename
         return any(name.endswith(end) and code.co_qualname == qualname for end, qualname in names)
 
+    def its_modules(frame):
+        """Whether ``frame`` runs with its module's own globals: a function an answer made of the library's code
+        (``types.FunctionType``) with globals of its own would pass for the library's, and call the answer's
+        names with what the library hands them (``traceback.extract_stack``'s frame)."""
+        space = frame.f_globals
+        name = dict.get(space, "__name__")
+        module = dict.get(loaded, name) if type(name) is str else None  # noqa: F821 - a private global
+        return type(module) is types.ModuleType and module.__dict__ is space
+
     def consumer(frame):
-        """Whether the library code that took a frame, past its wrappers, is one of :data:`FRAME_CONSUMERS`."""
+        """Whether the library code that took a frame, past its wrappers, is one of :data:`FRAME_CONSUMERS`, each
+        with its own module's globals."""
         while frame is not None and not learner(frame) and named(frame.f_code, FRAME_WRAPPERS):  # noqa: F821
+            if not its_modules(frame):
+                return False
             frame = frame.f_back
-        if frame is None or learner(frame):
+        if frame is None or learner(frame) or not its_modules(frame):
             return False
         if named(frame.f_code, (TRACEBACK_LINES,)):  # noqa: F821 - a private global
             return dict.get(frame.f_locals, "capture_locals") is False  # never an answer's object's __bool__
         return named(frame.f_code, FRAME_CONSUMERS)  # noqa: F821
+
+    def by_an_answer(frame):
+        """Whether ``frame``, or the code that called it through ctypes' own Python (``string_at``, ``cast`` wrap
+        its C functions), is an answer's."""
+        while frame is not None and frame.f_code.co_filename.endswith("/ctypes/__init__.py") and not learner(frame):
+            if not its_modules(frame):
+                return True
+            frame = frame.f_back
+        return frame is None or learner(frame)
 
     def frame_taken(caller):
         """Whether a frame taken by ``caller`` during a check could reach the answer: the answer's own call, or a
@@ -732,7 +766,7 @@ def _make_hook(
                 send(NOTE, "outside", f"opened {path}", here())
         elif event in ("os.symlink", "os.link") and type(args[0]) is str and "/proc/" in absolute(args[0]):
             refuse(f"a link to {args[0]}")
-        elif event.startswith("ctypes.") and learner(caller):
+        elif event.startswith("ctypes.") and by_an_answer(caller):
             refuse(event)  # raw memory: the seal's key, or any object
         elif event in ("gc.get_objects", "gc.get_referrers", "gc.get_referents") and learner_near(caller):
             refuse(event)  # every object, the hook's closures among them
