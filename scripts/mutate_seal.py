@@ -19,9 +19,10 @@ seal with ``tests/test_seal.py`` as the tests, and there:
 3. tells mutmut, in its copy of ``tests/test_seal.py``, that the seal's tests
    reach every function of the seal (mutmut counts calls in its own process,
    and the sealed Python of that count runs the original);
-4. runs mutmut on every mutant, on a seeded sample of ``N``, or on those that
-   change a line ``git diff REV`` shows changed in the seal (``--changed-since``:
-   a round on what changed since the last), then ``scripts/mutation_report.py`` there.
+4. runs mutmut on every mutant, or on those that change a line ``git diff REV``
+   shows changed in the seal (``--changed-since``: a round on what changed since
+   the last), or a seeded sample of ``N`` of either, then
+   ``scripts/mutation_report.py`` there.
 
 About 35 s a mutant on two cores (2026-11-28, the seal's tests then 17 s): the seal's 1,092 take about eleven hours.
 Remove the worktree with ``git worktree remove --force DIR``.
@@ -156,14 +157,19 @@ def main(argv=None) -> int:
     patch_mutants(tree)
     names = []
     if args.changed_since is not None:
-        names = mutants_on(tree, changed_lines(args.changed_since))
-        print(f"{len(names)} mutants change a line changed since {args.changed_since}", flush=True)
-        if not names:
+        every = mutants_on(tree, changed_lines(args.changed_since))
+        print(f"{len(every)} mutants change a line changed since {args.changed_since}", flush=True)
+        if not every:
             return 0
     elif args.sample is not None:
         listed = subprocess.run([*mutmut, "results", "--all", "true"], cwd=tree, capture_output=True, text=True)
         every = sorted(line.split(":")[0].strip() for line in listed.stdout.splitlines() if "__mutmut_" in line)
-        names = sorted(random.Random(args.seed).sample(every, min(args.sample, len(every))))
+    if args.sample is not None or args.changed_since is not None:
+        names = (
+            every
+            if args.sample is None
+            else sorted(random.Random(args.seed).sample(every, min(args.sample, len(every))))
+        )
     subprocess.run([*mutmut, "run", "--max-children", str(os.cpu_count() or 1), *names], cwd=tree, env=env)
     return subprocess.run([sys.executable, str(tree / "scripts" / "mutation_report.py")], cwd=tree).returncode
 
