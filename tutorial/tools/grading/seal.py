@@ -249,53 +249,18 @@ def install(
     }
     make = types.FunctionType(_make_hook.__code__, private, "_make_hook")
     hidden = tuple(h.rstrip("/") + "/" for h in hidden)
-    hook = make(
-        key,
-        fd,
-        modules,
-        roots,
-        readable,
-        hidden,
-        seed,
-        calls,
-        grader,
-        builtins.__dict__,
-        _hashlib.hmac_digest,
-        os.write,
-        sys._getframe,
-        # the real functions that set a Python signal handler or make a built-in module anew: in the hook's
-        # closures alone, their modules' names gated from here on
-        (
-            _signal.signal,
-            _signal.getsignal,
-            _signal.valid_signals,
-            _signal.default_int_handler,
-            _kernels_handler_codes(),
-        ),
-        _imp.create_builtin,
-    )
+    # the real functions that set a Python signal handler or make a built-in module anew go to the hook's
+    # closures alone; their modules' names are gated from here on
+    signals = (_signal.signal, _signal.getsignal, _signal.valid_signals, _signal.default_int_handler)
+    tools = (_hashlib.hmac_digest, os.write, sys._getframe, (*signals, _kernels_handler_codes()), _imp.create_builtin)
+    hook = make(key, fd, modules, roots, readable, hidden, seed, calls, grader, builtins.__dict__, tools)
     sys.addaudithook(hook)
     _signal.signal, _imp.create_builtin = _gated_signal, _gated_create_builtin
 
 
-def _make_hook(
-    key,
-    fd,
-    modules,
-    roots,
-    readable,
-    hidden,
-    seed,
-    calls,
-    grader,
-    builtin_names,
-    hmac_digest,
-    write,
-    getframe,
-    signals,
-    create_builtin,
-):  # noqa: C901
+def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, builtin_names, tools):  # noqa: C901
     """The audit hook, its state in closures only (made with private globals by :func:`install`)."""
+    hmac_digest, write, getframe, signals, create_builtin = tools
     trusted: dict[int, object] = {}  # id -> object (kept alive, so an id is never reused)
     snapshot: list[tuple] = []  # (where, namespace, name, object): compared by identity
     function_parts: list[tuple] = []  # (function, code, defaults, kwdefaults, closure contents)
