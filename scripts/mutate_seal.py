@@ -107,24 +107,24 @@ def changed_lines(rev: str) -> set[int]:
 def mutants_on(tree: Path, lines: set[int]) -> list[str]:
     """The mutants, in mutmut's copy of the seal, that change one of the seal's ``lines`` (its own numbering)."""
     source = (ROOT / SEAL).read_text().splitlines()
+    first = {line[4:].partition("(")[0]: i + 1 for i, line in enumerate(source) if line.startswith("def ")}
     copy = (tree / "mutants" / SEAL).read_text()
+    copied = copy.splitlines()
     functions = {
-        node.name: copy.splitlines()[node.lineno - 1 : node.end_lineno]
+        node.name: copied[node.lineno - 1 : node.end_lineno]
         for node in ast.walk(ast.parse(copy))
         if isinstance(node, ast.FunctionDef) and "__mutmut_" in node.name
     }
     found = []
     for name, body in functions.items():
         stem, _, number = name.rpartition("__mutmut_")
-        if number == "orig" or f"{stem}__mutmut_orig" not in functions:
+        start = first.get(stem[2:])  # mutmut names a function's copies x_<name>__mutmut_<n>
+        if number == "orig" or f"{stem}__mutmut_orig" not in functions or start is None:
             continue
         original = functions[f"{stem}__mutmut_orig"]
-        first = next((i + 1 for i, line in enumerate(source) if line.startswith(f"def {stem[2:]}(")), None)
-        if first is None:
-            continue
         body = [line.replace(name, f"{stem}__mutmut_orig") for line in body]
         for tag, i1, i2, _, _ in difflib.SequenceMatcher(a=original, b=body, autojunk=False).get_opcodes():
-            if tag != "equal" and any(first + i in lines for i in range(i1, max(i2, i1 + 1))):
+            if tag != "equal" and any(start + i in lines for i in range(i1, max(i2, i1 + 1))):
                 found.append(f"tutorial.tools.grading.seal.{name}")
                 break
     return sorted(found)
@@ -155,21 +155,17 @@ def main(argv=None) -> int:
     if not (tree / "mutants" / SEAL).exists():
         subprocess.run([*mutmut, "run"], cwd=tree, env=env, check=False)  # stops at its clean tests: step 1
     patch_mutants(tree)
-    names = []
+    names = []  # none: every mutant
     if args.changed_since is not None:
-        every = mutants_on(tree, changed_lines(args.changed_since))
-        print(f"{len(every)} mutants change a line changed since {args.changed_since}", flush=True)
-        if not every:
+        names = mutants_on(tree, changed_lines(args.changed_since))
+        print(f"{len(names)} mutants change a line changed since {args.changed_since}", flush=True)
+        if not names:
             return 0
     elif args.sample is not None:
         listed = subprocess.run([*mutmut, "results", "--all", "true"], cwd=tree, capture_output=True, text=True)
-        every = sorted(line.split(":")[0].strip() for line in listed.stdout.splitlines() if "__mutmut_" in line)
-    if args.sample is not None or args.changed_since is not None:
-        names = (
-            every
-            if args.sample is None
-            else sorted(random.Random(args.seed).sample(every, min(args.sample, len(every))))
-        )
+        names = sorted(line.split(":")[0].strip() for line in listed.stdout.splitlines() if "__mutmut_" in line)
+    if args.sample is not None:
+        names = sorted(random.Random(args.seed).sample(names, min(args.sample, len(names))))
     subprocess.run([*mutmut, "run", "--max-children", str(os.cpu_count() or 1), *names], cwd=tree, env=env)
     return subprocess.run([sys.executable, str(tree / "scripts" / "mutation_report.py")], cwd=tree).returncode
 

@@ -716,7 +716,11 @@ def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, b
             if filename.startswith(roots) or filename.startswith("<frozen"):
                 # Library code is known by its file's name: code compiled under that name is the library's only
                 # when it is that file's source (the import system's compile of it), whoever asked for it
-                if learner_near(caller) if event == "code.__new__" else not same_source(args[0], filename):
+                if event == "code.__new__":
+                    forged = learner_near(caller)
+                else:
+                    forged = not same_source(args[0], filename)
+                if forged:
                     refuse(f"code claiming to be the library's ({filename})")
         elif event == "open":
             path = args[0]
