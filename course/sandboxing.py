@@ -19,7 +19,12 @@ Its flags say why not, or what else was seen:
 - ``not run``: the kernel had died in an earlier cell, so no cell of the exercise ran;
 - ``over a limit``: memory, processes or CPU time ran out (``MemoryError``, ...);
 - ``network``, ``processes``, ``outside its folder``: what the seal noted the answer doing;
-- ``grader-aware``: the answer looks for nbgrader (``NBGRADER_...``).
+- ``grader-aware``: the answer looks for nbgrader (``NBGRADER_...``);
+- ``checked again``: the kernel asked the judge for a judged check that had already run (its first verdict
+  stands).
+
+A judged exercise (:data:`tutorial.tools.grading.judge.JUDGED`: its check ran in the judge, a process of the
+grader's, which the answer cannot reach) takes its verdict from the judge's lines alone.
 
 The flags go to ``flags.json`` in the course (kept across runs), the
 ``flags`` column of ``grades.csv``, the learner's feedback (one line under
@@ -44,6 +49,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from tutorial.tools.grading import keyrings
+from tutorial.tools.grading.judge import JUDGED_NAMES
 from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -219,17 +225,27 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
         gid = grade_id(cell)
         if gid.startswith(("exercise_", "check_")):
             current = number(gid)
-            exercises.setdefault(current, {"cells": [*before] if not exercises else [], "source": ""})
+            exercises.setdefault(current, {"cells": [*before] if not exercises else [], "source": "", "check": ""})
             if gid.startswith("exercise_"):
                 exercises[current]["source"] = "".join(cell["source"])
+            else:  # the test cell, nbgrader's read-only one: which check it calls
+                exercises[current]["check"] = "".join(cell["source"])
         if cell["cell_type"] == "code":
             (exercises[current]["cells"] if current else before).append(cell)
     passed: dict[str, bool] = {}
     flags: dict[str, list[str]] = {n: [] for n in exercises}
+    judged = {n for n, found in exercises.items() if JUDGED_NAMES & set(re.findall(r"\b(check_\w+)\(", found["check"]))}
     pending: list[str] = []  # notes before a check: the answer cell's, which comes before it
     lines = verdicts.read_text().splitlines() if verdicts.is_file() else []
     for line in lines:
         kind, *rest = line.split("\t")
+        by_judge = kind == "judged"  # the judge's own line (the seal's reader refuses one signed so)
+        if by_judge:
+            kind, *rest = rest or [""]
+        if kind in ("begin", "verdict") and rest and (rest[0] in judged) != by_judge:
+            if not by_judge:  # the seal saw a judged check run in the kernel: the teacher's, reloaded by the answer
+                flags.setdefault(rest[0], []).append("tampering")
+            continue  # a judged exercise's verdict is the judge's alone
         if kind == "note":
             flag = {"refused": "tampering", "outside": "outside its folder"}.get(rest[0], rest[0])
             if len(rest) > 2 and rest[2] in flags:  # a note that names its exercise

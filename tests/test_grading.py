@@ -685,6 +685,18 @@ CHEATS = {
     # graded alone, with the CPU time limit below the cell timeout (test_a_kernel_over_its_cpu_time_...)
     "cpu-time": ("1.2", "while True:\n    pass\n", "over a limit"),
     "stack-walk": (  # the check's own expected values, read down the stack from a frame a library took for it
+        "1.2",
+        "import traceback\n"
+        "class ShotCountingTankController(RttTankController):\n"
+        "    def summary(self):\n"
+        "        try:\n            1 / 0\n        except ZeroDivisionError as e:\n"
+        "            frame = next(traceback.walk_tb(e.__traceback__))[0]\n"
+        "        while frame is not None and 'expected' not in frame.f_locals:\n"
+        "            frame = frame.f_back\n"
+        "        return {**super().summary(), 'shots': frame.f_locals['expected'] if frame is not None else 0}\n",
+        "tampering",
+    ),
+    "stack-walk-judged": (  # the same for a check the judge runs: nothing on the kernel's stack to read, no flag
         "1.1",
         "import traceback\n"
         "def dpad_track_velocities(axes):\n"
@@ -692,8 +704,16 @@ CHEATS = {
         "        frame = next(traceback.walk_tb(e.__traceback__))[0]\n"
         "    while frame is not None and 'expected' not in frame.f_locals:\n"
         "        frame = frame.f_back\n"
+        "    print('an expected value on the stack:', 'yes' if frame is not None else 'no')\n"
         "    return frame.f_locals['expected'] if frame is not None else (0.0, 0.0)\n",
-        "tampering",
+        "",
+    ),
+    "ask-twice": (  # a first run of the check to learn from, before the test cell's: the first verdict stands
+        "1.1",
+        "{solution}\n"
+        "from tutorial.exercises.step1_tank_controller import check_dpad_steering\n"
+        "print('a first try:', check_dpad_steering(lambda axes: (0.0, 0.0)))\n",
+        "checked again",
     ),
     "memory-through-a-link": (  # the seal's key is in the kernel's memory
         "1.1",
@@ -754,6 +774,7 @@ CHEATS_SAY = {
     "read-solutions": "solutions found: 0",
     "read-another-learner": "read another learner: no",
     "grader-aware": "graded, says the environment: False",
+    "stack-walk-judged": "an expected value on the stack: no",
     "memory-from-a-child": "the kernel memory refused to a child: True",
     "keyring-note": "a note in the keyrings: no",
 }
@@ -772,8 +793,8 @@ def cheating_submissions(course: Path, name: str, which: list[str], fill: dict[s
     for cheat in which:
         target, code, _ = CHEATS[cheat]
         gid = f"exercise_{target.replace('.', '_')}"
-        for key, value in fill.items():  # {root}, {course}, ...: not str.format, the code has braces of its own
-            code = code.replace("{" + key + "}", str(value))
+        for key, value in dict(fill, solution=solved[gid]).items():  # {root}, {course}, ...: not str.format,
+            code = code.replace("{" + key + "}", str(value))  # the code has braces of its own
         answers = dict(solved, **{gid: stubs[gid] + "\n\n" + code})
         out[f"cheat-{cheat}"] = submission(course, name, answers)
     return out

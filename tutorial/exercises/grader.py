@@ -94,8 +94,12 @@ class Result:
         """
         sys.audit("rtt.verdict", self)  # to the grading kernel's seal (tutorial.tools.grading.seal), if any
         if not self.passed:
-            raise AssertionError(textwrap.fill(str(self), WRAP, subsequent_indent="  ", break_long_words=False))
+            raise AssertionError(self.wrapped())
         return self
+
+    def wrapped(self) -> str:
+        """The one line, wrapped at :data:`WRAP` characters without breaking a word."""
+        return textwrap.fill(str(self), WRAP, subsequent_indent="  ", break_long_words=False)
 
 
 def grade(exercise: str, cases: Iterable[Case]) -> Result:

@@ -42,12 +42,16 @@ import secrets
 import shlex
 import shutil
 import signal
+import socket
+import subprocess
 import sys
 import threading
 from pathlib import Path
 
 from jupyter_client.manager import AsyncKernelManager
 from nbgrader.preprocessors import Execute
+
+from tutorial.tools.grading import judged
 
 ENV = "RTT_SANDBOX"
 PRIVATE = ("/tmp", "/var/tmp", "/dev/shm")  # the kernel's own, empty at its start
@@ -229,8 +233,11 @@ class SandboxedKernelManager(AsyncKernelManager):
         self._key = secrets.token_bytes(32)
         self._key_read, self._key_write = os.pipe()
         self._verdict_read, self._verdict_write = os.pipe()
-        kw["pass_fds"] = (self._key_read, self._verdict_write)
+        self._judges_end, self._kernels_end = socket.socketpair()  # the judge's checks, data only (judge.py)
+        kw["pass_fds"] = (self._key_read, self._verdict_write, self._kernels_end.fileno())
         kw["env"]["RTT_SEAL_FDS"] = f"{self._key_read},{self._verdict_write}"
+        kw["env"][judged.ENV] = str(self._kernels_end.fileno())
+        self._judge_env = {k: v for k, v in kw["env"].items() if k in PASSED_ENV} | {"HOME": str(here)}
         # ipykernel's own launcher's arguments (the connection file, nbgrader's history in memory), sealed first
         kernel = [sys.executable, "-I", "-m", "tutorial.tools.grading.sealed_kernel", *cmd[cmd.index("-f") :]]
         return sandbox_command(job, kernel, kept_paths(job.hide), cgroups(job)), kw
@@ -241,7 +248,9 @@ class SandboxedKernelManager(AsyncKernelManager):
         finally:
             os.close(self._key_read)
             os.close(self._verdict_write)
+            self._kernels_end.close()
         job = self._job
+        self._start_judge(job)
         given = {
             "key": self._key.hex(),
             "test_calls": job.test_calls,
@@ -254,13 +263,36 @@ class SandboxedKernelManager(AsyncKernelManager):
         self._reader = threading.Thread(target=self._read_verdicts, name="seal-verdicts", daemon=True)
         self._reader.start()
 
+    def _start_judge(self, job: Job) -> None:
+        """The judge (:mod:`tutorial.tools.grading.judge`) of this kernel's judged checks: the grader's process,
+        outside the sandbox, which imports the teacher's checks now and gets the seed on a pipe."""
+        fd = self._judges_end.fileno()
+        self._judge = subprocess.Popen(
+            [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(fd), job.verdicts],
+            pass_fds=(fd,),
+            stdin=subprocess.PIPE,
+            stderr=open(Path(self.connection_file).parent / "judge.log", "ab"),  # noqa: SIM115 - the child's
+            env=self._judge_env,
+            text=True,
+        )
+        self._judges_end.close()
+        self._judge.stdin.write(job.seed + "\n")
+        self._judge.stdin.close()
+
     async def _async_cleanup_resources(self, restart: bool = False):
-        """After the kernel ended, shut down or dead (nbclient then only cleans up): every line it wrote is in
-        the verdict file before nbgrader goes on."""
+        """After the kernel ended, shut down or dead (nbclient then only cleans up): every line it and its judge
+        wrote is in the verdict file before nbgrader goes on."""
         await super()._async_cleanup_resources(restart=restart)
         reader = getattr(self, "_reader", None)
         if reader is not None:
             await asyncio.get_running_loop().run_in_executor(None, reader.join, 10.0)
+        judge = getattr(self, "_judge", None)
+        if judge is not None:  # it ends when the kernel's end of the socket closes; a check still running, later
+            try:
+                await asyncio.get_running_loop().run_in_executor(None, judge.wait, 30.0)
+            except subprocess.TimeoutExpired:
+                judge.kill()
+                judge.wait()
 
     # what nbclient calls (the base class binds its own function); shutdown_kernel calls the method above itself
     cleanup_resources = _async_cleanup_resources
@@ -277,7 +309,7 @@ class SandboxedKernelManager(AsyncKernelManager):
                 line = raw.decode("utf-8", "replace").rstrip("\n")
                 body, _, mac = line.rpartition("\t")
                 good = hmac.new(self._key, body.encode(), "sha256").hexdigest()
-                ok = hmac.compare_digest(mac.encode(), good.encode())
+                ok = hmac.compare_digest(mac.encode(), good.encode()) and not body.startswith("judged")
                 out.write((body if ok else "note\ttampering\tan unsigned line on the seal's pipe\t") + "\n")
                 out.flush()
 

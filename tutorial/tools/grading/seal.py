@@ -47,8 +47,9 @@ comes from the seal's signed verdicts, not from the cell's output:
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
   grader's; :mod:`tutorial.tools.grading.sandbox` reads and checks it.
 
-What the seal does not stop (one process is no wall; only the checks in a
-process of their own, exchanging data with the answer's, would be):
+What the seal does not stop (one process is no wall; the checks of
+:data:`tutorial.tools.grading.judge.JUDGED` run in a process of their own,
+the judge, exchanging only data with the answer's; the others run here):
 
 * reading or writing the process's memory without an audit event: NumPy's
   array interface (``__array_interface__`` with any address) and

@@ -1,0 +1,315 @@
+"""The judge: the checks of data-only exercises run in a process of their own, and only data crosses.
+
+A real judge process (``python -I -m tutorial.tools.grading.judge``) on one end
+of a socket pair, the kernel's side (:class:`tutorial.tools.grading.judged.Judge`)
+in this process on the other, as while grading:
+
+- a worked solution, and every wrong answer of a judged exercise, get from
+  the judge the very line the check gives in-process with the same seed
+  (so the judge's checks fail every mistake the tests prove the checks fail);
+- each check runs once (asked again: refused, its first verdict stands,
+  noted); an interrupted answer leaves no verdict and the next check runs;
+- a kernel that sends junk, an unknown check, a value the wire does not
+  build, or a float that compares as it likes gets a failing verdict and a
+  tampering note, and the judge keeps serving;
+- the wire builds only what it lists (:mod:`tutorial.tools.grading.wire`);
+- the grader takes a judged exercise's verdict from the judge alone.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from exercise_rules import HIDDEN_MISTAKES
+from test_exercises import MISTAKES, exercise, first_three_of_each, grade, hidden_cases_on, mistake_id
+
+from tutorial.tools.grading import judge, judged, wire
+
+from conftest import ROOT
+
+sys.path.insert(0, str(ROOT / "course"))
+import sandboxing  # noqa: E402 - course/ is not a package
+
+SEED = "test"  # the seed tests/test_exercises.py's grading_seed gives the in-process checks
+NUMBERS = ["1.1", "3.2", "7.2", "8.1", "8.2", "9.1", "10.1", "11.1"]  # the judged exercises
+
+
+class JudgeProcess:
+    """A judge process and the kernel's end of its socket (``kernel``), with its verdict file."""
+
+    def __init__(self, folder: Path, seed: str = SEED):
+        self.verdicts = folder / "verdicts.txt"
+        ours, theirs = socket.socketpair()
+        self.process = subprocess.Popen(
+            [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(theirs.fileno()), str(self.verdicts)],
+            pass_fds=(theirs.fileno(),),
+            stdin=subprocess.PIPE,
+            text=True,
+        )
+        theirs.close()
+        self.process.stdin.write(seed + "\n")
+        self.process.stdin.close()
+        self.sock = ours
+        self.kernel = judged.Judge(ours)
+
+    def lines(self) -> list[list[str]]:
+        return [line.split("\t") for line in self.verdicts.read_text().splitlines()] if self.verdicts.exists() else []
+
+    def close(self) -> int:
+        """The kernel's end closed: the judge ends (its exit status)."""
+        self.kernel._reader.close()
+        self.sock.close()
+        return self.process.wait(timeout=30)
+
+
+@pytest.fixture
+def judge_process(tmp_path):
+    made = JudgeProcess(tmp_path)
+    yield made
+    if made.process.poll() is None:
+        assert made.close() == 0
+
+
+def answer_of(number: str, source: str):
+    """The function ``source`` (after the stub) defines for exercise ``number``, as a notebook would."""
+    ex = exercise(number)
+    names: dict = {}
+
+    def keep(answer):  # the check is not run here: the judge runs it
+        names["answer"] = answer
+
+    import importlib
+
+    module = importlib.import_module(f"tutorial.exercises.{ex['checks']}")
+    real = getattr(module, ex["check"])
+    setattr(module, ex["check"], keep)
+    try:
+        grade(ex, ex["stub"], source)
+    except TypeError:
+        pass  # grade() called str() on what keep returned
+    finally:
+        setattr(module, ex["check"], real)
+    return names["answer"]
+
+
+def test_judged_is_the_judge_modules_table_and_names_the_function_exercises():
+    table = {(module, name) for module, names in judge.JUDGED.items() for name in names}
+    exercises = {(f"tutorial.exercises.{exercise(n)['checks']}", exercise(n)["check"]) for n in NUMBERS}
+    assert table == exercises and judge.JUDGED_NAMES == {name for _, name in table}
+
+
+KEPT = {"1.1", "9.1"}  # make test's: a function of lists, and one raising the KeyError its statement asks for
+
+
+@pytest.mark.parametrize(
+    "number", [n if n in KEPT else pytest.param(n, marks=pytest.mark.more) for n in sorted(NUMBERS)]
+)
+def test_the_judge_gives_the_worked_solution_the_line_the_kernel_would(ros, monkeypatch, judge_process, number):
+    ex = exercise(number)
+    hidden_cases_on(monkeypatch, ex["checks"], seed=SEED)
+    in_kernel = grade(ex, ex["stub"], ex["solution"])
+    got = judge_process.kernel.run(ex["check"], answer_of(number, ex["solution"]))
+    assert got.passed and "hidden ones)" in got.message, str(got)
+    assert str(got) == str(in_kernel)
+    lines = judge_process.lines()
+    assert lines[0] == ["judged", "begin", number] and lines[1][:5] == ["judged", "verdict", number, "1", "1"]
+
+
+JUDGED_MISTAKES = [m for m in MISTAKES if m[0] in NUMBERS] + [m for m in HIDDEN_MISTAKES if m[0] in NUMBERS]
+IN_MAKE_TEST = {mistake_id(m) for m in first_three_of_each([m for m in JUDGED_MISTAKES if m[0] == "1.1"])[:1]}
+
+
+@pytest.mark.parametrize(
+    "number, right, wrong, caught_by",
+    [m if mistake_id(m) in IN_MAKE_TEST else pytest.param(*m, marks=pytest.mark.more) for m in JUDGED_MISTAKES],
+    ids=[mistake_id(m) for m in JUDGED_MISTAKES],
+)
+def test_the_judge_fails_each_wrong_answer_as_the_kernel_would(
+    ros, monkeypatch, tmp_path, number, right, wrong, caught_by
+):
+    ex = exercise(number)
+    source = ex["solution"].replace(right, wrong)
+    hidden_cases_on(monkeypatch, ex["checks"], seed=SEED)
+    in_kernel = grade(ex, ex["stub"], source)
+    process = JudgeProcess(tmp_path)
+    try:
+        got = process.kernel.run(ex["check"], answer_of(number, source))
+    finally:
+        assert process.close() == 0
+    assert not got.passed and str(got) == str(in_kernel)
+    assert process.lines()[-1][:4] == ["judged", "verdict", number, "0"]
+
+
+def test_a_check_runs_once_and_its_first_verdict_stands(judge_process):
+    first = judge_process.kernel.run("check_dpad_steering", lambda axes: (0.0, 0.0))  # a try to learn from
+    right = answer_of("1.1", exercise("1.1")["solution"])
+    again = judge_process.kernel.run("check_dpad_steering", right)
+    assert not first.passed and not again.passed
+    assert "its first verdict stands" in again.message
+    verdicts = [line for line in judge_process.lines() if line[1] == "verdict"]
+    assert [v[3] for v in verdicts] == ["0"]
+    assert ["judged", "note", "checked again"] == judge_process.lines()[-1][:3]
+
+
+def test_an_interrupted_answer_leaves_no_verdict_and_the_next_check_runs(judge_process):
+    def interrupted(axes):
+        raise KeyboardInterrupt  # what the cell's timeout does to an answer that never returns
+
+    with pytest.raises(KeyboardInterrupt):
+        judge_process.kernel.run("check_dpad_steering", interrupted)
+    after = judge_process.kernel.run("check_after", answer_of("11.1", exercise("11.1")["solution"]))
+    assert after.passed, str(after)
+    lines = judge_process.lines()
+    assert ["judged", "begin", "1.1"] in lines and not any(line[1:3] == ["verdict", "1.1"] for line in lines)
+    assert any(line[1:5] == ["verdict", "11.1", "1", "1"] for line in lines)
+
+
+def raw_kernel(process: JudgeProcess, *messages: bytes, run: str = "raw") -> list[dict]:
+    """Send ``messages`` as the kernel's raw bytes; the judge's replies until it asks for a call or gives a result
+    for ``run`` (an id the kernel's own side never gives)."""
+    replies = []
+    reader = process.kernel._reader
+    for message in messages:
+        process.sock.sendall(message)
+    while True:
+        reply = json.loads(reader.readline())
+        replies.append(reply)
+        if ("result" in reply or "call" in reply) and reply.get("id") == run:
+            return replies
+
+
+def test_a_kernel_that_sends_junk_or_asks_for_no_check_is_noted_and_the_judge_goes_on(judge_process):
+    replies = raw_kernel(judge_process, b"not json\n", b'{"check": ["x"]}\n', b'{"check": "os.system", "id": "raw"}\n')
+    assert replies[-1]["result"]["passed"] is False
+    notes = [line for line in judge_process.lines() if line[1] == "note"]
+    assert [n[2] for n in notes] == ["tampering"] * 3
+    right = answer_of("1.1", exercise("1.1")["solution"])
+    assert judge_process.kernel.run("check_dpad_steering", right).passed
+
+
+@pytest.mark.parametrize(
+    "returned, said",
+    [
+        ({"object": ["os:system", {}]}, "no such class on the wire"),
+        ({"message": ["std_msgs/msg/String", {"data": "x"}]}, "no such message on the wire"),
+        ({"ndarray": ["|O", [2], [1, 2]]}, "only booleans and numbers cross"),
+        ({"opaque": ["Anything", "0.0", True]}, "compares as it likes"),
+    ],
+    ids=["a class not listed", "a message not listed", "an array of objects", "a float that says it is equal"],
+)
+def test_a_value_the_wire_does_not_build_fails_the_case_and_is_noted(judge_process, returned, said):
+    raw_kernel(judge_process, b'{"check": "check_dpad_steering", "id": "raw"}\n')
+    replies = raw_kernel(judge_process, wire.dumps({"id": "raw", "return": {"tuple": [returned, 0.0]}}))
+    assert replies[-1]["result"]["passed"] is False
+    notes = [line for line in judge_process.lines() if line[1] == "note"]
+    assert notes and notes[0][2] == "tampering" and said in notes[0][3], judge_process.lines()
+    verdict = next(line for line in judge_process.lines() if line[1] == "verdict")
+    assert verdict[3:5] == ["0", "0"]  # failed, and not intact
+
+
+def test_an_answers_own_float_class_arrives_as_a_value_equal_to_nothing(judge_process):
+    class Anything(float):
+        def __eq__(self, other):
+            return True
+
+        __hash__ = float.__hash__
+
+    got = judge_process.kernel.run("check_dpad_steering", lambda axes: (Anything(0), Anything(0)))
+    assert not got.passed and "returned (0.0, 0.0)" in got.message
+    assert any(line[1:3] == ["note", "tampering"] and "a Anything" in line[3] for line in judge_process.lines())
+
+
+def test_an_exception_arrives_by_its_name_and_a_keyerror_as_itself(ros, judge_process):
+    def lookup(transforms, frame):
+        raise KeyError(frame)
+
+    got = judge_process.kernel.run("check_lookup", lookup)  # a KeyError for a frame that is not there passes
+    assert not got.passed and "raised KeyError" in got.message and "expected a KeyError" not in got.message
+
+
+WIRED = [
+    None,
+    True,
+    3,
+    2.5,
+    math.inf,
+    "text",
+    [1, (2.0, "x")],
+    {"a": [1.0]},
+    np.arange(6.0).reshape(2, 3),
+    np.float32(1.5),
+    np.int64(7),
+]
+
+
+@pytest.mark.parametrize("value", WIRED, ids=[type(v).__name__ for v in WIRED])
+def test_the_wire_builds_back_what_it_carries(value):
+    got = wire.decode(wire.loads(wire.dumps({"v": wire.encode(value)}))["v"])
+    assert type(got) is type(value)
+    if isinstance(value, np.ndarray):
+        assert got.dtype == value.dtype and (got == value).all()
+    else:
+        assert got == value
+
+
+def test_the_wire_carries_the_checks_data_classes_messages_parameters_and_qos(ros):
+    from rcl_interfaces.msg import SetParametersResult
+    from rclpy.parameter import Parameter
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    from tutorial.interfaces.tf import Transform
+
+    values = [
+        Transform((1, 2), "world", "CHASSIS", (1.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)),
+        SetParametersResult(successful=False, reason="no"),
+        Parameter("rate", Parameter.Type.DOUBLE, 50.0),
+        QoSProfile(depth=3, reliability=ReliabilityPolicy.BEST_EFFORT),
+    ]
+    for value in values:
+        got = wire.decode(wire.loads(wire.dumps({"v": wire.encode(value)}))["v"])
+        assert type(got) is type(value)
+    assert got.depth == 3 and got.reliability == ReliabilityPolicy.BEST_EFFORT
+
+
+@pytest.mark.parametrize(
+    "line",
+    [b'{"v": NaN}', b"[1]", b'{"v": ' * 2000 + b"1" + b"}" * 2000, b" " * (wire.MAX_LINE + 1)],
+    ids=["an untagged NaN", "not an object", "nested too deep", "too long"],
+)
+def test_the_wire_refuses_a_line_it_does_not_read(line):
+    with pytest.raises(wire.WireError):
+        wire.loads(line)
+
+
+def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_path):
+    def cell(gid, source, grade=False):
+        meta = {"nbgrader": {"grade_id": gid, "grade": grade, "solution": not grade}}
+        return {"cell_type": "code", "metadata": meta, "source": source, "outputs": []}
+
+    notebook = {
+        "cells": [
+            cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
+            cell("check_1_1", "check_dpad_steering(dpad_track_velocities).require()", True),
+            cell("exercise_1_2", "class ShotCountingTankController: ..."),
+            cell("check_1_2", "check_shot_counter(ShotCountingTankController).require()", True),
+        ]
+    }
+    graded = tmp_path / "graded.ipynb"
+    graded.write_text(json.dumps(notebook))
+    verdicts = tmp_path / "verdicts.txt"
+    # the seal's lines (signed, so from the kernel) pass 1.1 too: the kernel's word for a judged check counts not
+    verdicts.write_text("begin\t1.1\nverdict\t1.1\t1\t1\t\njudged\tbegin\t1.1\njudged\tverdict\t1.1\t0\t1\t\n")
+    verdicts.write_text(verdicts.read_text() + "begin\t1.2\nverdict\t1.2\t1\t1\t\n")
+    judged_ = sandboxing.judge(graded, verdicts, "")
+    assert judged_["1.1"] == (False, ["tampering"]) and judged_["1.2"] == (True, [])
+    verdicts.write_text("judged\tbegin\t1.1\njudged\tverdict\t1.1\t1\t1\t\nbegin\t1.2\nverdict\t1.2\t1\t1\t\n")
+    assert sandboxing.judge(graded, verdicts, "") == {"1.1": (True, []), "1.2": (True, [])}
+    verdicts.write_text("begin\t1.2\njudged\tverdict\t1.2\t1\t1\t\n")  # the judge's word for a sealed check: none
+    assert sandboxing.judge(graded, verdicts, "")["1.2"][0] is False

@@ -1,0 +1,283 @@
+"""``python -I -m tutorial.tools.grading.judge FD VERDICTS``: the teacher's checks, in a process of their own.
+
+An answer and a check in one process are no wall: the answer can reach the
+check's memory (:mod:`tutorial.tools.grading.seal` says how).  So, while
+grading, the checks of :data:`JUDGED` (the exercises whose answer is a
+function of data) run here, in the judge, which
+:class:`tutorial.tools.grading.sandbox.SandboxedKernelManager` starts beside
+each graded kernel, outside its sandbox.  The judge imports the teacher's
+checks before the kernel runs any cell, keeps the learner's seed of hidden
+cases (read from its standard input, never an argument another user can read),
+and shares with the kernel only a socket (``FD``), over which data crosses
+(:mod:`tutorial.tools.grading.wire`):
+
+1. the kernel's test cell calls the check (:mod:`tutorial.tools.grading.judged`
+   put a stand-in in its place), which asks: ``{"check": name}``;
+2. the judge runs the teacher's check with a stand-in for the answer
+   (:class:`Answer`): each call of it sends the arguments, ``{"call": [...]}``,
+   and the kernel runs the learner's function on them and sends back what it
+   returned or raised;
+3. the judge writes the verdict to ``VERDICTS`` (which the grader alone reads:
+   ``course/sandboxing.py``) and sends the kernel the check's line to show.
+
+The expected values, the hidden cases' rules and the seed never leave this
+process; an answer learns a hidden case's input, as any function does, and
+only whether the check passed.  Each check runs once: asked again, the judge
+refuses (its first verdict stands), so no answer can search the hidden cases
+by trying.  The kernel can say anything on the socket; whatever it says, the
+worst it gets is the verdict its answers earn.
+
+Its lines in ``VERDICTS`` begin with ``judged``: ``judged begin N``,
+``judged verdict N PASSED INTACT WHY``, ``judged note FLAG WHAT N``.  Runs as
+the grader (it runs only the teacher's code); one thread.
+"""
+
+from __future__ import annotations
+
+import builtins
+import os
+import re
+import socket
+import sys
+import threading
+
+from tutorial.tools.grading import wire
+
+# The checks the judge runs, by module: those whose answer is a function of data, with no class and no state a
+# check must watch from inside.  The other exercises' checks run in the kernel, sealed.
+JUDGED = {
+    "tutorial.exercises.step1_tank_controller": ("check_dpad_steering",),
+    "tutorial.exercises.step3_viewer": ("check_own_matcher",),
+    "tutorial.exercises.record_and_replay": ("check_peak_speed",),
+    "tutorial.exercises.across_machines": ("check_lossy_link_qos", "check_camera_settings"),
+    "tutorial.exercises.stock_ros2_tools": ("check_lookup",),
+    "tutorial.exercises.parameters_and_services": ("check_judge_rate",),
+    "tutorial.exercises.managed_nodes_and_actions": ("check_after",),
+}
+JUDGED_NAMES = frozenset(n for names in JUDGED.values() for n in names)
+NUMBER = re.compile(r"Exercise (\d+\.\d+)")
+GONE = "the grading kernel is gone"
+
+
+class Interrupted(BaseException):
+    """The kernel stopped running the answer (the cell's timeout interrupted it): the check ends, no verdict."""
+
+
+class Answer:
+    """The judge's stand-in for the learner's function: a call sends its arguments to the kernel and returns
+    what the answer returned there (built from data), or raises what it raised (its class's name and message).
+
+    Raises (from a call): ``NotImplementedError`` for the learner's stub; a built-in exception as itself (a
+    ``KeyError`` a statement asks for); any other as an ``Exception`` subclass of the same name;
+    :class:`Interrupted` when the kernel says it was interrupted; ``ConnectionError`` when the kernel is gone.
+    """
+
+    def __init__(self, channel: Channel, name: str, run):
+        self._channel, self._run = channel, run
+        self.__name__ = self.__qualname__ = name
+
+    def __call__(self, *args):
+        reply = self._channel.ask({"id": self._run, "call": [wire.encode(a) for a in args]})
+        if "check" in reply:  # the kernel went on to another check (this one's cell was interrupted)
+            self._channel.push_back(reply)
+            raise Interrupted
+        if reply.get("id") != self._run:
+            raise Interrupted  # an abort, or a reply of an older run: this check's kernel side is gone
+        if "return" in reply:
+            try:
+                value = wire.decode(reply["return"])
+            except wire.WireError as exc:  # never what the kernel's own encoder sends
+                self._channel.note("tampering", f"the kernel sent back what is no value ({exc})")
+                raise
+            self._channel.note_own_classes(value)
+            return value
+        if "raised" in reply:
+            raise _exception(reply["raised"])
+        if "abort" in reply:
+            raise Interrupted
+        raise wire.WireError("the kernel answered a call with neither a value nor an exception")
+
+
+def _exception(said) -> Exception:
+    """The exception an answer raised, from what the kernel said of it (``{"type", "builtin", "args",
+    "not_done"}``): never its class, only a class of its name."""
+    said = dict(said)
+    name = str(said.get("type", "Exception"))
+    name = name if wire.NAME.fullmatch(name) else "Exception"
+    try:
+        args = tuple(wire.decode(said.get("args", [])))
+    except wire.WireError:
+        args = ()
+    args = tuple(a if type(a) in (str, int, float, bool) or a is None else repr(a)[: wire.MAX_TEXT] for a in args)
+    if said.get("not_done") is True:
+        return NotImplementedError(*args)
+    builtin = getattr(builtins, name, None)
+    if said.get("builtin") is True and isinstance(builtin, type) and issubclass(builtin, Exception):
+        try:
+            return builtin(*args)
+        except Exception:  # noqa: BLE001 - arguments that class will not take (an OSError's): its text alone
+            return builtin(" ".join(map(str, args)))
+    return type(name, (Exception,), {"__module__": "answer"})(*args)
+
+
+class Channel:
+    """The judge's end of the socket: one message out, the kernel's reply in.  A lock, because rclpy may call
+    an :class:`Answer` from an executor's thread while a check waits on the main one (10.1's node)."""
+
+    def __init__(self, sock: socket.socket, verdicts: str):
+        self._sock = sock
+        self._reader = sock.makefile("rb")
+        self._lock = threading.Lock()
+        self._fd = os.open(verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
+        self._back: list[dict] = []  # a request read while a check waited for its answer
+        self.number: str | None = None  # the exercise of the check now running
+        self.notes: list[str] = []  # what the kernel did wrong during it (tampering)
+
+    def send(self, message: dict) -> None:
+        self._sock.sendall(wire.dumps(message))
+
+    def receive(self) -> dict | None:
+        """The kernel's next message; None when it is gone.
+
+        Raises:
+            wire.WireError: a line that is no message.
+        """
+        if self._back:
+            return self._back.pop()
+        line = self._reader.readline(wire.MAX_LINE + 1)
+        if not line:
+            return None
+        if not line.endswith(b"\n"):
+            raise wire.WireError(f"a message of more than {wire.MAX_LINE} bytes")
+        return wire.loads(line)
+
+    def push_back(self, message: dict) -> None:
+        """``message`` is the next :meth:`receive` gives."""
+        self._back.append(message)
+
+    def ask(self, message: dict) -> dict:
+        with self._lock:
+            self.send(message)
+            reply = self.receive()
+        if reply is None:
+            raise ConnectionError(GONE)
+        return reply
+
+    def write(self, *fields: str) -> None:
+        """One line in the verdict file (tabs and newlines in a field become spaces)."""
+        clean = [re.sub(r"[\t\r\n]", " ", str(f)) for f in fields]
+        os.write(self._fd, ("\t".join(["judged", *clean]) + "\n").encode())
+
+    def note(self, flag: str, what: str) -> None:
+        self.notes.append(what)
+        self.write("note", flag, what, self.number or "")
+
+    def note_own_classes(self, value) -> None:
+        """Note an answer's value holding an object of a class of its own that compares as it likes."""
+        todo = [value]
+        while todo:
+            v = todo.pop()
+            if isinstance(v, wire.Opaque) and v.own_eq:
+                self.note("tampering", f"an answer returned a {v.kind}, a class of its own that compares as it likes")
+                return
+            if type(v) in (list, tuple):
+                todo += v
+            elif type(v) is dict:
+                todo += [*v.keys(), *v.values()]
+
+
+def checks() -> dict:
+    """The teacher's checks of :data:`JUDGED`, by name, imported now (before the kernel runs any cell)."""
+    import importlib
+
+    found = {}
+    for module, names in JUDGED.items():
+        loaded = importlib.import_module(module)
+        found.update({name: getattr(loaded, name) for name in names})
+    return found
+
+
+def serve(channel: Channel, found: dict) -> None:
+    """Answer the kernel's requests until it is gone: each check once, its verdict written, its line sent."""
+    done: set[str] = set()
+    while True:
+        try:
+            request = channel.receive()
+        except wire.WireError as exc:
+            channel.note("tampering", f"the kernel sent what is no request ({exc})")
+            continue
+        if request is None:
+            return
+        if "check" not in request:
+            continue  # an abort of a check already dropped, or a reply to it
+        name, run = request.get("check"), request.get("id")
+        if type(name) is not str or name not in found:
+            channel.note("tampering", f"the kernel asked for no check of the judge's: {str(name)[:60]!r}")
+            channel.send({"id": run, "result": _refusal(str(name)[:60], "no such check while grading.")})
+            continue
+        if name in done:
+            channel.note("checked again", f"{name} asked for again: its first verdict stands")
+            said = "this check already ran while grading; its first verdict stands."
+            channel.send({"id": run, "result": _refusal(name, said)})
+            continue
+        done.add(name)
+        channel.number, channel.notes = None, []
+        answer = Answer(channel, _answer_name(request.get("answer")), run)
+        try:
+            result = found[name](answer)
+        except Interrupted:
+            continue  # no verdict: the exercise gets 0 (the cell's timeout is flagged from the notebook)
+        except ConnectionError:
+            return
+        channel.write("verdict", channel.number, int(result.passed), int(not channel.notes), "; ".join(channel.notes))
+        try:
+            said = {k: getattr(result, k) for k in ("exercise", "passed", "message", "case")}
+            channel.send({"id": run, "result": said})
+        except OSError:
+            return
+
+
+def _refusal(name: str, why: str) -> dict:
+    return {"exercise": name, "passed": False, "message": why, "case": None}
+
+
+def _answer_name(name) -> str:
+    return name if type(name) is str and wire.NAME.fullmatch(name) else "answer"
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    fd, verdicts = int(argv[0]), argv[1]
+    seed = sys.stdin.readline().strip()  # the learner's seed of hidden cases: the grader's, on a pipe
+    sock = socket.socket(fileno=fd)
+    channel = Channel(sock, verdicts)
+
+    def hook(event: str, args: tuple) -> None:
+        """The checks' own events, as the seal would take them in a kernel: the seed given, each check's start
+        written down (a check that never ends, its cell stopped, leaves its begin without a verdict)."""
+        if event == "rtt.seed" and seed and type(args[0]) is list:
+            args[0].append(seed)
+        elif event == "rtt.check_begin":
+            found = NUMBER.match(str(args[0]))
+            channel.number = found.group(1) if found else "?"
+            channel.write("begin", channel.number)
+
+    found = checks()
+    sys.addaudithook(hook)
+    try:
+        import rclpy
+
+        rclpy.init()  # 10.1's check sets its parameter on a node of its own
+    except ImportError:
+        rclpy = None
+    try:
+        serve(channel, found)
+    finally:
+        if rclpy is not None:
+            rclpy.try_shutdown()
+        sock.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
