@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT / "course"))
 import sandboxing  # noqa: E402 - course/ is not a package
 
 SEED = "test"  # the seed tests/test_exercises.py's grading_seed gives the in-process checks
-NUMBERS = ["1.1", "3.2", "7.2", "8.1", "8.2", "9.1", "10.1", "11.1"]  # the judged exercises
+NUMBERS = ["1.1", "3.2", "7.1", "7.2", "8.1", "8.2", "9.1", "10.1", "11.1"]  # the judged exercises
 
 
 class JudgeProcess:
@@ -201,8 +201,15 @@ def test_a_kernel_that_sends_junk_or_asks_for_no_check_is_noted_and_the_judge_go
         ({"message": ["std_msgs/msg/String", {"data": "x"}]}, "no such message on the wire"),
         ({"ndarray": ["|O", [2], [1, 2]]}, "only booleans and numbers cross"),
         ({"opaque": ["Anything", "0.0", True]}, "compares as it likes"),
+        ({"file": ["x.mcap", ""]}, "a file goes only to the kernel"),
     ],
-    ids=["a class not listed", "a message not listed", "an array of objects", "a float that says it is equal"],
+    ids=[
+        "a class not listed",
+        "a message not listed",
+        "an array of objects",
+        "a float that says it is equal",
+        "a file",
+    ],
 )
 def test_a_value_the_wire_does_not_build_fails_the_case_and_is_noted(judge_process, returned, said):
     raw_kernel(judge_process, b'{"check": "check_dpad_steering", "id": "raw"}\n')
@@ -313,3 +320,19 @@ def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_pa
     assert sandboxing.judge(graded, verdicts, "") == {"1.1": (True, []), "1.2": (True, [])}
     verdicts.write_text("begin\t1.2\njudged\tverdict\t1.2\t1\t1\t\n")  # the judge's word for a sealed check: none
     assert sandboxing.judge(graded, verdicts, "")["1.2"][0] is False
+
+
+def test_a_file_a_check_made_crosses_into_a_folder_of_the_kernels_own_and_is_gone_after_the_call(tmp_path):
+    bag = tmp_path / "check.mcap"
+    bag.write_bytes(b"\x89MCAP0\r\n bytes")
+    seen = {}
+
+    def answer(path):
+        seen["path"], seen["bytes"] = path, path.read_bytes()
+        return []
+
+    reply = judged._called(answer, wire.loads(wire.dumps({"call": [wire.encode(bag)]}))["call"])
+    assert reply == {"return": []}
+    assert seen["bytes"] == bag.read_bytes() and seen["path"] != bag and not seen["path"].exists()
+    with pytest.raises(wire.WireError):
+        wire.decode({"file": ["../up", ""]}, folder=str(tmp_path))

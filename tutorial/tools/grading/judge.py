@@ -48,7 +48,7 @@ from tutorial.tools.grading import wire
 JUDGED = {
     "tutorial.exercises.step1_tank_controller": ("check_dpad_steering",),
     "tutorial.exercises.step3_viewer": ("check_own_matcher",),
-    "tutorial.exercises.record_and_replay": ("check_peak_speed",),
+    "tutorial.exercises.record_and_replay": ("check_release_times", "check_peak_speed"),
     "tutorial.exercises.across_machines": ("check_lossy_link_qos", "check_camera_settings"),
     "tutorial.exercises.stock_ros2_tools": ("check_lookup",),
     "tutorial.exercises.parameters_and_services": ("check_judge_rate",),

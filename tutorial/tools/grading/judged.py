@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import importlib
 import os
+import shutil
 import socket
+import tempfile
 import threading
 
 from tutorial.exercises.grader import Result, not_done
@@ -89,9 +91,9 @@ class Judge:
 def _called(answer, call) -> dict:
     """What ``answer(*call)`` gave, as the judge's reply: what it returned, or what it raised (an ``Exception``;
     anything else, such as the cell's ``KeyboardInterrupt``, goes on up)."""
-    args = wire.decode(call)
+    folder = tempfile.mkdtemp(prefix="rtt-judged-")  # a file the check made for the answer (7.1's bag), removed after
     try:
-        value = answer(*args)
+        value = answer(*wire.decode(call, folder=folder))
     except Exception as exc:  # noqa: BLE001 - the answer's bug, said to the judge with its class's name
         said = {"type": type(exc).__name__, "builtin": type(exc).__module__ == "builtins", "not_done": not_done(exc)}
         try:
@@ -99,6 +101,8 @@ def _called(answer, call) -> dict:
         except wire.WireError:
             said["args"] = [str(exc)[: wire.MAX_TEXT]]
         return {"raised": said}
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
     try:
         return {"return": wire.encode(value)}
     except wire.WireError as exc:

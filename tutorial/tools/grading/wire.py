@@ -7,8 +7,10 @@ into JSON's types, :func:`decode` builds it back, and builds only these:
 
 * ``None``, ``bool``, ``int``, ``float`` (NaN and the infinities too), ``str``;
   ``list``, ``tuple``, ``dict``; NumPy's arrays and scalars of booleans and numbers;
-* the checks' own data classes (:data:`CLASSES`), ROS messages of :data:`MESSAGES`,
-  ``rclpy``'s ``Parameter``, ``QoSProfile`` and ``Duration``.
+* the checks' own data classes and the ROS messages they name (:func:`_classes`, :func:`_messages`),
+  ``rclpy``'s ``Parameter``, ``QoSProfile`` and ``Duration``;
+* a file a check made for the answer to read (a ``Path``): its bytes cross, and the kernel's side writes them
+  into a folder of its own (a bag of 7.1's).
 
 Anything else an answer gives back (an object of a class of its own, a float
 subclass) arrives as an :class:`Opaque`: its class's name and its ``repr``,
@@ -18,10 +20,12 @@ can only say what its data says.  Pure functions; any thread.
 
 from __future__ import annotations
 
+import base64
 import dataclasses
 import json
 import math
 import re
+from pathlib import Path, PurePath
 
 MAX_LINE = 8 << 20  # bytes of one message: a longer one is refused, not read
 MAX_DEPTH = 64  # nesting of one value
@@ -115,6 +119,10 @@ def encode(value, depth: int = 0):
         return {"message": [message, fields]}
     if module == "rclpy.parameter" and kind.__qualname__ == "Parameter":
         return {"parameter": [value.name, int(value.type_.value), encode(_plain(value.value), depth + 1)]}
+    if isinstance(value, PurePath) and kind is type(Path()):  # a file a check made for the answer to read
+        if not value.is_file():
+            raise WireError(f"a path that is no file: {value}")
+        return {"file": [value.name, base64.b64encode(value.read_bytes()).decode()]}
     if module == "rclpy.duration" and kind.__qualname__ == "Duration":
         return {"duration": value.nanoseconds}
     if module == "rclpy.qos" and kind.__qualname__ == "QoSProfile":
@@ -176,8 +184,10 @@ def _own_eq(kind) -> bool:
         return True
 
 
-def decode(data, depth: int = 0):
+def decode(data, depth: int = 0, folder: str | None = None):
     """The value :func:`encode` made ``data`` from (a new object), built only from the types it lists.
+
+    ``folder``: where a file the value carries is written (the kernel's side gives one; the judge's, none).
 
     Raises:
         WireError: ``data`` is not one :func:`encode` makes: a tag, a class, a message or a dtype not listed, a
@@ -189,12 +199,12 @@ def decode(data, depth: int = 0):
     if data is None or kind in (bool, int, str, float):
         return data
     if kind is list:
-        return [decode(v, depth + 1) for v in data]
+        return [decode(v, depth + 1, folder) for v in data]
     if kind is not dict or len(data) != 1:
         raise WireError(f"not a value: a {kind.__name__}")
     (tag, body), deeper = next(iter(data.items())), depth + 1
     try:
-        return _DECODERS[tag](body, deeper)
+        return _DECODERS[tag](body, deeper, folder)
     except KeyError:
         if tag not in _DECODERS:
             raise WireError(f"no such kind of value: {tag!r:.40}") from None
@@ -211,7 +221,7 @@ def _list(body) -> list:
     return body
 
 
-def _float(body, depth):
+def _float(body, depth, folder):
     if body not in ("nan", "inf", "-inf"):
         raise WireError(f"not a float: {body!r:.40}")
     return float(body)
@@ -226,28 +236,28 @@ def _numpy_dtype(text):
     return dtype
 
 
-def _ndarray(body, depth):
+def _ndarray(body, depth, folder):
     import numpy as np
 
     dtype, shape, values = body
     shape = [int(n) for n in shape]
-    return np.array(decode(values, depth), dtype=_numpy_dtype(dtype)).reshape(shape)
+    return np.array(decode(values, depth, folder), dtype=_numpy_dtype(dtype)).reshape(shape)
 
 
-def _scalar(body, depth):
+def _scalar(body, depth, folder):
     dtype, value = body
-    return _numpy_dtype(dtype).type(decode(value, depth))
+    return _numpy_dtype(dtype).type(decode(value, depth, folder))
 
 
-def _object(body, depth):
+def _object(body, depth, folder):
     key, fields = body
     cls = _table("classes").get(key)
     if cls is None:
         raise WireError(f"no such class on the wire: {key!r:.80}")
-    return cls(**{str(k): decode(v, depth) for k, v in dict(fields).items()})
+    return cls(**{str(k): decode(v, depth, folder) for k, v in dict(fields).items()})
 
 
-def _message(body, depth):
+def _message(body, depth, folder):
     name, fields = body
     cls = _table("messages").get(name)
     if cls is None:
@@ -256,18 +266,18 @@ def _message(body, depth):
     for field, value in dict(fields).items():
         if field not in cls.get_fields_and_field_types():
             raise WireError(f"{name} has no field {field!r:.40}")
-        setattr(message, field, decode(value, depth))
+        setattr(message, field, decode(value, depth, folder))
     return message
 
 
-def _parameter(body, depth):
+def _parameter(body, depth, folder):
     from rclpy.parameter import Parameter
 
     name, type_, value = body
-    return Parameter(str(name), Parameter.Type(int(type_)), decode(value, depth))
+    return Parameter(str(name), Parameter.Type(int(type_)), decode(value, depth, folder))
 
 
-def _duration(body, depth):
+def _duration(body, depth, folder):
     from rclpy.duration import Duration
 
     if type(body) is not int:
@@ -275,22 +285,34 @@ def _duration(body, depth):
     return Duration(nanoseconds=body)
 
 
-def _qos(body, depth):
+def _qos(body, depth, folder):
     from rclpy.qos import QoSProfile
 
-    given = {str(k): decode(v, depth) for k, v in dict(body).items() if k in QOS_FIELDS}
+    given = {str(k): decode(v, depth, folder) for k, v in dict(body).items() if k in QOS_FIELDS}
     return QoSProfile(**given)
 
 
-def _opaque(body, depth):
+def _file(body, depth, folder):
+    if folder is None:
+        raise WireError("a file goes only to the kernel")
+    name, content = body
+    if not re.fullmatch(r"[A-Za-z0-9_-]{1,60}(\.[A-Za-z0-9]{1,8})?", str(name)):
+        raise WireError(f"not a file's name: {name!r:.40}")
+    path = Path(folder) / str(name)
+    path.write_bytes(base64.b64decode(content, validate=True))
+    return path
+
+
+def _opaque(body, depth, folder):
     kind, text, own_eq = body
     return Opaque(str(kind)[:60], str(text)[: MAX_TEXT + 3], bool(own_eq))
 
 
 _DECODERS = {
     "float": _float,
-    "tuple": lambda body, depth: tuple(decode(_list(body), depth)),
-    "dict": lambda body, depth: {decode(k, depth): decode(v, depth) for k, v in _list(body)},
+    "tuple": lambda body, depth, folder: tuple(decode(_list(body), depth, folder)),
+    "dict": lambda body, depth, folder: {decode(k, depth, folder): decode(v, depth, folder) for k, v in _list(body)},
+    "file": _file,
     "ndarray": _ndarray,
     "scalar": _scalar,
     "object": _object,
