@@ -20,6 +20,9 @@ Its flags say why not, or what else was seen:
 - ``over a limit``: memory, processes or CPU time ran out (``MemoryError``, ...);
 - ``network``, ``processes``, ``outside its folder``: what the seal noted the answer doing;
 - ``grader-aware``: the answer looks for nbgrader (``NBGRADER_...``);
+- ``the checks' code``: the answer cell names the checks' package (``tutorial.exercises``) other than to import
+  its public names, so reaches the rules that compute what the checks expect: an answer that calls them
+  copies the answer (its points stand; the teacher reads it);
 - ``checked again``: the kernel asked the judge for a judged check that had already run (its first verdict
   stands).
 
@@ -56,6 +59,8 @@ ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")
 TEACHERS_ONLY = ("notebooks", "course", "book", ".git")  # the repository's folders with worked solutions
 LIMIT_ERRORS = re.compile(r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory")
+# An import of public names from the checks' package (10.2's stub imports TrackSwitch): what an answer may name
+PUBLIC_IMPORT = re.compile(r"^[ \t]*from tutorial\.exercises\.\w+ import (?!_)\w+(?:, *(?!_)\w+)*[ \t]*(?:#.*)?$", re.M)
 CPU_SECONDS = "RTT_GRADING_CPU_SECONDS"  # a kernel's CPU time, s (RLIMIT_CPU; default 600)
 
 
@@ -288,6 +293,8 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
             mine.append("tampering")
         if "NBGRADER" in found["source"]:
             mine.append("grader-aware")
+        if re.search(r"\bexercises\b", PUBLIC_IMPORT.sub("", found["source"])):  # the checks' private rules
+            mine.append("the checks' code")
         if check_ok and not passed.get(ex, False):  # the notebook passed what the seal did not see pass
             mine.append("tampering")
         out[ex] = (passed.get(ex, False), sorted(set(mine)))

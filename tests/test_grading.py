@@ -708,6 +708,14 @@ CHEATS = {
         "    return frame.f_locals['expected'] if frame is not None else (0.0, 0.0)\n",
         "",
     ),
+    "copy-the-rule": (  # the check module's own rule, called: full points, which the teacher must see
+        "1.1",
+        "import math\nfrom tutorial.exercises.step1_tank_controller import _dpad\n"
+        "def dpad_track_velocities(axes):\n"
+        "    a = [x if math.isfinite(x) else 0.0 for x in (list(axes) + [0.0] * 8)[:8]]\n"
+        "    return _dpad(a[4], a[5])\n",
+        "the checks' code",
+    ),
     "ask-twice": (  # a first run of the check to learn from, before the test cell's: the first verdict stands
         "1.1",
         "{solution}\n"
@@ -778,6 +786,8 @@ CHEATS_SAY = {
     "memory-from-a-child": "the kernel memory refused to a child: True",
     "keyring-note": "a note in the keyrings: no",
 }
+# A cheat that keeps its points, flagged for the teacher to read: an answer that calls the checks' own rule is right.
+KEEPS_ITS_POINTS = {"copy-the-rule"}
 # A flag a cheat must not get: a kernel killed is not one over a limit, and one stopped at its limit did not crash.
 CHEATS_NOT = {"crash": "over a limit", "cpu-time": "crash"}
 IN_MAKE_TEST_CHEATS = ["rebind-check"]  # graded among make test's submissions of notebook 01
@@ -871,8 +881,9 @@ def grade_cheats(tmp_path: Path, which: list[str]) -> None:
         target, _, flag = CHEATS[cheat]
         row = rows[f"cheat-{cheat}"]
         other = next(n for n in exercises_of(name) if n != target)
-        if float(row["score"]) != assignments.POINTS[other]:
-            wrong.append(f"{cheat}: score {row['score']}, expected {assignments.POINTS[other]} (exercise {other})")
+        score = assignments.POINTS[other] + (assignments.POINTS[target] if cheat in KEEPS_ITS_POINTS else 0)
+        if float(row["score"]) != score:
+            wrong.append(f"{cheat}: score {row['score']}, expected {score} (exercise {other}, and {target}'s if kept)")
         flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
         if flag not in flags.get(target, "") or (not flag and flags.get(target)):
             wrong.append(f"{cheat}: flags {row['flags']!r}, expected {flag!r} on {target}")

@@ -295,11 +295,33 @@ def test_the_wire_refuses_a_line_it_does_not_read(line):
         wire.loads(line)
 
 
-def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_path):
-    def cell(gid, source, grade=False):
-        meta = {"nbgrader": {"grade_id": gid, "grade": grade, "solution": not grade}}
-        return {"cell_type": "code", "metadata": meta, "source": source, "outputs": []}
+def cell(gid, source, grade=False):
+    """An autograded notebook's code cell, as nbgrader leaves it."""
+    meta = {"nbgrader": {"grade_id": gid, "grade": grade, "solution": not grade}}
+    return {"cell_type": "code", "metadata": meta, "source": source, "outputs": []}
 
+
+@pytest.mark.parametrize(
+    "answer, flagged",
+    [
+        ("from tutorial.exercises.step1_tank_controller import _dpad\n", True),
+        ("import tutorial.exercises.step1_tank_controller as m\n", True),
+        ("from tutorial.exercises.parameters_and_services import TrackSwitch  # .enabled, .lock\n", False),
+        ("import math\n", False),
+    ],
+    ids=["a private rule imported", "the module imported", "a public name, as 10.2's stub", "no checks"],
+)
+def test_an_answer_naming_the_checks_package_is_flagged_unless_it_imports_public_names(tmp_path, answer, flagged):
+    graded = tmp_path / "graded.ipynb"
+    source = answer + "def dpad_track_velocities(axes): ..."
+    checked = "check_dpad_steering(dpad_track_velocities).require()"
+    graded.write_text(json.dumps({"cells": [cell("exercise_1_1", source), cell("check_1_1", checked, True)]}))
+    verdicts = tmp_path / "verdicts.txt"
+    verdicts.write_text("judged\tbegin\t1.1\njudged\tverdict\t1.1\t1\t1\t\n")
+    assert sandboxing.judge(graded, verdicts, "")["1.1"] == (True, ["the checks' code"] if flagged else [])
+
+
+def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_path):
     notebook = {
         "cells": [
             cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
