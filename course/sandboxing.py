@@ -241,7 +241,9 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
     flags: dict[str, list[str]] = {n: [] for n in exercises}
     judged = {n for n, found in exercises.items() if JUDGED_NAMES & set(re.findall(r"\b(check_\w+)\(", found["check"]))}
     pending: list[str] = []  # notes before a check: the answer cell's, which comes before it
-    lines = verdicts.read_text().splitlines() if verdicts.is_file() else []
+    # lines split at "\n" alone, as the seal's pipe reader and the judge write them (str.splitlines() would also
+    # split at "\r", "\x1c" or U+2028, which a body the kernel signed may hold)
+    lines = verdicts.read_text().split("\n") if verdicts.is_file() else []
     for line in lines:
         kind, *rest = line.split("\t")
         by_judge = kind == "judged"  # the judge's own line (the seal's reader refuses one signed so)

@@ -358,3 +358,58 @@ def test_a_file_a_check_made_crosses_into_a_folder_of_the_kernels_own_and_is_gon
     assert seen["bytes"] == bag.read_bytes() and seen["path"] != bag and not seen["path"].exists()
     with pytest.raises(wire.WireError):
         wire.decode({"file": ["../up", ""]}, folder=str(tmp_path))
+
+
+def test_a_signed_line_that_another_reader_would_split_is_never_the_judges(tmp_path):
+    """The seal's pipe reader refuses a signed body with a line break of any kind (U+2028 among them) or naming
+    the judge; the grader splits the file at "\\n" alone."""
+    import hmac
+    import os
+    import threading
+    import types
+
+    from tutorial.tools.grading.sandbox import MAX_REFUSED_LINES, SandboxedKernelManager
+
+    key = b"k" * 32
+    read, write = os.pipe()
+    verdicts = tmp_path / "verdicts.txt"
+
+    def signed(body: str) -> bytes:
+        return (body + "\t" + hmac.new(key, body.encode(), "sha256").hexdigest() + "\n").encode()
+
+    forged = "\u2028judged\tverdict\t1.1\t1\t1"
+    reader = types.SimpleNamespace(_key=key, _verdict_read=read, _job=types.SimpleNamespace(verdicts=str(verdicts)))
+    thread = threading.Thread(target=SandboxedKernelManager._read_verdicts, args=(reader,))  # as the grader's
+    thread.start()
+    with os.fdopen(write, "wb") as pipe:  # a line of 100 kB, more than the pipe holds
+        pipe.write(signed("begin\t1.2") + signed(forged) + signed("note\tx\tjudged\t1.1") + b"y" * 100_000)
+        pipe.write(b"\n" + b"junk\n" * 100)
+    thread.join(timeout=30)
+    assert not thread.is_alive()
+    lines = verdicts.read_text().split("\n")
+    assert lines[0] == "begin\t1.2" and "\u2028" not in verdicts.read_text()
+    assert lines[1:-1] == ["note\ttampering\tan unsigned line on the seal's pipe\t"] * MAX_REFUSED_LINES
+    notebook = {"cells": [cell("exercise_1_1", "..."), cell("check_1_1", "check_dpad_steering(f).require()", True)]}
+    graded = tmp_path / "graded.ipynb"
+    graded.write_text(json.dumps(notebook))
+    verdicts.write_text("judged\tbegin\t1.1\njudged\tverdict\t1.1\t0\t1\t\n" + forged + "\n")  # had it got through
+    assert sandboxing.judge(graded, verdicts, "")["1.1"][0] is False
+
+
+def test_the_kernel_holds_a_seed_from_which_the_judges_draws_cannot_be_had():
+    from tutorial.tools.grading.sandbox import sealed_seed
+
+    assert sealed_seed("0123456789abcdef") == sealed_seed("0123456789abcdef") != "0123456789abcdef"
+    assert len(sealed_seed("0123456789abcdef")) == 16 and sealed_seed("") == ""
+
+
+def test_the_judges_notes_are_bounded_and_an_odd_character_does_not_stop_it(judge_process):
+    judge_process.sock.sendall(b"x\n" * 500)  # junk between checks: notes counted, not written without end
+    raw_kernel(judge_process, b'{"check": "check_dpad_steering", "id": "raw"}\n')
+    replies = raw_kernel(judge_process, b'{"id": "raw", "return": {"opaque": ["X\\ud800", "r", true]}}\n')
+    assert replies[-1]["result"]["passed"] is False
+    lines = judge_process.lines()
+    assert sum(line[1] == "note" for line in lines) <= judge.MAX_NOTES_IN_ALL
+    assert any(line[1:3] == ["verdict", "1.1"] for line in lines)  # written, the lone surrogate replaced
+    right = answer_of("11.1", exercise("11.1")["solution"])
+    assert judge_process.kernel.run("check_after", right).passed  # the judge goes on

@@ -56,6 +56,9 @@ JUDGED = {
 }
 JUDGED_NAMES = frozenset(n for names in JUDGED.values() for n in names)
 NUMBER = re.compile(r"Exercise (\d+\.\d+)")
+BREAKS = re.compile(r"[\t\n\r\x0b\x0c\x1c-\x1e\x85\u2028\u2029]")  # a tab, and every line break of str.splitlines()
+MAX_FIELD = 500  # characters of one field of a line
+MAX_NOTES, MAX_NOTES_IN_ALL = 5, 50  # notes written for one check, and in all (the rest are counted)
 GONE = "the grading kernel is gone"
 
 
@@ -132,6 +135,7 @@ class Channel:
         self._back: list[dict] = []  # a request read while a check waited for its answer
         self.number: str | None = None  # the exercise of the check now running
         self.notes: list[str] = []  # what the kernel did wrong during it (tampering)
+        self.noted = 0  # notes in all, written or not
 
     def send(self, message: dict) -> None:
         self._sock.sendall(wire.dumps(message))
@@ -164,13 +168,16 @@ class Channel:
         return reply
 
     def write(self, *fields: str) -> None:
-        """One line in the verdict file (tabs and newlines in a field become spaces)."""
-        clean = [re.sub(r"[\t\r\n]", " ", str(f)) for f in fields]
-        os.write(self._fd, ("\t".join(["judged", *clean]) + "\n").encode())
+        """One line in the verdict file: a tab or any line break (``str.splitlines()``'s) in a field a space."""
+        clean = [BREAKS.sub(" ", str(f))[:MAX_FIELD] for f in fields]
+        os.write(self._fd, ("\t".join(["judged", *clean]) + "\n").encode("utf-8", "replace"))
 
     def note(self, flag: str, what: str) -> None:
+        """A note in the verdict file; past :data:`MAX_NOTES` of a check, or between checks, only counted."""
         self.notes.append(what)
-        self.write("note", flag, what, self.number or "")
+        self.noted += 1
+        if len(self.notes) <= MAX_NOTES and self.noted <= MAX_NOTES_IN_ALL:
+            self.write("note", flag, what, self.number or "")
 
     def note_own_classes(self, value) -> None:
         """Note an answer's value holding an object of a class of its own that compares as it likes."""
@@ -229,7 +236,10 @@ def serve(channel: Channel, found: dict) -> None:
             continue  # no verdict: the exercise gets 0 (the cell's timeout is flagged from the notebook)
         except ConnectionError:
             return
-        channel.write("verdict", channel.number, int(result.passed), int(not channel.notes), "; ".join(channel.notes))
+        why = "; ".join(channel.notes[:MAX_NOTES]) + (
+            f" (and {len(channel.notes) - MAX_NOTES} more)" if len(channel.notes) > MAX_NOTES else ""
+        )
+        channel.write("verdict", channel.number, int(result.passed), int(not channel.notes), why)
         try:
             said = {k: getattr(result, k) for k in ("exercise", "passed", "message", "case")}
             channel.send({"id": run, "result": said})

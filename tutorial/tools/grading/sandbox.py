@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import asyncio
 import dataclasses
+import hashlib
 import hmac
 import json
 import os
@@ -97,6 +98,13 @@ class Job:
 
     def to_env(self) -> str:
         return json.dumps(dataclasses.asdict(self))
+
+
+def sealed_seed(seed: str) -> str:
+    """The seed of the sealed checks' hidden cases, from the learner's: the kernel holds it (where an answer
+    that reads the kernel's memory finds it), and the judge's draws, from ``seed`` itself, cannot be had from it.
+    Empty for an empty seed (no hidden cases)."""
+    return hashlib.sha256(f"{seed}/sealed".encode()).hexdigest()[:16] if seed else ""
 
 
 def cgroups(job: Job) -> list[Path]:
@@ -237,7 +245,9 @@ class SandboxedKernelManager(AsyncKernelManager):
         kw["pass_fds"] = (self._key_read, self._verdict_write, self._kernels_end.fileno())
         kw["env"]["RTT_SEAL_FDS"] = f"{self._key_read},{self._verdict_write}"
         kw["env"][judged.ENV] = str(self._kernels_end.fileno())
-        self._judge_env = {k: v for k, v in kw["env"].items() if k in PASSED_ENV} | {"HOME": str(here)}
+        judges = Path(job.folder) / (here.name + "-judge")  # root's: rclpy writes its log there, as root
+        judges.mkdir(mode=0o700)
+        self._judge_env = {k: v for k, v in kw["env"].items() if k in PASSED_ENV} | {"HOME": str(judges)}
         # ipykernel's own launcher's arguments (the connection file, nbgrader's history in memory), sealed first
         kernel = [sys.executable, "-I", "-m", "tutorial.tools.grading.sealed_kernel", *cmd[cmd.index("-f") :]]
         return sandbox_command(job, kernel, kept_paths(job.hide), cgroups(job)), kw
@@ -256,7 +266,7 @@ class SandboxedKernelManager(AsyncKernelManager):
             "test_calls": job.test_calls,
             "hidden": job.hide,
             "checks": job.checks,
-            "seed": job.seed,
+            "seed": sealed_seed(job.seed),
         }
         with os.fdopen(self._key_write, "w") as out:
             json.dump(given, out)
@@ -271,7 +281,7 @@ class SandboxedKernelManager(AsyncKernelManager):
             [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(fd), job.verdicts],
             pass_fds=(fd,),
             stdin=subprocess.PIPE,
-            stderr=open(Path(self.connection_file).parent / "judge.log", "ab"),  # noqa: SIM115 - the child's
+            stderr=open(Path(self._judge_env["HOME"]) / "judge.log", "ab"),  # noqa: SIM115 - the child's
             env=self._judge_env,
             text=True,
         )
@@ -305,14 +315,24 @@ class SandboxedKernelManager(AsyncKernelManager):
         """
         fd = os.open(self._job.verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
         with os.fdopen(self._verdict_read, "rb") as pipe, os.fdopen(fd, "a", encoding="utf-8") as out:
-            for raw in pipe:
-                line = raw.decode("utf-8", "replace").rstrip("\n")
+            refused = 0
+            while raw := pipe.readline(MAX_SEAL_LINE):  # a line past the limit is read, and refused, in pieces
+                line = raw.decode("utf-8", "replace").removesuffix("\n")
                 body, _, mac = line.rpartition("\t")
                 good = hmac.new(self._key, body.encode(), "sha256").hexdigest()
-                ok = hmac.compare_digest(mac.encode(), good.encode()) and not body.startswith("judged")
-                out.write((body if ok else "note\ttampering\tan unsigned line on the seal's pipe\t") + "\n")
+                ok = hmac.compare_digest(mac.encode(), good.encode()) and raw.endswith(b"\n")
+                # a signed body with a line break of any kind (str.splitlines()'s), or naming the judge, is no seal's
+                ok = ok and len(body.splitlines()) <= 1 and "judged" not in body
+                if ok:
+                    out.write(body + "\n")
+                elif refused < MAX_REFUSED_LINES:  # counted, not written without end
+                    out.write("note\ttampering\tan unsigned line on the seal's pipe\t\n")
+                refused += not ok
                 out.flush()
 
+
+MAX_SEAL_LINE = 4096  # bytes of one of the seal's lines (its longest, a verdict's reasons, is far shorter)
+MAX_REFUSED_LINES = 20  # tampering notes written for the bytes an answer writes on the seal's pipe
 
 KERNEL_DIED = "the kernel died while this cell ran"
 CPU_TIME_RAN_OUT = "its CPU time ran out"  # RLIMIT_CPU's SIGXCPU
