@@ -84,8 +84,6 @@ class Answer:
         if "check" in reply:  # the kernel went on to another check (this one's cell was interrupted)
             self._channel.push_back(reply)
             raise Interrupted
-        if reply.get("id") != self._run:
-            raise Interrupted  # an abort, or a reply of an older run: this check's kernel side is gone
         if "return" in reply:
             try:
                 value = wire.decode(reply["return"])
