@@ -1,4 +1,4 @@
-"""``python -I -m tutorial.tools.grading.judge FD VERDICTS``: the teacher's checks, in a process of their own.
+"""``python -I -m tutorial.tools.grading.judge FD VERDICTS [MODULES]``: the teacher's checks, in a process of their own.
 
 An answer and a check in one process are no wall: the answer can reach the
 check's memory (:mod:`tutorial.tools.grading.seal` says how).  So, while
@@ -6,7 +6,8 @@ grading, the checks of :data:`JUDGED` (the exercises whose answer is a
 function of data) run here, in the judge, which
 :class:`tutorial.tools.grading.sandbox.SandboxedKernelManager` starts beside
 each graded kernel, outside its sandbox.  The judge imports the teacher's
-checks before the kernel runs any cell, keeps the learner's seed of hidden
+checks (those of the assignment's check ``MODULES``, comma-separated) before the kernel runs any cell, keeps the
+learner's seed of hidden
 cases (read from its standard input, never an argument another user can read),
 and shares with the kernel only a socket (``FD``), over which data crosses
 (:mod:`tutorial.tools.grading.wire`):
@@ -191,12 +192,15 @@ class Channel:
                 todo += [*v.keys(), *v.values()]
 
 
-def checks() -> dict:
-    """The teacher's checks of :data:`JUDGED`, by name, imported now (before the kernel runs any cell)."""
+def checks(modules: list[str] | None = None) -> dict:
+    """The teacher's checks of :data:`JUDGED` in ``modules`` (the assignment's check modules; None: all), by
+    name, imported now (before the kernel runs any cell)."""
     import importlib
 
     found = {}
     for module, names in JUDGED.items():
+        if modules is not None and module not in modules:
+            continue  # another assignment's: not imported (about 0.15 s a module)
         loaded = importlib.import_module(module)
         found.update({name: getattr(loaded, name) for name in names})
     return found
@@ -256,6 +260,7 @@ def _answer_name(name) -> str:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     fd, verdicts = int(argv[0]), argv[1]
+    modules = argv[2].split(",") if len(argv) > 2 else None
     seed = sys.stdin.readline().strip()  # the learner's seed of hidden cases: the grader's, on a pipe
     sock = socket.socket(fileno=fd)
     channel = Channel(sock, verdicts)
@@ -270,19 +275,15 @@ def main(argv: list[str] | None = None) -> int:
             channel.number = found.group(1) if found else "?"
             channel.write("begin", channel.number)
 
-    found = checks()
+    found = checks(modules)
     sys.addaudithook(hook)
-    try:
-        import rclpy
+    import rclpy
 
-        rclpy.init()  # 10.1's check sets its parameter on a node of its own
-    except ImportError:
-        rclpy = None
+    rclpy.init()  # 10.1's check sets its parameter on a node of its own
     try:
         serve(channel, found)
     finally:
-        if rclpy is not None:
-            rclpy.try_shutdown()
+        rclpy.try_shutdown()
         sock.close()
     return 0
 

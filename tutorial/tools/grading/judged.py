@@ -109,11 +109,14 @@ def _called(answer, call) -> dict:
         return {"return": {"opaque": [type(value).__name__, f"<a value the grader cannot read: {exc}>", False]}}
 
 
-def install(fd: int) -> None:
-    """Put a stand-in asking the judge on ``fd`` (a connected Unix socket) in place of each judged check."""
+def install(fd: int, modules: list[str] | None = None) -> None:
+    """Put a stand-in asking the judge on ``fd`` (a connected Unix socket) in place of each judged check of
+    ``modules`` (the assignment's check modules; None: all)."""
     os.set_inheritable(fd, False)  # an answer's subprocess gets no end of it
     judge = Judge(socket.socket(fileno=fd))
     for module, names in JUDGED.items():
+        if modules is not None and module not in modules:
+            continue
         loaded = importlib.import_module(module)
         for name in names:
             setattr(loaded, name, _asking(judge, name, getattr(loaded, name)))

@@ -278,7 +278,7 @@ class SandboxedKernelManager(AsyncKernelManager):
         outside the sandbox, which imports the teacher's checks now and gets the seed on a pipe."""
         fd = self._judges_end.fileno()
         self._judge = subprocess.Popen(
-            [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(fd), job.verdicts],
+            [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(fd), job.verdicts, ",".join(job.checks)],
             pass_fds=(fd,),
             stdin=subprocess.PIPE,
             stderr=open(Path(self._judge_env["HOME"]) / "judge.log", "ab"),  # noqa: SIM115 - the child's

@@ -34,7 +34,7 @@ def main() -> None:
     # The judged checks ask the judge, a process of the grader's, before the seal snapshots the checks' modules
     judge_fd = os.environ.pop(judged.ENV, None)  # the sandbox always gives one; without, the checks run here
     if judge_fd is not None:
-        judged.install(int(judge_fd))
+        judged.install(int(judge_fd), given["checks"])
 
     seal.install(
         bytes.fromhex(given["key"]), verdict_fd, given["test_calls"], given["hidden"], given["checks"], given["seed"]
