@@ -964,5 +964,5 @@ def test_a_rebound_check_gets_0_and_is_flagged_in_every_assignment(tmp_path, mon
     csv_path = grade.grade(course, [name], collect=False, jobs=1, ids=DOMAINS[:1])
     [row] = list(csv.DictReader(csv_path.open()))
     flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
-    assert flags == {target: "tampering"}, row["flags"]
+    assert flags == {target: "tampering, the checks' code"}, row["flags"]  # it names the checks' package too
     assert float(row["score"]) == sum(float(assignments.POINTS[n]) for n in numbers[1:]), row
