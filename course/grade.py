@@ -34,6 +34,7 @@ import contextlib
 import os
 import queue
 import re
+import secrets
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -179,6 +180,7 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
                 if job:
                     job.test_calls, job.checks = calls, checks
                     job.seed = learner_seed(course, assignment, learner)
+                    job.judge_key = secrets.token_hex(32)  # the judge's lines', which no kernel holds
                     Path(job.verdicts).unlink(missing_ok=True)
                     env["RTT_SANDBOX"] = job.to_env()
                 try:
@@ -189,7 +191,10 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
                 finally:
                     if job:
                         clear(job)
-                problem = settle(course, assignment, learner, job, log, died) if job else None
+                try:
+                    problem = settle(course, assignment, learner, job, log, died) if job else None
+                except Exception as error:  # noqa: BLE001 - one submission's, named: the others are graded
+                    problem = f"not settled ({type(error).__name__}: {error})"
                 if problem:
                     failed.append(f"{assignment}, {learner}: {problem}")
 

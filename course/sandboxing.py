@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from tutorial.tools.grading import keyrings
-from tutorial.tools.grading.judge import JUDGED_NAMES
+from tutorial.tools.grading.judge import JUDGED_NAMES, genuine
 from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -211,7 +211,9 @@ def number(grade_id: str) -> str:
     return grade_id.split("_", 1)[1].replace("_", ".")
 
 
-def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dict[str, tuple[bool, list[str]]]:
+def judge(
+    autograded: Path, verdicts: Path, log: str, died: bool = False, judge_key: str = ""
+) -> dict[str, tuple[bool, list[str]]]:
     """Each exercise of one graded notebook: (whether the seal let its points stand, its flags).
 
     ``autograded``: the notebook nbgrader executed (none: nbgrader removed it, every exercise 0); ``verdicts``:
@@ -246,14 +248,18 @@ def judge(autograded: Path, verdicts: Path, log: str, died: bool = False) -> dic
     lines = verdicts.read_text().split("\n") if verdicts.is_file() else []
     for line in lines:
         kind, *rest = line.split("\t")
-        by_judge = kind == "judged"  # the judge's own line (the seal's reader refuses one signed so)
+        by_judge = kind == "judged"  # the judge's own line, signed with its key (the seal's reader refuses one)
         if by_judge:
-            kind, *rest = rest or [""]
+            body = genuine(bytes.fromhex(judge_key), line)
+            if body is None:  # cut short and finished by another writer's bytes, or forged
+                pending.append("tampering")
+                continue
+            kind, *rest = body.split("\t")[1:] or [""]
         if kind in ("begin", "verdict") and rest and (rest[0] in judged) != by_judge:
             if not by_judge:  # the seal saw a judged check run in the kernel: the teacher's, reloaded by the answer
                 flags.setdefault(rest[0], []).append("tampering")
             continue  # a judged exercise's verdict is the judge's alone
-        if kind == "note":
+        if kind == "note" and rest:
             flag = {"refused": "tampering", "outside": "outside its folder"}.get(rest[0], rest[0])
             if len(rest) > 2 and rest[2] in flags:  # a note that names its exercise
                 flags[rest[2]].append(flag)
@@ -316,7 +322,7 @@ def settle(course: Path, assignment: str, learner: str, job: Job, log: str, died
     if not died and not verdicts.exists():
         return f"not graded in the sandbox (nbgrader's log: {log[-500:]})"
     notebook = course / "autograded" / learner / assignment / f"{assignment}.ipynb"
-    judged = judge(notebook, verdicts, log, died)
+    judged = judge(notebook, verdicts, log, died, job.judge_key)
     if notebook.parent.is_dir() and verdicts.exists():  # what the seal said, and why, for the teacher
         shutil.copyfile(verdicts, notebook.parent / "seal.txt")
     if notebook.is_file():

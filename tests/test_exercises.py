@@ -334,8 +334,16 @@ MISTAKES = [
     ("7.1", "if released and pushed:", "if released:", "let go, then repeated at 20 Hz"),
     ("7.1", "first = log_time if first is None else first", "first = first or 0", "forward for 1 s, then let go"),
     ("7.1", 'read_messages(path, topics=["/joy"])', "read_messages(path)", "joint states around the Joys"),
+    # a time that is no number: NaN compares False with everything, so a check must ask "within", not "past"
+    ("7.1", "times.append((log_time - first) * 1e-9)", "times.append(float('nan'))", "forward for 1 s, then let go"),
     ("7.2", "speeds = np.abs(dq[moving] / dt[moving])", "speeds = dq[moving] / dt[moving]", "turning back"),
     ("7.2", "usable = ~np.isnan(q)", "usable = np.ones(len(q), dtype=bool)", "a state without the joint"),
+    (
+        "7.2",
+        "return float(speeds[k]), float(t[1:][moving][k])",
+        "return float('nan'), float(t[1:][moving][k])",
+        "steady at 1 rad/s",
+    ),
     (
         "7.2",
         "return float(speeds[k]), float(t[1:][moving][k])",

@@ -60,6 +60,7 @@ class JudgeProcess:
         self.kernel = judged.Judge(ours)
 
     def lines(self) -> list[list[str]]:
+        """The verdict file's lines, each split at tabs (the last field of each the judge's signature)."""
         return [line.split("\t") for line in self.verdicts.read_text().splitlines()] if self.verdicts.exists() else []
 
     def close(self) -> int:
@@ -119,7 +120,7 @@ def test_the_judge_gives_the_worked_solution_the_line_the_kernel_would(ros, monk
     assert got.passed and "hidden ones)" in got.message, str(got)
     assert str(got) == str(in_kernel)
     lines = judge_process.lines()
-    assert lines[0] == ["judged", "begin", number] and lines[1][:5] == ["judged", "verdict", number, "1", "1"]
+    assert lines[0][:3] == ["judged", "begin", number] and lines[1][:5] == ["judged", "verdict", number, "1", "1"]
 
 
 JUDGED_MISTAKES = [m for m in MISTAKES if m[0] in NUMBERS] + [m for m in HIDDEN_MISTAKES if m[0] in NUMBERS]
@@ -167,7 +168,7 @@ def test_an_interrupted_answer_leaves_no_verdict_and_the_next_check_runs(judge_p
     after = judge_process.kernel.run("check_after", answer_of("11.1", exercise("11.1")["solution"]))
     assert after.passed, str(after)
     lines = judge_process.lines()
-    assert ["judged", "begin", "1.1"] in lines and not any(line[1:3] == ["verdict", "1.1"] for line in lines)
+    assert ["judged", "begin", "1.1"] in [line[:3] for line in lines] and not any(line[1:3] == ["verdict", "1.1"] for line in lines)
     assert any(line[1:5] == ["verdict", "11.1", "1", "1"] for line in lines)
 
 
@@ -295,6 +296,11 @@ def test_the_wire_refuses_a_line_it_does_not_read(line):
         wire.loads(line)
 
 
+def by_judge(body: str, key: bytes = b"") -> str:
+    """A line of the judge's (``judged`` and ``body``), signed with ``key``, as a judge given that key writes it."""
+    return judge.signed(key, "judged\t" + body) + "\n"
+
+
 def cell(gid, source, grade=False):
     """An autograded notebook's code cell, as nbgrader leaves it."""
     meta = {"nbgrader": {"grade_id": gid, "grade": grade, "solution": not grade}}
@@ -317,7 +323,7 @@ def test_an_answer_naming_the_checks_package_is_flagged_unless_it_imports_public
     checked = "check_dpad_steering(dpad_track_velocities).require()"
     graded.write_text(json.dumps({"cells": [cell("exercise_1_1", source), cell("check_1_1", checked, True)]}))
     verdicts = tmp_path / "verdicts.txt"
-    verdicts.write_text("judged\tbegin\t1.1\njudged\tverdict\t1.1\t1\t1\t\n")
+    verdicts.write_text(by_judge("begin\t1.1") + by_judge("verdict\t1.1\t1\t1\t"))
     assert sandboxing.judge(graded, verdicts, "")["1.1"] == (True, ["the checks' code"] if flagged else [])
 
 
@@ -334,13 +340,17 @@ def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_pa
     graded.write_text(json.dumps(notebook))
     verdicts = tmp_path / "verdicts.txt"
     # the seal's lines (signed, so from the kernel) pass 1.1 too: the kernel's word for a judged check counts not
-    verdicts.write_text("begin\t1.1\nverdict\t1.1\t1\t1\t\njudged\tbegin\t1.1\njudged\tverdict\t1.1\t0\t1\t\n")
+    verdicts.write_text(
+        "begin\t1.1\nverdict\t1.1\t1\t1\t\n" + by_judge("begin\t1.1") + by_judge("verdict\t1.1\t0\t1\t")
+    )
     verdicts.write_text(verdicts.read_text() + "begin\t1.2\nverdict\t1.2\t1\t1\t\n")
     judged_ = sandboxing.judge(graded, verdicts, "")
     assert judged_["1.1"] == (False, ["tampering"]) and judged_["1.2"] == (True, [])
-    verdicts.write_text("judged\tbegin\t1.1\njudged\tverdict\t1.1\t1\t1\t\nbegin\t1.2\nverdict\t1.2\t1\t1\t\n")
+    verdicts.write_text(
+        by_judge("begin\t1.1") + by_judge("verdict\t1.1\t1\t1\t") + "begin\t1.2\nverdict\t1.2\t1\t1\t\n"
+    )
     assert sandboxing.judge(graded, verdicts, "") == {"1.1": (True, []), "1.2": (True, [])}
-    verdicts.write_text("begin\t1.2\njudged\tverdict\t1.2\t1\t1\t\n")  # the judge's word for a sealed check: none
+    verdicts.write_text("begin\t1.2\n" + by_judge("verdict\t1.2\t1\t1\t"))  # the judge's word for a sealed check: none
     assert sandboxing.judge(graded, verdicts, "")["1.2"][0] is False
 
 
@@ -392,7 +402,7 @@ def test_a_signed_line_that_another_reader_would_split_is_never_the_judges(tmp_p
     notebook = {"cells": [cell("exercise_1_1", "..."), cell("check_1_1", "check_dpad_steering(f).require()", True)]}
     graded = tmp_path / "graded.ipynb"
     graded.write_text(json.dumps(notebook))
-    verdicts.write_text("judged\tbegin\t1.1\njudged\tverdict\t1.1\t0\t1\t\n" + forged + "\n")  # had it got through
+    verdicts.write_text(by_judge("begin\t1.1") + by_judge("verdict\t1.1\t0\t1\t") + forged + "\n")  # had it got through
     assert sandboxing.judge(graded, verdicts, "")["1.1"][0] is False
 
 
@@ -413,3 +423,20 @@ def test_the_judges_notes_are_bounded_and_an_odd_character_does_not_stop_it(judg
     assert any(line[1:3] == ["verdict", "1.1"] for line in lines)  # written, the lone surrogate replaced
     right = answer_of("11.1", exercise("11.1")["solution"])
     assert judge_process.kernel.run("check_after", right).passed  # the judge goes on
+
+
+def test_a_judge_line_cut_short_and_finished_by_the_kernel_or_signed_otherwise_is_no_verdict(tmp_path):
+    """The seal's reader appends the kernel's lines to the judge's file: a judge line the disk cut short, then
+    finished by a line the kernel signed, carries no signature of the judge's key."""
+    key = bytes(range(32))
+    graded = tmp_path / "graded.ipynb"
+    checked = "check_dpad_steering(dpad_track_velocities).require()"
+    graded.write_text(json.dumps({"cells": [cell("exercise_1_1", "..."), cell("check_1_1", checked, True)]}))
+    verdicts = tmp_path / "verdicts.txt"
+    cut = by_judge("verdict\t1.1\t0\t1\t", key)[: len("judged\tverdict\t1.1\t")]
+    verdicts.write_text(by_judge("begin\t1.1", key) + cut + "1\t1\t\n")
+    assert sandboxing.judge(graded, verdicts, "", judge_key=key.hex())["1.1"] == (False, ["tampering"])
+    verdicts.write_text(by_judge("begin\t1.1", b"other") + by_judge("verdict\t1.1\t1\t1\t", b"other"))
+    assert sandboxing.judge(graded, verdicts, "", judge_key=key.hex())["1.1"][0] is False
+    verdicts.write_text(by_judge("begin\t1.1", key) + by_judge("verdict\t1.1\t1\t1\t", key) + "note\n")
+    assert sandboxing.judge(graded, verdicts, "", judge_key=key.hex())["1.1"] == (True, [])  # a bare note: nothing

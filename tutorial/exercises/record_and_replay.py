@@ -91,7 +91,8 @@ def check_release_times(func) -> Result:
                 got_list = [float(t) for t in got]
             except (TypeError, ValueError):
                 raise CaseFailed(f"{call} returned {got!r}, expected a list of seconds {show(expected)}.") from None
-            if len(got_list) != len(expected) or any(abs(a - b) > 1e-6 for a, b in zip(got_list, expected)):
+            # not abs(...) <= tol: a NaN time, which compares False with everything, fails
+            if len(got_list) != len(expected) or any(not abs(a - b) <= 1e-6 for a, b in zip(got_list, expected)):
                 raise CaseFailed(
                     f"{call} returned {show([round(t, 4) for t in got_list])}, expected {show(expected)}.", hint
                 )
@@ -272,7 +273,7 @@ def check_peak_speed(func) -> Result:
                 raise CaseFailed(f"{call} returned {got!r}, expected (speed, time) {show(expected)}.") from None
             want_speed, want_at = expected
             same_at = (math.isnan(at) and math.isnan(want_at)) or abs(at - want_at) <= 1e-9
-            if abs(speed - want_speed) > 1e-9 or not same_at:
+            if not abs(speed - want_speed) <= 1e-9 or not same_at:  # a NaN speed fails
                 said = f"{call} returned ({speed:.6g}, {at:.6g}), expected ({want_speed:.6g}, {want_at:.6g})."
                 if speed == want_speed == 0.0 and math.isnan(at) and not math.isnan(want_at):
                     raise CaseFailed(  # a joint that stood still, taken for one with no pairs

@@ -244,7 +244,7 @@ def check_selected_joints(cls) -> Result:
                     raise CaseFailed(f"{call}: a message stamped {_stamp(msg):.3f} s, not a step of the run.")
                 for name, q in zip(names, msg.position):
                     true = float(state[0][body.joint(name).info.qpos_adr])
-                    if abs(q - true) > 1e-9:
+                    if not abs(q - true) <= 1e-9:  # a NaN position fails
                         raise CaseFailed(
                             f"{call}: at t = {_stamp(msg):.3f} s {name} was published as "
                             f"{q:.6f} rad, but the simulation had {true:.6f} rad.",
@@ -263,7 +263,7 @@ def check_selected_joints(cls) -> Result:
                 ):
                     for name, v in zip(names, values):
                         true = float(source[body.joint(name).info.dof_adr])
-                        if abs(v - true) > 1e-9:
+                        if not abs(v - true) <= 1e-9:
                             raise CaseFailed(
                                 f"{call}: at t = {_stamp(msg):.3f} s {name}'s {field} was published as "
                                 f"{v:.6f} {unit}, but the simulation had {true:.6f} {unit}.",
@@ -397,7 +397,7 @@ def check_pose_publisher(cls) -> Result:
             )
         for k, msg in enumerate(messages):
             t = _stamp(msg)
-            if abs(t - k / rate) > 1e-9:
+            if not abs(t - k / rate) <= 1e-9:
                 raise CaseFailed(
                     f"{who}: pose {k} is stamped {t:.4f} s, expected {k / rate:.4f} s.",
                     f"stamp with simulation time (io.data.time), the first at t = 0, every {1 / rate:g} s: "

@@ -29,13 +29,15 @@ by trying.  The kernel can say anything on the socket; whatever it says, the
 worst it gets is the verdict its answers earn.
 
 Its lines in ``VERDICTS`` begin with ``judged``: ``judged begin N``,
-``judged verdict N PASSED INTACT WHY``, ``judged note FLAG WHAT N``.  Runs as
+``judged verdict N PASSED INTACT WHY``, ``judged note FLAG WHAT N``, each
+signed with a key of the grader's (read after the seed), which the kernel never holds.  Runs as
 the grader (it runs only the teacher's code); one thread.
 """
 
 from __future__ import annotations
 
 import builtins
+import hmac
 import os
 import re
 import socket
@@ -126,15 +128,18 @@ class Channel:
     """The judge's end of the socket: one message out, the kernel's reply in.  A lock, because rclpy may call
     an :class:`Answer` from an executor's thread while a check waits on the main one (10.1's node)."""
 
-    def __init__(self, sock: socket.socket, verdicts: str):
+    def __init__(self, sock: socket.socket, verdicts: str, key: bytes = b""):
         self._sock = sock
         self._reader = sock.makefile("rb")
         self._lock = threading.Lock()
         self._fd = os.open(verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
+        self._key = key
+        self._key = key
         self._back: list[dict] = []  # a request read while a check waited for its answer
         self.number: str | None = None  # the exercise of the check now running
-        self.notes: list[str] = []  # what the kernel did wrong during it (tampering)
+        self.notes: list[str] = []  # what the kernel did wrong during it (tampering): the first MAX_NOTES
         self.noted = 0  # notes in all, written or not
+        self.more = 0  # notes of the check now running past its first MAX_NOTES, only counted
 
     def send(self, message: dict) -> None:
         self._sock.sendall(wire.dumps(message))
@@ -167,15 +172,20 @@ class Channel:
         return reply
 
     def write(self, *fields: str) -> None:
-        """One line in the verdict file: a tab or any line break (``str.splitlines()``'s) in a field a space."""
+        """One line in the verdict file, signed (:func:`signed`): a tab or any line break (``str.splitlines()``'s)
+        in a field a space.  The seal's reader writes the kernel's lines into the same file, so a line cut short
+        (the disk full) could be finished by one of theirs: unsigned then, and the grader takes no such line."""
         clean = [BREAKS.sub(" ", str(f))[:MAX_FIELD] for f in fields]
-        os.write(self._fd, ("\t".join(["judged", *clean]) + "\n").encode("utf-8", "replace"))
+        os.write(self._fd, (signed(self._key, "\t".join(["judged", *clean])) + "\n").encode("utf-8", "replace"))
 
     def note(self, flag: str, what: str) -> None:
         """A note in the verdict file; past :data:`MAX_NOTES` of a check, or between checks, only counted."""
-        self.notes.append(what)
         self.noted += 1
-        if len(self.notes) <= MAX_NOTES and self.noted <= MAX_NOTES_IN_ALL:
+        if len(self.notes) >= MAX_NOTES:
+            self.more += 1  # counted, never kept: an answer could send junk without end
+            return
+        self.notes.append(what)
+        if self.noted <= MAX_NOTES_IN_ALL:
             self.write("note", flag, what, self.number or "")
 
     def note_own_classes(self, value) -> None:
@@ -230,7 +240,7 @@ def serve(channel: Channel, found: dict) -> None:
             channel.send({"id": run, "result": _refusal(name, said)})
             continue
         done.add(name)
-        channel.number, channel.notes = None, []
+        channel.number, channel.notes, channel.more = None, [], 0
         answer = Answer(channel, _answer_name(request.get("answer")), run)
         try:
             result = found[name](answer)
@@ -238,15 +248,28 @@ def serve(channel: Channel, found: dict) -> None:
             continue  # no verdict: the exercise gets 0 (the cell's timeout is flagged from the notebook)
         except ConnectionError:
             return
-        why = "; ".join(channel.notes[:MAX_NOTES]) + (
-            f" (and {len(channel.notes) - MAX_NOTES} more)" if len(channel.notes) > MAX_NOTES else ""
-        )
+        why = "; ".join(channel.notes) + (f" (and {channel.more} more)" if channel.more else "")
         channel.write("verdict", channel.number, int(result.passed), int(not channel.notes), why)
         try:
             said = {k: getattr(result, k) for k in ("exercise", "passed", "message", "case")}
             channel.send({"id": run, "result": said})
         except OSError:
             return
+
+
+def signed(key: bytes, body: str) -> str:
+    """``body`` and its signature (HMAC-SHA256 with ``key``, hex), tab-separated: how the judge writes a line."""
+    return body + "\t" + hmac.new(key, body.encode("utf-8", "replace"), "sha256").hexdigest()
+
+
+def genuine(key: bytes, line: str) -> str | None:
+    """``line``'s body if ``key`` signed it (:func:`signed`), else None (a line cut short, or not the judge's)."""
+    body, _, mac = line.rpartition("\t")
+    return (
+        body
+        if hmac.compare_digest(signed(key, body).encode("utf-8", "replace"), line.encode("utf-8", "replace"))
+        else None
+    )
 
 
 def _refusal(name: str, why: str) -> dict:
@@ -262,8 +285,9 @@ def main(argv: list[str] | None = None) -> int:
     fd, verdicts = int(argv[0]), argv[1]
     modules = argv[2].split(",") if len(argv) > 2 else None
     seed = sys.stdin.readline().strip()  # the learner's seed of hidden cases: the grader's, on a pipe
+    key = bytes.fromhex(sys.stdin.readline().strip())  # what the judge signs its lines with: the grader's too
     sock = socket.socket(fileno=fd)
-    channel = Channel(sock, verdicts)
+    channel = Channel(sock, verdicts, key)
 
     def hook(event: str, args: tuple) -> None:
         """The checks' own events, as the seal would take them in a kernel: the seed given, each check's start

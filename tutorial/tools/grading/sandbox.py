@@ -71,6 +71,8 @@ class Job:
         test_calls: each test cell's statement (``check_x(answer).require()``): the seal's only callers of require().
         checks: the modules the test cells import their checks from: what the seal snapshots.
         seed: the learner's seed of hidden cases (from the teacher's, ``course/grade.py``).
+        judge_key: the key (hex) the judge signs its lines with: the grader's, never the kernel's.
+        judge_key: the key (hex) the judge signs its lines with: the grader's, never the kernel's.
         memory_bytes: the address space a kernel may have (RLIMIT_AS): past it, a ``MemoryError``.
         processes: processes and threads the job's user may have (RLIMIT_NPROC).
         cpu_seconds: CPU time a kernel may use (RLIMIT_CPU).
@@ -86,6 +88,8 @@ class Job:
     test_calls: list[str]
     checks: list[str] = dataclasses.field(default_factory=list)
     seed: str = ""
+    judge_key: str = ""
+    judge_key: str = ""
     memory_bytes: int = 4 << 30
     processes: int = 256
     cpu_seconds: int = 600
@@ -277,8 +281,24 @@ class SandboxedKernelManager(AsyncKernelManager):
         """The judge (:mod:`tutorial.tools.grading.judge`) of this kernel's judged checks: the grader's process,
         outside the sandbox, which imports the teacher's checks now and gets the seed on a pipe."""
         fd = self._judges_end.fileno()
+        limits = [
+            "prlimit",
+            f"--as={job.memory_bytes}",
+            f"--cpu={job.cpu_seconds}",
+            "--core=0",
+            "--",
+        ]  # as the kernel's
         self._judge = subprocess.Popen(
-            [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(fd), job.verdicts, ",".join(job.checks)],
+            [
+                *limits,
+                sys.executable,
+                "-I",
+                "-m",
+                "tutorial.tools.grading.judge",
+                str(fd),
+                job.verdicts,
+                ",".join(job.checks),
+            ],
             pass_fds=(fd,),
             stdin=subprocess.PIPE,
             stderr=open(Path(self._judge_env["HOME"]) / "judge.log", "ab"),  # noqa: SIM115 - the child's
@@ -286,7 +306,7 @@ class SandboxedKernelManager(AsyncKernelManager):
             text=True,
         )
         self._judges_end.close()
-        self._judge.stdin.write(job.seed + "\n")
+        self._judge.stdin.write(job.seed + "\n" + job.judge_key + "\n")
         self._judge.stdin.close()
 
     async def _async_cleanup_resources(self, restart: bool = False):
@@ -315,7 +335,7 @@ class SandboxedKernelManager(AsyncKernelManager):
         """
         fd = os.open(self._job.verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
         with os.fdopen(self._verdict_read, "rb") as pipe, os.fdopen(fd, "a", encoding="utf-8") as out:
-            refused = 0
+            refused = written = 0
             while raw := pipe.readline(MAX_SEAL_LINE):  # a line past the limit is read, and refused, in pieces
                 line = raw.decode("utf-8", "replace").removesuffix("\n")
                 body, _, mac = line.rpartition("\t")
@@ -323,7 +343,8 @@ class SandboxedKernelManager(AsyncKernelManager):
                 ok = hmac.compare_digest(mac.encode(), good.encode()) and raw.endswith(b"\n")
                 # a signed body with a line break of any kind (str.splitlines()'s), or naming the judge, is no seal's
                 ok = ok and len(body.splitlines()) <= 1 and "judged" not in body
-                if ok:
+                written += ok
+                if ok and written <= MAX_SEAL_LINES:
                     out.write(body + "\n")
                 elif refused < MAX_REFUSED_LINES:  # counted, not written without end
                     out.write("note\ttampering\tan unsigned line on the seal's pipe\t\n")
@@ -333,6 +354,8 @@ class SandboxedKernelManager(AsyncKernelManager):
 
 MAX_SEAL_LINE = 4096  # bytes of one of the seal's lines (its longest, a verdict's reasons, is far shorter)
 MAX_REFUSED_LINES = 20  # tampering notes written for the bytes an answer writes on the seal's pipe
+MAX_SEAL_LINES = 10_000  # signed lines written (a notebook's checks and notes make tens; the key is in the kernel)
+MAX_SEAL_LINES = 10_000  # signed lines written (a notebook's checks and notes make tens; the key is in the kernel)
 
 KERNEL_DIED = "the kernel died while this cell ran"
 CPU_TIME_RAN_OUT = "its CPU time ran out"  # RLIMIT_CPU's SIGXCPU
