@@ -134,7 +134,6 @@ class Channel:
         self._lock = threading.Lock()
         self._fd = os.open(verdicts, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o600)
         self._key = key
-        self._key = key
         self._back: list[dict] = []  # a request read while a check waited for its answer
         self.number: str | None = None  # the exercise of the check now running
         self.notes: list[str] = []  # what the kernel did wrong during it (tampering): the first MAX_NOTES

@@ -72,7 +72,6 @@ class Job:
         checks: the modules the test cells import their checks from: what the seal snapshots.
         seed: the learner's seed of hidden cases (from the teacher's, ``course/grade.py``).
         judge_key: the key (hex) the judge signs its lines with: the grader's, never the kernel's.
-        judge_key: the key (hex) the judge signs its lines with: the grader's, never the kernel's.
         memory_bytes: the address space a kernel may have (RLIMIT_AS): past it, a ``MemoryError``.
         processes: processes and threads the job's user may have (RLIMIT_NPROC).
         cpu_seconds: CPU time a kernel may use (RLIMIT_CPU).
@@ -88,7 +87,6 @@ class Job:
     test_calls: list[str]
     checks: list[str] = dataclasses.field(default_factory=list)
     seed: str = ""
-    judge_key: str = ""
     judge_key: str = ""
     memory_bytes: int = 4 << 30
     processes: int = 256
@@ -354,7 +352,6 @@ class SandboxedKernelManager(AsyncKernelManager):
 
 MAX_SEAL_LINE = 4096  # bytes of one of the seal's lines (its longest, a verdict's reasons, is far shorter)
 MAX_REFUSED_LINES = 20  # tampering notes written for the bytes an answer writes on the seal's pipe
-MAX_SEAL_LINES = 10_000  # signed lines written (a notebook's checks and notes make tens; the key is in the kernel)
 MAX_SEAL_LINES = 10_000  # signed lines written (a notebook's checks and notes make tens; the key is in the kernel)
 
 KERNEL_DIED = "the kernel died while this cell ran"
