@@ -279,24 +279,10 @@ class SandboxedKernelManager(AsyncKernelManager):
         """The judge (:mod:`tutorial.tools.grading.judge`) of this kernel's judged checks: the grader's process,
         outside the sandbox, which imports the teacher's checks now and gets the seed on a pipe."""
         fd = self._judges_end.fileno()
-        limits = [
-            "prlimit",
-            f"--as={job.memory_bytes}",
-            f"--cpu={job.cpu_seconds}",
-            "--core=0",
-            "--",
-        ]  # as the kernel's
+        command = ["prlimit", f"--as={job.memory_bytes}", f"--cpu={job.cpu_seconds}", "--core=0", "--"]  # the kernel's
+        command += [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(fd), job.verdicts]
         self._judge = subprocess.Popen(
-            [
-                *limits,
-                sys.executable,
-                "-I",
-                "-m",
-                "tutorial.tools.grading.judge",
-                str(fd),
-                job.verdicts,
-                ",".join(job.checks),
-            ],
+            [*command, ",".join(job.checks)],
             pass_fds=(fd,),
             stdin=subprocess.PIPE,
             stderr=open(Path(self._judge_env["HOME"]) / "judge.log", "ab"),  # noqa: SIM115 - the child's
