@@ -246,11 +246,12 @@ def judge(
     # lines split at "\n" alone, as the seal's pipe reader and the judge write them (str.splitlines() would also
     # split at "\r", "\x1c" or U+2028, which a body the kernel signed may hold)
     lines = verdicts.read_text().split("\n") if verdicts.is_file() else []
+    key = bytes.fromhex(judge_key)
     for line in lines:
         kind, *rest = line.split("\t")
         by_judge = kind == "judged"  # the judge's own line, signed with its key (the seal's reader refuses one)
         if by_judge:
-            body = genuine(bytes.fromhex(judge_key), line)
+            body = genuine(key, line)
             if body is None:  # cut short and finished by another writer's bytes, or forged
                 pending.append("tampering")
                 continue

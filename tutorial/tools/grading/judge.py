@@ -264,11 +264,8 @@ def signed(key: bytes, body: str) -> str:
 def genuine(key: bytes, line: str) -> str | None:
     """``line``'s body if ``key`` signed it (:func:`signed`), else None (a line cut short, or not the judge's)."""
     body, _, mac = line.rpartition("\t")
-    return (
-        body
-        if hmac.compare_digest(signed(key, body).encode("utf-8", "replace"), line.encode("utf-8", "replace"))
-        else None
-    )
+    good = hmac.new(key, body.encode("utf-8", "replace"), "sha256").hexdigest()
+    return body if hmac.compare_digest(mac.encode("utf-8", "replace"), good.encode()) else None
 
 
 def _refusal(name: str, why: str) -> dict:

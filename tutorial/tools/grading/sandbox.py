@@ -36,7 +36,6 @@ from __future__ import annotations
 import asyncio
 import dataclasses
 import hashlib
-import hmac
 import json
 import os
 import secrets
@@ -53,6 +52,7 @@ from jupyter_client.manager import AsyncKernelManager
 from nbgrader.preprocessors import Execute
 
 from tutorial.tools.grading import judged
+from tutorial.tools.grading.judge import genuine
 
 ENV = "RTT_SANDBOX"
 PRIVATE = ("/tmp", "/var/tmp", "/dev/shm")  # the kernel's own, empty at its start
@@ -322,11 +322,9 @@ class SandboxedKernelManager(AsyncKernelManager):
             refused = written = 0
             while raw := pipe.readline(MAX_SEAL_LINE):  # a line past the limit is read, and refused, in pieces
                 line = raw.decode("utf-8", "replace").removesuffix("\n")
-                body, _, mac = line.rpartition("\t")
-                good = hmac.new(self._key, body.encode(), "sha256").hexdigest()
-                ok = hmac.compare_digest(mac.encode(), good.encode()) and raw.endswith(b"\n")
+                body = genuine(self._key, line)  # signed as the judge signs, with the seal's key
                 # a signed body with a line break of any kind (str.splitlines()'s), or naming the judge, is no seal's
-                ok = ok and len(body.splitlines()) <= 1 and "judged" not in body
+                ok = body is not None and raw.endswith(b"\n") and len(body.splitlines()) <= 1 and "judged" not in body
                 written += ok
                 if ok and written <= MAX_SEAL_LINES:
                     out.write(body + "\n")

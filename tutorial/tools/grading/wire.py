@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import base64
 import dataclasses
+import functools
 import json
 import math
 import re
@@ -54,6 +55,7 @@ class Opaque:
     __hash__ = object.__hash__
 
 
+@functools.cache
 def _classes() -> dict:
     from tutorial.core.body import JointInfo
     from tutorial.interfaces.tf import Transform
@@ -62,19 +64,11 @@ def _classes() -> dict:
     return {f"{c.__module__}:{c.__qualname__}": c for c in (JointInfo, Transform, JointSeries)}
 
 
+@functools.cache
 def _messages() -> dict:
     from rcl_interfaces.msg import SetParametersResult
 
     return {"rcl_interfaces/msg/SetParametersResult": SetParametersResult}
-
-
-_LAZY: dict = {}
-
-
-def _table(name: str) -> dict:
-    if name not in _LAZY:
-        _LAZY[name] = {"classes": _classes, "messages": _messages}[name]()
-    return _LAZY[name]
 
 
 NUMPY_KINDS = "biuf"  # NumPy dtypes the wire carries: booleans, integers, floats
@@ -110,11 +104,11 @@ def encode(value, depth: int = 0):
         if isinstance(value, np.generic) and value.dtype.kind in NUMPY_KINDS:
             return {"scalar": [value.dtype.str, encode(value.item(), depth + 1)]}
     key = f"{module}:{getattr(kind, '__qualname__', '')}"
-    if key in _table("classes"):
+    if key in _classes():
         fields = {f.name: encode(getattr(value, f.name), depth + 1) for f in dataclasses.fields(kind)}
         return {"object": [key, fields]}
     message = _message_name(kind)
-    if message in _table("messages"):
+    if message in _messages():
         fields = {name: encode(_plain(getattr(value, name)), depth + 1) for name in kind.get_fields_and_field_types()}
         return {"message": [message, fields]}
     if module == "rclpy.parameter" and kind.__qualname__ == "Parameter":
@@ -251,7 +245,7 @@ def _scalar(body, depth, folder):
 
 def _object(body, depth, folder):
     key, fields = body
-    cls = _table("classes").get(key)
+    cls = _classes().get(key)
     if cls is None:
         raise WireError(f"no such class on the wire: {key!r:.80}")
     return cls(**{str(k): decode(v, depth, folder) for k, v in dict(fields).items()})
@@ -259,7 +253,7 @@ def _object(body, depth, folder):
 
 def _message(body, depth, folder):
     name, fields = body
-    cls = _table("messages").get(name)
+    cls = _messages().get(name)
     if cls is None:
         raise WireError(f"no such message on the wire: {name!r:.80}")
     message = cls()
