@@ -241,7 +241,9 @@ def judge(
             (exercises[current]["cells"] if current else before).append(cell)
     passed: dict[str, bool] = {}
     flags: dict[str, list[str]] = {n: [] for n in exercises}
-    judged = {n for n, found in exercises.items() if JUDGED_NAMES & set(re.findall(r"\b(check_\w+)\(", found["check"]))}
+    called = {n: set(re.findall(r"\b(check_\w+)\(", found["check"])) for n, found in exercises.items()}
+    judged = {n for n, names in called.items() if JUDGED_NAMES & names}
+    by_check = {name: n for n, names in called.items() for name in names}  # a note of the seal's names the check
     pending: list[str] = []  # notes before a check: the answer cell's, which comes before it
     # lines split at "\n" alone, as the seal's pipe reader and the judge write them (str.splitlines() would also
     # split at "\r", "\x1c" or U+2028, which a body the kernel signed may hold)
@@ -262,8 +264,9 @@ def judge(
             continue  # a judged exercise's verdict is the judge's alone
         if kind == "note" and rest:
             flag = {"refused": "tampering", "outside": "outside its folder"}.get(rest[0], rest[0])
-            if len(rest) > 2 and rest[2] in flags:  # a note that names its exercise
-                flags[rest[2]].append(flag)
+            ex = by_check.get(rest[2], rest[2]) if len(rest) > 2 else None
+            if ex in flags:  # a note that names its exercise, or the judged check it ran in the kernel for
+                flags[ex].append(flag)
             else:
                 pending.append(flag)
         elif kind == "begin" and rest:
@@ -306,7 +309,9 @@ def judge(
             mine.append("the checks' code")
         if check_ok and not passed.get(ex, False):  # the notebook passed what the seal did not see pass
             mine.append("tampering")
-        out[ex] = (passed.get(ex, False), sorted(set(mine)))
+        # tampering costs the exercise its points: a judged check's experiments, replaced in the kernel, could
+        # have sent the judge what a right answer would
+        out[ex] = (passed.get(ex, False) and "tampering" not in mine, sorted(set(mine)))
     return out
 
 

@@ -310,14 +310,10 @@ def _stand_in_2_1(
     each message; ``at(seconds, state)`` stands in for the probe's state at a stamp; ``refuse``: refuse a name the
     tank lacks, or those names for which ``refuse(names)`` is true (``log``: with an error logged; "not done": a
     stub's NotImplementedError instead)."""
-    import logging
-
     from tutorial.app.app import ControllerError
 
     qpos, qvel, effort = [0.0] * 7 + [0.0, -0.5], [0.0] * 6 + [0.0, -2.5], [0.0] * 6 + [3.0, 4.0]
     state = (qpos, None, None, qvel, effort)
-    infos = {name: SimpleNamespace(qpos_adr=q, dof_adr=d) for name, (q, d) in JOINT_ADDRESSES.items()}
-    body = SimpleNamespace(joint=lambda name: SimpleNamespace(info=infos[name]))
 
     def drive(name, cls, parameters, script=None, duration=None, tumble=None):
         joints, rate = parameters["joints"], parameters["rate"]
@@ -326,9 +322,9 @@ def _stand_in_2_1(
         if refuse(names) if callable(refuse) else refuse and not set(names) <= set(step2.TANK):
             if log == "not done":  # the refusal left as a stub
                 raise ControllerError("Selected raised in configure") from NotImplementedError()
-            if log:
-                logging.getLogger("rtt.Selected").error("joints: Tank has no joint %s", names)
-            raise ControllerError("Selected refused to configure")
+            refused = ControllerError("Selected refused to configure")
+            refused.errors_logged = 1 if log else 0  # what _drive says of config.log's errors
+            raise refused
         messages = []
         for k in range(count(rate)):
             sec, nanosec = divmod(round(k / rate * 1e9), 1_000_000_000)
@@ -346,7 +342,7 @@ def _stand_in_2_1(
         publisher = SimpleNamespace(messages=lambda: messages)
         node = SimpleNamespace(published=lambda topic: [publisher] if topic == "/Tank/joint_state" else [])
         probe = SimpleNamespace(at=lambda seconds: at(seconds, state) if at else state)
-        return node, probe, SimpleNamespace(bodies={"Tank": body})
+        return node, probe, dict(JOINT_ADDRESSES)
 
     return drive
 

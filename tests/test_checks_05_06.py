@@ -384,15 +384,14 @@ def test_6_1_off_by_one_in_at_most_1_percent_of_the_pixels_and_more_than_one_nev
 def test_6_1_a_camera_publishing_no_image_on_its_topic_is_told_so(monkeypatch):
     """Fast DDS refuses a second type on one topic, so only an answer that makes its own publisher instead of
     the Image's gets here: a stand-in rig shows the line."""
-    from types import SimpleNamespace
 
-    from sensor_msgs.msg import CompressedImage
+    from rclpy.qos import QoSProfile
 
     from tutorial.exercises import step6_camera as step6
 
-    publisher = SimpleNamespace(msg_type=CompressedImage, topic="/Tank/camera/image")
-    rig = SimpleNamespace(name="RttGrayCameraPublisher", images=lambda: publisher)
-    monkeypatch.setattr(step6, "drive", lambda cls, camera, poses: rig)
+    publisher = {"topic": "/Tank/camera/image", "type": "sensor_msgs/msg/CompressedImage", "qos": QoSProfile(depth=1)}
+    record = {"publishers": [{**publisher, "destroyed": True, "messages": []}], "destroyed": [0], "times": []}
+    monkeypatch.setattr(step6, "_drove", lambda cls, camera, poses, pictures: {**record, "references": []})
     monkeypatch.setattr(step6, "hidden_random", lambda exercise: None)
     result = step6.check_gray_camera(type("RttGrayCameraPublisher", (), {}))
     assert not result.passed
@@ -482,14 +481,15 @@ def test_6_1_each_hidden_case_fails_on_its_own_rule_on_the_hidden_camera(monkeyp
     rule: the hidden case of that rule is the one that fails."""
     from types import SimpleNamespace
 
-    from sensor_msgs.msg import Image
-
     from tutorial.exercises import step6_camera as step6
     from tutorial.interfaces.timing import stamp_parts
 
     rng = np.random.default_rng(7)
 
-    def drive(cls, camera, poses):
+    from rclpy.qos import QoSProfile
+
+    def drove(cls, camera, poses, pictures):  # the experiment's record of a drive
+        camera = step6.Camera(**camera)
         times = [camera.start + 0.1 * k for k in range(len(poses))]
         colours = [rng.integers(0, 256, (camera.height, camera.width, 3)).astype(float) for _ in poses]
         messages = []
@@ -507,13 +507,11 @@ def test_6_1_each_hidden_case_fails_on_its_own_rule_on_the_hidden_camera(monkeyp
                     gray = np.frombuffer(msg.data, np.uint8).astype(int)
                     msg.data = np.clip(gray + np.where(gray < 128, 3, -3), 0, 255).astype(np.uint8).tobytes()
             messages.append(msg)
-        publisher = SimpleNamespace(msg_type=Image, topic=camera.topic("image"), messages=lambda: messages)
-        return SimpleNamespace(
-            name="Gray", images=lambda: publisher, poses=[(t, None) for t in times], colours=colours
-        )  # fmt: skip
+        publisher = {"topic": camera.topic("image"), "type": "sensor_msgs/msg/Image", "qos": QoSProfile(depth=1)}
+        publisher.update(destroyed=True, messages=messages)
+        return {"publishers": [publisher], "destroyed": [0], "times": times, "references": colours}
 
-    monkeypatch.setattr(step6, "drive", drive)
-    monkeypatch.setattr(step6, "references", lambda rig: rig.colours)
+    monkeypatch.setattr(step6, "_drove", drove)
     monkeypatch.setattr(step6, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
     result = step6.check_gray_camera(type("Gray", (), {}))
     assert not result.passed and result.case == told and result.message.startswith(f"a hidden case failed: {told}.")

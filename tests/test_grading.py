@@ -684,7 +684,7 @@ CHEATS = {
     "crash": ("1.2", "import os\nos.kill(os.getpid(), 9)\n", "crash"),  # 1.1, before it, keeps its points
     # graded alone, with the CPU time limit below the cell timeout (test_a_kernel_over_its_cpu_time_...)
     "cpu-time": ("1.2", "while True:\n    pass\n", "over a limit"),
-    "stack-walk": (  # the check's own expected values, read down the stack from a frame a library took for it
+    "stack-walk": (  # the check's expected values down the stack: the judge runs every check, nothing to read
         "1.2",
         "import traceback\n"
         "class ShotCountingTankController(RttTankController):\n"
@@ -693,20 +693,20 @@ CHEATS = {
         "            frame = next(traceback.walk_tb(e.__traceback__))[0]\n"
         "        while frame is not None and 'expected' not in frame.f_locals:\n"
         "            frame = frame.f_back\n"
+        "        print('an expected value on the stack:', 'yes' if frame is not None else 'no')\n"
         "        return {**super().summary(), 'shots': frame.f_locals['expected'] if frame is not None else 0}\n",
-        "tampering",
-    ),
-    "stack-walk-judged": (  # the same for a check the judge runs: nothing on the kernel's stack to read, no flag
-        "1.1",
-        "import traceback\n"
-        "def dpad_track_velocities(axes):\n"
-        "    try:\n        1 / 0\n    except ZeroDivisionError as e:\n"
-        "        frame = next(traceback.walk_tb(e.__traceback__))[0]\n"
-        "    while frame is not None and 'expected' not in frame.f_locals:\n"
-        "        frame = frame.f_back\n"
-        "    print('an expected value on the stack:', 'yes' if frame is not None else 'no')\n"
-        "    return frame.f_locals['expected'] if frame is not None else (0.0, 0.0)\n",
         "",
+    ),
+    "replace-the-experiments": (  # what the judge asks the kernel to run on the class, replaced by the rules
+        "1.2",
+        GRADER + "import tutorial.exercises.step1_tank_controller as m\n"
+        "said = {'_shots_counted': lambda cls, presses: m._shots(presses),\n"
+        "        '_input_after_one_joy': lambda cls, buttons, axes: (1, axes),\n"
+        "        '_summary_after_one_joy': lambda cls, buttons: {'joy_received': 1},\n"
+        "        '_state_touched': lambda cls, presses: ([], [])}\n"
+        "for name, fake in said.items():\n"
+        "    grader.EXPERIMENTS[f'{m.__name__}:{name}'] = fake\n",
+        "tampering",
     ),
     "copy-the-rule": (  # the check module's own rule, called: full points, which the teacher must see
         "1.1",
@@ -782,7 +782,7 @@ CHEATS_SAY = {
     "read-solutions": "solutions found: 0",
     "read-another-learner": "read another learner: no",
     "grader-aware": "graded, says the environment: False",
-    "stack-walk-judged": "an expected value on the stack: no",
+    "stack-walk": "an expected value on the stack: no",
     "memory-from-a-child": "the kernel memory refused to a child: True",
     "keyring-note": "a note in the keyrings: no",
 }

@@ -1,4 +1,4 @@
-"""The judge: the checks of data-only exercises run in a process of their own, and only data crosses.
+"""The judge: every exercise's check runs in a process of its own, and only data crosses.
 
 A real judge process (``python -I -m tutorial.tools.grading.judge``) on one end
 of a socket pair, the kernel's side (:class:`tutorial.tools.grading.judged.Judge`)
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from exercise_rules import HIDDEN_MISTAKES
-from test_exercises import MISTAKES, exercise, first_three_of_each, grade, hidden_cases_on, mistake_id
+from test_exercises import EXERCISES, MISTAKES, exercise, first_three_of_each, grade, hidden_cases_on, mistake_id
 
 from tutorial.tools.grading import judge, judged, wire
 
@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT / "course"))
 import sandboxing  # noqa: E402 - course/ is not a package
 
 SEED = "test"  # the seed tests/test_exercises.py's grading_seed gives the in-process checks
-NUMBERS = ["1.1", "3.2", "7.1", "7.2", "8.1", "8.2", "9.1", "10.1", "11.1"]  # the judged exercises
+NUMBERS = list(EXERCISES)  # the judged exercises: every one
 
 
 class JudgeProcess:
@@ -100,13 +100,14 @@ def answer_of(number: str, source: str):
     return names["answer"]
 
 
-def test_judged_is_the_judge_modules_table_and_names_the_function_exercises():
+def test_judged_is_the_judge_modules_table_and_names_every_exercise():
     table = {(module, name) for module, names in judge.JUDGED.items() for name in names}
     exercises = {(f"tutorial.exercises.{exercise(n)['checks']}", exercise(n)["check"]) for n in NUMBERS}
     assert table == exercises and judge.JUDGED_NAMES == {name for _, name in table}
 
 
-KEPT = {"1.1", "9.1"}  # make test's: a function of lists, and one raising the KeyError its statement asks for
+# make test's: a function of lists, one raising the KeyError its statement asks for, and a class run in a simulation
+KEPT = {"1.1", "9.1", "2.2"}
 
 
 @pytest.mark.parametrize(
@@ -124,7 +125,9 @@ def test_the_judge_gives_the_worked_solution_the_line_the_kernel_would(ros, monk
 
 
 JUDGED_MISTAKES = [m for m in MISTAKES if m[0] in NUMBERS] + [m for m in HIDDEN_MISTAKES if m[0] in NUMBERS]
-IN_MAKE_TEST = {mistake_id(m) for m in first_three_of_each([m for m in JUDGED_MISTAKES if m[0] == "1.1"])[:1]}
+IN_MAKE_TEST = {  # a function's first wrong answer, and a class's
+    mistake_id(m) for n in ("1.1", "1.2") for m in first_three_of_each([m for m in JUDGED_MISTAKES if m[0] == n])[:1]
+}
 
 
 @pytest.mark.parametrize(
@@ -333,8 +336,9 @@ def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_pa
         "cells": [
             cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
             cell("check_1_1", "check_dpad_steering(dpad_track_velocities).require()", True),
+            # a check the judge does not run (none of the course's): its verdict is the sealed kernel's
             cell("exercise_1_2", "class ShotCountingTankController: ..."),
-            cell("check_1_2", "check_shot_counter(ShotCountingTankController).require()", True),
+            cell("check_1_2", "check_in_the_kernel(ShotCountingTankController).require()", True),
         ]
     }
     graded = tmp_path / "graded.ipynb"
@@ -441,3 +445,147 @@ def test_a_judge_line_cut_short_and_finished_by_the_kernel_or_signed_otherwise_i
     assert sandboxing.judge(graded, verdicts, "", judge_key=key.hex())["1.1"][0] is False
     verdicts.write_text(by_judge("begin\t1.1", key) + by_judge("verdict\t1.1\t1\t1\t", key) + "note\n")
     assert sandboxing.judge(graded, verdicts, "", judge_key=key.hex())["1.1"] == (True, [])  # a bare note: nothing
+
+
+SEALED_KERNEL = """
+import socket, subprocess, sys
+from tutorial.tools.grading import judged, seal
+MODULES = ["tutorial.exercises.step1_tank_controller"]
+ours, theirs = socket.socketpair()
+judge = subprocess.Popen(
+    [sys.executable, "-I", "-m", "tutorial.tools.grading.judge", str(theirs.fileno()), {verdicts!r}, *MODULES],
+    pass_fds=(theirs.fileno(),), stdin=subprocess.PIPE, text=True,
+)
+theirs.close()
+judge.stdin.write("seed\\n" + "00" * 32 + "\\n")
+judge.stdin.close()
+judged.install(ours.detach(), MODULES)
+seal.install(b"k" * 32, 1, ["check_shot_counter(ShotCountingTankController).require()"], checks=MODULES, seed="x")
+from tutorial.app.reference.tank_controller import RttTankController
+from tutorial.exercises.step1_tank_controller import check_shot_counter
+from tutorial.interfaces import joy
+{answer}
+{before}
+print(check_shot_counter(ShotCountingTankController), file=sys.stderr)
+"""
+REPLACE_THE_EXPERIMENTS = """
+import tutorial.exercises.grader as grader
+import tutorial.exercises.step1_tank_controller as m
+said = {"_shots_counted": lambda cls, presses: m._shots(presses),
+        "_input_after_one_joy": lambda cls, buttons, axes: (1, axes),
+        "_summary_after_one_joy": lambda cls, buttons: {"joy_received": 1},
+        "_state_touched": lambda cls, presses: ([], [])}
+for name, fake in said.items():
+    grader.EXPERIMENTS[f"{m.__name__}:{name}"] = fake
+"""
+
+
+# Code an answer runs before its test cell that leaves what the experiments report right, but changes the kernel's
+# side of the judge (each is what a cheat would wrap); the seal notes it for the check that runs next.
+JUDGES_END_WRAPPED = """
+judge = next(c.cell_contents for c in check_shot_counter.__closure__ if type(c.cell_contents).__name__ == "Judge")
+judge._send = judge._send  # an attribute of the object's own now, in front of the method
+"""
+PARTIAL_WRAPPED = """
+import functools
+real = functools.partial
+functools.partial = lambda *a, **k: real(*a, **k)
+"""
+
+
+@pytest.mark.parametrize(
+    "answer, before, noted",
+    [
+        ("solution", "", None),
+        ("stub", REPLACE_THE_EXPERIMENTS, "the experiment tutorial.exercises.step1_tank_controller:_shots_counted was"),
+        pytest.param(
+            "solution", JUDGES_END_WRAPPED, "the kernel's end of the judge was changed", marks=pytest.mark.more
+        ),
+        pytest.param("solution", PARTIAL_WRAPPED, "functools.partial was replaced", marks=pytest.mark.more),
+    ],
+    ids=["honest", "experiments replaced", "the judge's end wrapped", "functools.partial wrapped"],
+)
+def test_a_class_checks_experiments_run_in_the_kernel_and_replacing_them_is_tampering(tmp_path, answer, before, noted):
+    """The judge has the kernel run 1.2's experiments on the learner's class; the seal compares what they use (their
+    module's names, the experiments by name, the standard modules the kernel's side of the judge calls, and that
+    side's own object) with its snapshot as the judged check begins and ends: an answer that replaced one passes the
+    judge, and is noted as tampering for that check (the grader then gives it no points)."""
+    from test_seal import sealed, signed_lines
+
+    ex = exercise("1.2")
+    code = ex[answer].replace(ex["check"], "")  # the test cell's call is below
+    done = sealed(SEALED_KERNEL.format(verdicts=str(tmp_path / "verdicts.txt"), answer=code, before=before))
+    assert "passed (" in done.stderr, done.stderr  # the judge's line: the experiments said what the rule says
+    # (its temporary folders, outside the sandbox's /tmp here, are noted "outside"; no flag of this test's)
+    notes = [line for line in signed_lines(done.stdout) if line[0] == "note" and line[1] == "tampering"]
+    if noted:
+        assert notes and notes[0][3] == "check_shot_counter" and noted in notes[0][2], notes
+    else:
+        assert notes == []
+
+
+def test_a_standard_library_class_is_not_taken_for_an_answers_own():
+    """An honest summary may hold a deque or a namespace: it crosses as a value equal to nothing, never flagged."""
+    import collections
+    import types
+
+    for value in (collections.deque([1]), collections.OrderedDict(a=1), types.SimpleNamespace(a=1)):
+        kind, _, own_eq = wire.encode(value)["opaque"]
+        assert not own_eq, kind
+    assert wire.encode(type("Mine", (), {"__eq__": lambda self, other: True})())["opaque"][2]
+
+
+STILL_HEADING = """
+from geometry_msgs.msg import PoseStamped
+from tutorial.core.controller import SimpleController
+from tutorial.core.period import PeriodAccumulator
+from tutorial.interfaces.joint_state import joint_state_qos
+from tutorial.interfaces.timing import stamp_parts
+
+
+class RttPosePublisher(SimpleController):  # publishes honestly, and holds the tank's heading still
+    PARAMETERS = {"rate": (float, 10.0, "publish rate, Hz of simulated time")}
+
+    def configure(self, config):
+        self.node, self.rate = config.node, config.parameters["rate"]
+        self.publisher = config.node.create_publisher(PoseStamped, f"/{config.body_name}/pose", joint_state_qos())
+        return True
+
+    def unconfigure(self):
+        self.node.destroy_publisher(self.publisher)
+
+    def initialize(self, io):
+        self.io, self.accumulator = io, PeriodAccumulator(io.time_step, self.rate)
+        joint = io.body.model.body_jntadr[io.body.root_id]
+        self.q, self.v = int(io.body.model.jnt_qposadr[joint]), int(io.body.model.jnt_dofadr[joint])
+        return True
+
+    def control(self):
+        self.io.data.qpos[self.q + 3 : self.q + 7] = [1.0, 0.0, 0.0, 0.0]
+        self.io.data.qvel[self.v + 3 : self.v + 6] = 0.0
+        if self.accumulator.tick():
+            msg = PoseStamped()
+            msg.header.frame_id = "world"
+            msg.header.stamp.sec, msg.header.stamp.nanosec = stamp_parts(self.io.current_time)
+            (x, y, z), (w, qx, qy, qz) = self.io.body.root_pose()
+            msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = float(x), float(y), float(z)
+            o = msg.pose.orientation
+            o.x, o.y, o.z, o.w = float(qx), float(qy), float(qz), float(w)
+            self.publisher.publish(msg)
+        return True
+"""
+
+
+@pytest.mark.more
+def test_a_check_that_raises_outside_its_cases_fails_the_exercise_and_the_judge_goes_on(ros, judge_process):
+    """2.2's check raises when its own drive did not turn the tank (a class that held the heading still): the
+    exercise fails with the check's words, and the judge still serves the next check."""
+    import tutorial.exercises.step2_joint_state_publisher  # noqa: F401 - its experiments, as install imports them
+
+    names: dict = {}
+    exec(STILL_HEADING, names)
+    got = judge_process.kernel.run("check_pose_publisher", names["RttPosePublisher"])
+    assert not got.passed and "the check could not judge this answer (RuntimeError" in got.message, str(got)
+    assert judge_process.lines()[-1][:4] == ["judged", "verdict", "2.2", "0"]
+    again = judge_process.kernel.run("check_dpad_steering", lambda axes: (0.0, 0.0))
+    assert not again.passed and "Exercise 1.1" in str(again)  # judged, not "the judge is gone"

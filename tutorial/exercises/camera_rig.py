@@ -130,14 +130,7 @@ class Rig:
 
     def images(self):
         """The capturing publisher of the camera's Image topic (the first one made)."""
-        topic = self.camera.topic("image")
-        pubs = self.node.published(topic)
-        if not pubs:
-            raise CaseFailed(
-                f"{self.name} made no publisher of {topic} (it made {[p.topic for p in self.node.published()]}).",
-                "let RttCameraImagePublisher.configure create it: call super().configure(config).",
-            )
-        return pubs[0]
+        return image_publisher(self.node, self.camera, self.name)
 
     def picture(self, turret_y: float, turret_p: float) -> None:
         """Pose the turret, step to the next picture, and wait until it is published."""
@@ -187,6 +180,22 @@ class Rig:
                     c.loop.wake()
                 c.thread.join(5.0)
             self.node.destroy_node()
+
+
+def image_publisher(node, camera: Camera, name: str):
+    """The first publisher of ``camera``'s Image topic that ``node`` (capturing or recorded) has.
+
+    Raises:
+        CaseFailed: the learner's class ``name`` made none.
+    """
+    topic = camera.topic("image")
+    pubs = node.published(topic)
+    if not pubs:
+        raise CaseFailed(
+            f"{name} made no publisher of {topic} (it made {[p.topic for p in node.published()]}).",
+            "let RttCameraImagePublisher.configure create it: call super().configure(config).",
+        )
+    return pubs[0]
 
 
 def drive(cls, camera: Camera, poses) -> Rig:

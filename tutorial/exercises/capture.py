@@ -132,3 +132,74 @@ def scripted_drive(name: str, cls, parameters: dict, node: CapturingNode, script
     summary, app = run_headless(project, duration, node=node, attach=attach)
     raise_run_error(summary)
     return app
+
+
+def publishers_record(node: CapturingNode) -> list[dict]:
+    """What each capturing publisher of ``node`` saw, as data (an experiment's, :func:`~tutorial.exercises.grader.
+    experiment`): ``{"topic", "type"`` (``pkg/msg/Name``), ``"qos"``, ``"destroyed"``, ``"messages"}``.
+
+    The QoS is the real publisher's, and destroyed means gone from the real node too: a class can write
+    ``qos_profile`` or ``destroyed`` on the capturing publisher it was handed, not make rclpy's say so.
+    """
+    live = node.node.publishers
+    return [
+        {
+            "topic": p.topic,
+            "type": f"{p.msg_type.__module__.split('.')[0]}/msg/{p.msg_type.__name__}",
+            "qos": p.real.qos_profile,
+            "destroyed": p.destroyed and not any(p.real is q for q in live),
+            "messages": p.messages(),
+        }
+        for p in node.published()
+    ]
+
+
+class RecordedPublisher:
+    """A capturing publisher as :func:`publishers_record` recorded it: what a check reads of one."""
+
+    def __init__(self, record: dict):
+        from rclpy.qos import QoSProfile
+
+        self.topic, self.qos_profile = str(record["topic"]), record["qos"]
+        if not isinstance(self.qos_profile, QoSProfile):
+            raise TypeError(f"a publisher's QoS recorded as {self.qos_profile!r:.60}")
+        self.msg_type = _message_class(str(record["type"]))
+        self.destroyed = record["destroyed"] is True
+        self._messages = list(record["messages"])
+
+    def messages(self) -> list:
+        return list(self._messages)
+
+    require_destroyed = CapturingPublisher.require_destroyed
+
+
+class RecordedNode:
+    """A capturing node's publishers as :func:`publishers_record` recorded them (``published``, as its own)."""
+
+    def __init__(self, records: list[dict]):
+        self.publishers = [RecordedPublisher(r) for r in records]
+
+    published = CapturingNode.published
+
+
+# The message types a check of a publisher names (what a recorded publisher's type is compared with).
+CHECKED_MESSAGES = (
+    "sensor_msgs/msg/JointState",
+    "geometry_msgs/msg/PoseStamped",
+    "sensor_msgs/msg/Imu",
+    "std_msgs/msg/Float64",
+    "geometry_msgs/msg/Vector3Stamped",
+    "sensor_msgs/msg/Image",
+    "sensor_msgs/msg/CameraInfo",
+)
+
+
+def _message_class(name: str) -> type:
+    """The class of message type ``name`` (``pkg/msg/Name``) if it is one of :data:`CHECKED_MESSAGES`; else a class
+    of that name alone (no other module is imported for a name a recording gives)."""
+    import importlib
+
+    package, _, kind = name.partition("/msg/")
+    if name in CHECKED_MESSAGES:
+        return getattr(importlib.import_module(f"{package}.msg"), kind)
+    return type(kind if kind.isidentifier() else "message", (), {})

@@ -129,6 +129,32 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
         logger.propagate = propagate
 
 
+EXPERIMENTS: dict[str, Callable] = {}  # "module:name" -> every function marked @experiment
+
+
+def experiment(func: Callable) -> Callable:
+    """Mark ``func(cls, *args)`` as one of a check's experiments on a learner's class: what it returns is data
+    (the wire's types: numbers, text, lists, tuples, dicts, arrays), which the check then judges.
+
+    While grading, the check runs in the judge (:mod:`tutorial.tools.grading.judge`), and :func:`observe` has
+    the graded kernel, where the class lives, run the experiment by this name.
+    """
+    EXPERIMENTS[f"{func.__module__}:{func.__qualname__}"] = func
+    return func
+
+
+def observe(func: Callable, cls, *args):
+    """What experiment ``func(cls, *args)`` (marked :func:`experiment`) gives: run here, or while grading in the
+    kernel that holds the learner's class, whose reply is built back from data.  The caller's thread.
+
+    Raises:
+        what the experiment raised (while grading: a class of its name, as the judge rebuilds it).
+    """
+    box: list = []
+    sys.audit("rtt.observe", box)  # the judge, where it runs this check, puts its way to the kernel in the box
+    return box[0](func, *args) if box else func(cls, *args)
+
+
 def hidden_random(exercise: str) -> random.Random | None:
     """The random source of this learner's hidden cases of ``exercise`` (e.g. ``"1.1"``), while grading; else None.
 

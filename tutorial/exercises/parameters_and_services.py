@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import threading
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random
+from tutorial.exercises.grader import Case, CaseFailed, Result, experiment, grade, hidden_random, observe
 
 RATE = "RttJointStatePublisher.rate"
 MAX_RATE = 1000.0  # Hz: the simulation's steps per second
@@ -248,30 +248,30 @@ def check_switch_tracks(func) -> Result:
     While grading, a hidden case sends a drawn sequence of requests from a
     drawn start, each answer and the switch after it judged by the statement.
     """
-    from std_srvs.srv import SetBool
 
     # A failing line without a hint of its own gets its case's (grader.CaseFailed).
-    def ask(switch, data: bool, call: str):
-        response = SetBool.Response()
-        got = func(switch, SetBool.Request(data=data), response)
-        if switch.lock.locked():
+    def answered(seen: dict, call: str) -> dict:
+        """One request's answer (:func:`_switched`), unless it held the lock or returned no response."""
+        if seen["locked"]:
             raise CaseFailed(
                 f"{call} returned with switch.lock still held: the simulation thread would wait for it forever.",
                 "`with switch.lock:` lets the lock go however the block ends.",
             )
-        if not isinstance(got, SetBool.Response):
-            raise CaseFailed(f"{call} returned {got!r}, expected the response (a service callback returns it).")
-        return got
+        if not seen["response"]:
+            raise CaseFailed(
+                f"{call} returned {seen['returned']}, expected the response (a service callback returns it)."
+            )
+        return seen
 
-    def expect(call: str, switch, got, was: bool, data: bool) -> None:
+    def expect(call: str, seen: dict, was: bool, data: bool) -> None:
         wanted = _said(data, was)
-        if switch.enabled is not data:
-            raise CaseFailed(f"{call} left switch.enabled = {switch.enabled!r}, expected {data}.")
-        if not got.success:
+        if seen["enabled"] is not data:
+            raise CaseFailed(f"{call} left switch.enabled = {seen['enabled']!r}, expected {data}.")
+        if not seen["success"]:
             raise CaseFailed(f"{call} answered success=False, expected True: the switch did what was asked.")
-        if got.message != wanted:
-            raise CaseFailed(f"{call} answered {got.message!r}, expected {wanted!r}.")
-        if switch.unlocked_writes:
+        if seen["message"] != wanted:
+            raise CaseFailed(f"{call} answered {seen['message']!r}, expected {wanted!r}.")
+        if seen["unlocked_writes"]:
             raise CaseFailed(
                 f"{call} set switch.enabled outside `with switch.lock:`.",
                 "the simulation thread reads it: write it with the lock held.",
@@ -281,49 +281,27 @@ def check_switch_tracks(func) -> Result:
         call = f"switch_tracks(a switch {'on' if was else 'off'}, SetBool.Request(data={data}))"
 
         def run():
-            switch = _WatchedSwitch(was)
-            expect(call, switch, ask(switch, data, call), was, data)
+            (seen,) = observe(_switched, func, was, [(data, False)])
+            expect(call, answered(seen, call), was, data)
 
         return Case(call, run, hint)
 
     def round_trip() -> None:
-        import rclpy
-        from rclpy.executors import SingleThreadedExecutor
-
         call = "a SetBool client asking a service whose callback is switch_tracks to turn a switch off"
-        node = rclpy.create_node("exercise_check_switch")
-        executor = SingleThreadedExecutor()
-        try:
-            switch = _WatchedSwitch(True)
-            node.create_service(
-                SetBool, "exercise_check_switch/enable_tracks", lambda req, resp: func(switch, req, resp)
-            )
-            client = node.create_client(SetBool, "exercise_check_switch/enable_tracks")
-            executor.add_node(node)
-            future = client.call_async(SetBool.Request(data=False))
-            try:
-                executor.spin_until_future_complete(future, timeout_sec=ROUND_TRIP_TIMEOUT)
-            except TypeError as exc:  # rclpy could not send what the callback returned
-                raise CaseFailed(f"{call}: rclpy could not send the answer ({exc!r}).", "return the response.") from exc
-            if not future.done():
-                raise CaseFailed(f"{call}: no answer within {ROUND_TRIP_TIMEOUT:.0f} s.", "return the response.")
-            expect(call, switch, future.result(), True, False)
-        finally:
-            executor.shutdown()
-            node.destroy_node()
+        seen = observe(_switched_by_a_service, func)
+        if seen["refused"] is not None:  # rclpy could not send what the callback returned
+            raise CaseFailed(f"{call}: rclpy could not send the answer ({seen['refused']}).", "return the response.")
+        if not seen["done"]:
+            raise CaseFailed(f"{call}: no answer within {ROUND_TRIP_TIMEOUT:.0f} s.", "return the response.")
+        expect(call, seen, True, False)
 
     def sequence(rng, call: str, meddled: bool) -> Case:
         start, steps = _hidden_sequence(rng, meddled)
         hint = "each answer says what this request did to the switch as it was, whoever turned it last."
 
         def run():
-            switch = _WatchedSwitch(start)
-            for data, turned in steps:
-                if turned:
-                    with switch.lock:
-                        switch.enabled = not switch.enabled
-                was = switch.enabled
-                expect(call, switch, ask(switch, data, call), was, data)
+            for (data, _), seen in zip(steps, observe(_switched, func, start, steps)):
+                expect(call, answered(seen, call), seen["was"], data)
 
         return Case(call, run, hint, True)
 
@@ -350,3 +328,61 @@ def check_switch_tracks(func) -> Result:
             ),
         ],
     )
+
+
+def _answer(switch: _WatchedSwitch, got, was) -> dict:
+    """What a check reads of one answer of ``switch_tracks`` (:func:`_switched`): the switch before (``was``) and
+    after, whether the lock is still held, and the response (``returned``: its repr when it is none)."""
+    from std_srvs.srv import SetBool
+
+    seen = {"was": was, "locked": switch.lock.locked(), "enabled": switch.enabled}
+    seen["response"] = isinstance(got, SetBool.Response)
+    seen["returned"] = None if seen["response"] else repr(got)[:2000]
+    seen["success"], seen["message"] = (bool(got.success), got.message) if seen["response"] else (None, None)
+    seen["unlocked_writes"] = switch.unlocked_writes
+    return seen
+
+
+@experiment
+def _switched(func, start: bool, steps) -> list[dict]:
+    """``func`` asked each request of ``steps`` (``(data, turned)``: the switch turned over first, under its lock,
+    by this thread), on one switch from ``start``: each answer as :func:`_answer` reads it."""
+    from std_srvs.srv import SetBool
+
+    switch, seen = _WatchedSwitch(start), []
+    for data, turned in steps:
+        if turned:
+            with switch.lock:
+                switch.enabled = not switch.enabled
+        was = switch.enabled
+        seen.append(_answer(switch, func(switch, SetBool.Request(data=data), SetBool.Response()), was))
+    return seen
+
+
+@experiment
+def _switched_by_a_service(func) -> dict:
+    """A SetBool client asking a service whose callback is ``func`` to turn a switch off, on this thread's executor:
+    the answer as :func:`_answer` reads it, with ``done`` (it came within :data:`ROUND_TRIP_TIMEOUT`) and ``refused``
+    (rclpy's ``TypeError`` sending it, as text, or None)."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from std_srvs.srv import SetBool
+
+    node = rclpy.create_node("exercise_check_switch")
+    executor = SingleThreadedExecutor()
+    try:
+        switch = _WatchedSwitch(True)
+        node.create_service(SetBool, "exercise_check_switch/enable_tracks", lambda req, resp: func(switch, req, resp))
+        client = node.create_client(SetBool, "exercise_check_switch/enable_tracks")
+        executor.add_node(node)
+        future = client.call_async(SetBool.Request(data=False))
+        try:
+            executor.spin_until_future_complete(future, timeout_sec=ROUND_TRIP_TIMEOUT)
+        except TypeError as exc:  # rclpy could not send what the callback returned
+            return {"refused": repr(exc)[:2000], "done": False}
+        if not future.done():
+            return {"refused": None, "done": False}
+        return {"refused": None, "done": True, **_answer(switch, future.result(), True)}
+    finally:
+        executor.shutdown()
+        node.destroy_node()

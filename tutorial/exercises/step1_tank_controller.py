@@ -15,8 +15,10 @@ from tutorial.exercises.grader import (
     CaseFailed,
     Result,
     expect_numbers,
+    experiment,
     grade,
     hidden_random,
+    observe,
     same_numbers,
     same_value,
     show,
@@ -170,10 +172,7 @@ def check_shot_counter(cls) -> Result:
         call = label if hidden else f"{cls.__name__}().on_joy() with buttons {_runs(presses)} ({label})"
 
         def run():
-            controller = cls()
-            for buttons in presses:
-                controller.on_joy(_joy(buttons))
-            shots = controller.summary().get("shots")
+            shots = observe(_shots_counted, cls, presses)
             if not same_value(shots, expected):
                 # no hint of its own: the grader gives the case's (grader._failed)
                 raise CaseFailed(f"{call} gave summary()['shots'] == {shots!r}, expected {expected}.")
@@ -183,9 +182,7 @@ def check_shot_counter(cls) -> Result:
     stick = [0.0, 1.0] + [0.0] * (joy.NUM_AXES - 2)
 
     def still_drives():
-        controller = cls()
-        controller.on_joy(_joy(A, stick))
-        count_, axes, _ = controller.take_input()
+        count_, axes = observe(_input_after_one_joy, cls, A, stick)
         if not (same_numbers(axes, stick) and same_value(count_, 1)):
             raise CaseFailed(
                 f"after one on_joy(axes={show(stick)}), take_input() gave ({count_!r}, {show(list(axes))}, ...), "
@@ -194,9 +191,7 @@ def check_shot_counter(cls) -> Result:
             )
 
     def still_summarises():
-        controller = cls()
-        controller.on_joy(_joy(A))
-        got = controller.summary()
+        got = observe(_summary_after_one_joy, cls, A)
         if not (type(got) is dict and same_value(got.get("joy_received"), 1)):
             raise CaseFailed(
                 f"after one on_joy(), summary() gave {got!r}: RttTankController's own fields are gone.",
@@ -204,15 +199,8 @@ def check_shot_counter(cls) -> Result:
             )
 
     def under_the_lock():
-        controller = _watched(cls)()
-        base = next(c for c in cls.__mro__ if c.__name__ == "RttTankController")
-        own = set(vars(base()))  # RttTankController's own state: its on_joy keeps it under the lock
-        object.__setattr__(controller, "_lock", _WatchedLock(controller._lock))  # the learner's lock, watched
-        object.__setattr__(controller, "_watch", [])
-        for phase, run in (("on_joy", lambda: [controller.on_joy(_joy(b)) for b in (A, NONE, A)]), ("summary", None)):
-            object.__setattr__(controller, "_phase", phase)
-            (run or controller.summary)()
-        seen = [row for row in controller.__dict__["_watch"] if row[2] not in own]
+        own, watched = observe(_state_touched, cls, [A, NONE, A])
+        seen = [row for row in watched if row[2] not in own]
         # what both threads touch: read by summary() (the main thread), read or written by on_joy (the spin thread)
         shared = {n for p, w, n, _ in seen if p == "summary" and w == "read"} & {
             n for p, *_, n, _ in seen if p == "on_joy"
@@ -238,6 +226,48 @@ def check_shot_counter(cls) -> Result:
     cases.append(Case(f"{cls.__name__}: summary() after one Joy", still_summarises))
     cases.append(Case(f"{cls.__name__}: what on_joy() remembers, under self._lock", under_the_lock))
     return grade("Exercise 1.2, count the shots", cases)
+
+
+@experiment
+def _shots_counted(cls, presses) -> object:
+    """A new ``cls()`` given a Joy of each buttons list of ``presses``: its ``summary().get("shots")``."""
+    controller = cls()
+    for buttons in presses:
+        controller.on_joy(_joy(buttons))
+    return controller.summary().get("shots")
+
+
+@experiment
+def _input_after_one_joy(cls, buttons, axes) -> tuple:
+    """A new ``cls()`` given one Joy: the count and the axes its ``take_input()`` gives."""
+    controller = cls()
+    controller.on_joy(_joy(buttons, axes))
+    count_, got, _ = controller.take_input()
+    return count_, got
+
+
+@experiment
+def _summary_after_one_joy(cls, buttons) -> object:
+    """A new ``cls()`` given one Joy: its ``summary()``."""
+    controller = cls()
+    controller.on_joy(_joy(buttons))
+    return controller.summary()
+
+
+@experiment
+def _state_touched(cls, presses) -> tuple[list, list]:
+    """``(RttTankController's own attributes, what the answer touched)`` of a new ``cls()`` given a Joy of each
+    of ``presses``, then asked for its ``summary()``: each state attribute read or written, as
+    ``(phase, "read" or "write", name, whether its lock was held)`` (:func:`_watched`)."""
+    controller = _watched(cls)()
+    base = next(c for c in cls.__mro__ if c.__name__ == "RttTankController")
+    own = sorted(vars(base()))  # RttTankController's own state: its on_joy keeps it under the lock
+    object.__setattr__(controller, "_lock", _WatchedLock(controller._lock))  # the learner's lock, watched
+    object.__setattr__(controller, "_watch", [])
+    for phase, run in (("on_joy", lambda: [controller.on_joy(_joy(b)) for b in presses]), ("summary", None)):
+        object.__setattr__(controller, "_phase", phase)
+        (run or controller.summary)()
+    return own, [tuple(row) for row in controller.__dict__["_watch"]]
 
 
 SHORT = [1]  # a Joy with button A alone: pressed

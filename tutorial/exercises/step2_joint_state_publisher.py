@@ -28,15 +28,17 @@ import contextlib
 import logging
 import math
 
-from tutorial.exercises.capture import CapturingNode, scripted_drive
+from tutorial.exercises.capture import CapturingNode, RecordedNode, publishers_record, scripted_drive
 from tutorial.exercises.grader import (
     Case,
     CaseFailed,
     Result,
     expect_qos,
+    experiment,
     grade,
     hidden_random,
     not_done,
+    observe,
     show,
 )
 
@@ -66,12 +68,21 @@ class _Probe:
 
         self.controller = Probe()
 
+
+class _ProbeRecord:
+    """A :class:`_Probe`'s run as :func:`_drive_record` recorded it: the states at the steps that messages were
+    stamped at (``at``), and the root's quaternion at every step (``quats``)."""
+
+    def __init__(self, record: dict):
+        self.time_step, self.quats = float(record["time_step"]), list(record["quats"])
+        self.states = {int(k): v for k, v in dict(record["states"]).items()}
+
     def at(self, seconds: float):
         """``(qpos, root position, root quaternion w x y z, qvel, qfrc_actuator)`` at the step of ``seconds``.
 
         None when no step of the run is at ``seconds``.
         """
-        return self.controller.states.get(round(seconds / self.controller.io.time_step))
+        return self.states.get(round(seconds / self.time_step))
 
 
 # A drive that turns the tank on the spot, left, from 0.2 s: the pose's orientation then changes (the
@@ -80,15 +91,61 @@ TURN_SCRIPT = ((0.2, (0.0, 0.0, 0.0, 0.0)), (10.0, (0.8, 0.0, 0.0, 0.0)))
 
 
 def _drive(name: str, cls, parameters: dict, script=None, duration: float = DURATION, tumble=None):
-    """:func:`~tutorial.exercises.capture.scripted_drive` with the probe; ``(capturing node, probe, app)``.
+    """The learner's ``cls`` in a scripted drive (:func:`_drive_record`, where ``cls`` lives: :func:`observe`):
+    ``(its publishers, the probe's states, {joint: (qpos address, dof address)})``.
 
-    ``tumble``: a controller attached first (:func:`_tumbling`).
+    ``tumble``: the start of a controller attached first (:func:`_tumble`), or None.
+
+    Raises:
+        tutorial.app.app.ControllerError: the learner's controller refused to configure; its ``errors_logged``
+            is how many errors its logger (``config.log``) had logged.
+    """
+    from tutorial.app.app import ControllerError
+
+    record = observe(_drive_record, cls, name, parameters, script, duration, tumble)
+    if "refused" in record:
+        refused = ControllerError(str(record["refused"]))
+        refused.errors_logged = record["logged"]
+        raise refused
+    joints = {str(k): (int(q), int(d)) for k, (q, d) in dict(record["joints"]).items()}
+    return RecordedNode(record["publishers"]), _ProbeRecord(record), joints
+
+
+@experiment
+def _drive_record(cls, name: str, parameters: dict, script, duration: float, tumble) -> dict:
+    """:func:`~tutorial.exercises.capture.scripted_drive` with ``cls`` and the probe, as data: ``{"publishers"``
+    (:func:`~tutorial.exercises.capture.publishers_record`), ``"joints"`` (the tank's, ``{name: (qpos address,
+    dof address)}``), ``"time_step"`` (s), ``"states"`` (the probe's, ``{step: state}``, at each step a message
+    was stamped at), ``"quats"`` (the root's, w x y z, every step)``}``; or ``{"refused": why, "logged": n}``
+    when ``cls`` refused to configure (``n`` errors its ``config.log`` logged).
+
+    Raises:
+        tutorial.app.app.ControllerError: the class's stub raised ``NotImplementedError`` there.
     """
     import rclpy
 
+    from tutorial.app.app import ControllerError
+
     node, probe = CapturingNode(rclpy.create_node("exercise_check")), _Probe()
-    app = scripted_drive(name, cls, parameters, node, script, duration, probe.controller, first=tumble)
-    return node, probe, app
+    first = _tumbling(tumble) if tumble is not None else None
+    with _errors_logged(f"rtt.{name}") as logged:  # config.log, the controller's own logger
+        try:
+            app = scripted_drive(name, cls, parameters, node, script, duration, probe.controller, first=first)
+        except ControllerError as exc:
+            if not_done(exc):
+                raise
+            return {"refused": str(exc), "logged": len(logged)}
+    publishers, states = publishers_record(node), probe.controller.states
+    dt = probe.controller.io.time_step
+    stamped = {round(_stamp(m) / dt) for p in publishers for m in p["messages"] if hasattr(m, "header")}
+    body = app.bodies["Tank"]
+    return {
+        "publishers": publishers,
+        "joints": {n: (body.joint(n).info.qpos_adr, body.joint(n).info.dof_adr) for n in body.joint_names},
+        "time_step": dt,
+        "states": {step: states[step] for step in sorted(stamped) if step in states},
+        "quats": [state[2] for state in states.values()],
+    }
 
 
 def _stamp(msg) -> float:
@@ -122,11 +179,9 @@ def _tumble(rng) -> dict:
     }
 
 
-def _tumbling(rng):
-    """A controller that turns gravity off and puts the tank in the air at t = 0 (:func:`_tumble`'s start)."""
+def _tumbling(start: dict):
+    """A controller that turns gravity off and puts the tank in the air at t = 0 (``start``: :func:`_tumble`'s)."""
     from tutorial.core.controller import SimpleController
-
-    start = _tumble(rng)
 
     class Tumble(SimpleController):
         def initialize(self, io):
@@ -212,7 +267,7 @@ def check_selected_joints(cls) -> Result:
     from tutorial.interfaces.joint_state import joint_state_topic
 
     def published(joints: str, rate: float, script=None):
-        node, probe, app = _drive("Selected", cls, {"joints": joints, "rate": rate}, script)
+        node, probe, addresses = _drive("Selected", cls, {"joints": joints, "rate": rate}, script)
         pubs = node.published(joint_state_topic("Tank"))
         if len(pubs) != 1:
             raise CaseFailed(
@@ -221,14 +276,13 @@ def check_selected_joints(cls) -> Result:
                 "let RttJointStatePublisher.configure "
                 "create it: call super().configure(config) and check what it returns.",
             )
-        return pubs[0].messages(), probe, app
+        return pubs[0].messages(), probe, addresses
 
     def selects(joints: str, expected: list[str], rate: float = 50.0, hint: str = "", script=None, label=None):
         call = label or f"{cls.__name__} with joints={joints!r}, rate={rate}"
 
         def run():
-            messages, probe, app = published(joints, rate, script)
-            body = app.bodies["Tank"]
+            messages, probe, addresses = published(joints, rate, script)
             want = round(rate * DURATION)
             if len(messages) < want:
                 raise CaseFailed(
@@ -243,7 +297,7 @@ def check_selected_joints(cls) -> Result:
                 if state is None:
                     raise CaseFailed(f"{call}: a message stamped {_stamp(msg):.3f} s, not a step of the run.")
                 for name, q in zip(names, msg.position):
-                    true = float(state[0][body.joint(name).info.qpos_adr])
+                    true = float(state[0][addresses[name][0]])
                     if not abs(q - true) <= 1e-9:  # a NaN position fails
                         raise CaseFailed(
                             f"{call}: at t = {_stamp(msg):.3f} s {name} was published as "
@@ -262,7 +316,7 @@ def check_selected_joints(cls) -> Result:
                     ("effort", msg.effort, state[4], "N m"),
                 ):
                     for name, v in zip(names, values):
-                        true = float(source[body.joint(name).info.dof_adr])
+                        true = float(source[addresses[name][1]])
                         if not abs(v - true) <= 1e-9:
                             raise CaseFailed(
                                 f"{call}: at t = {_stamp(msg):.3f} s {name}'s {field} was published as "
@@ -281,15 +335,14 @@ def check_selected_joints(cls) -> Result:
         )
 
         def run():
-            with _errors_logged("rtt.Selected") as logged:  # config.log, the controller's own logger
-                try:
-                    published(joints, 50.0)
-                except ControllerError as exc:
-                    if not_done(exc):
-                        raise
-                    if label and not logged:  # a hidden case also holds the statement's config.log.error(...)
-                        raise CaseFailed(f"{call}: configure returned False without config.log.error(...).") from None
-                    return
+            try:
+                published(joints, 50.0)
+            except ControllerError as exc:
+                if not_done(exc):
+                    raise
+                if label and not exc.errors_logged:  # a hidden case also holds the statement's config.log.error(...)
+                    raise CaseFailed(f"{call}: configure returned False without config.log.error(...).") from None
+                return
             unknown = next((n for n in (n.strip() for n in joints.split(",")) if n and n not in TANK), joints)
             raise CaseFailed(f"{call} was accepted, but the tank has no joint {unknown!r}.")
 
@@ -453,7 +506,7 @@ def check_pose_publisher(cls) -> Result:
         """
         if kind not in runs:  # the learner's cases of this kind did not run it
             return
-        quats = [state[2] for state in runs[kind][2].controller.states.values()]
+        quats = runs[kind][2].quats
         if kind == "turn" and not _turned(quats) > 0.3:
             raise RuntimeError(f"the check's own drive did not turn the tank ({_turned(quats):.3f} rad)")
         if plans[kind][3] is not None:  # from the first step on: MuJoCo puts a state it cannot step back upright
@@ -491,7 +544,7 @@ def check_pose_publisher(cls) -> Result:
             ),
         )
         for kind, rates in HIDDEN_POSE_RATES.items():
-            plans[kind] = (rng.choice(rates), None, HIDDEN_DURATION, _tumbling(rng))
+            plans[kind] = (rng.choice(rates), None, HIDDEN_DURATION, _tumble(rng))
             who = f"the tank tilted and tumbling in the air, at a rate of its own, a {kind} number of hertz"
             for what, test, hint in rules:
                 yield Case(f"{who}: {what}", lambda test=test, kind=kind, who=who: test(kind, who), hint, hidden=True)

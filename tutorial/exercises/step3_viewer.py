@@ -11,7 +11,18 @@ from __future__ import annotations
 
 import math
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, same_numbers, same_value, show
+from tutorial.exercises.grader import (
+    Case,
+    CaseFailed,
+    Result,
+    experiment,
+    grade,
+    hidden_random,
+    observe,
+    same_numbers,
+    same_value,
+    show,
+)
 
 TANK = ["TURRET_Y", "TURRET_P"]
 
@@ -212,43 +223,25 @@ def check_wrong_model(cls) -> Result:
     it once as ``wrong_model`` and ``applied`` does not count it.  Any other
     message is handled as before (the matcher still rejects bad entries).
     """
-    import rclpy
-    from sensor_msgs.msg import JointState
-
-    from tutorial.core.controller import ControllerConfig
-
-    def message(names, positions):
-        msg = JointState()
-        msg.name, msg.position = list(names), [float(p) for p in positions]
-        return msg
 
     def run_messages(messages, kind=cls):
-        """Configure a fresh controller (``kind``) on a fresh tank, apply each message on this thread."""
-        body = _tank()
-        node = rclpy.create_node("exercise_check_wrong_model")
-        try:
-            controller = kind()
-            config = ControllerConfig(name="Strict", body=body, node=node)
-            if not controller.configure(config):
-                raise CaseFailed(
-                    f"{cls.__name__}.configure() returned False.",
-                    "keep RttJointStateSubscriber.configure: return super().configure(config).",
-                )
-            for msg in messages:
-                controller.update_joint_state(msg)
-            summary = controller.summary()
-            controller.unconfigure()
-        finally:
-            node.destroy_node()
-        return body, summary
+        """``(the tank's joint positions, rounded, summary())`` after a fresh controller (``kind``) on a fresh tank
+        applied each message (the learner's class: where it lives, :func:`observe`)."""
+        sent = [(list(m.name), list(m.position)) for m in messages]
+        got = observe(_applied, cls, sent) if kind is cls else _applied(kind, sent)
+        if got is None:
+            raise CaseFailed(
+                f"{cls.__name__}.configure() returned False.",
+                "keep RttJointStateSubscriber.configure: return super().configure(config).",
+            )
+        return got
 
     def expect(label, messages, applied, rejected, positions, hint, hidden=False):
         sent = "; ".join(f"{show(list(m.name))} {show(list(m.position))}" for m in messages)
         call = label if hidden else f"{cls.__name__}.update_joint_state() for {sent} ({label})"
 
         def run():
-            body, summary = run_messages(messages)
-            got = {k: round(v, 9) for k, v in body.joint_positions().items()}
+            got, summary = run_messages(messages)
             summary = summary if type(summary) is dict else {}
             # no hints of their own below: the grader gives the case's (grader._failed)
             if not (same_value(summary.get("applied"), applied) and _same_counts(summary.get("rejected"), rejected)):
@@ -275,9 +268,8 @@ def check_wrong_model(cls) -> Result:
             messages = [message(names, positions) for names, positions in run]
             ours = [m for m in messages if m.name and all(n in TANK for n in m.name)]
             refused = len(messages) - len(ours)
-            body, summary = run_messages(ours, RttJointStateSubscriber)
+            positions, summary = run_messages(ours, RttJointStateSubscriber)
             rejected = dict(summary["rejected"], **({"wrong_model": refused} if refused else {}))
-            positions = {k: round(v, 9) for k, v in body.joint_positions().items()}
             yield expect(
                 "a random run of the tank's, the crane's and mixed messages",
                 messages,
@@ -288,6 +280,7 @@ def check_wrong_model(cls) -> Result:
                 True,
             )
 
+    message = _message
     zero = {"TURRET_Y": 0.0, "TURRET_P": 0.0}
     rng = hidden_random("3.1")  # while grading: this learner's own runs of messages
     return grade(
@@ -370,3 +363,36 @@ def check_wrong_model(cls) -> Result:
             *(hidden_cases(rng) if rng else ()),
         ],
     )
+
+
+def _message(names, positions):
+    """A ``sensor_msgs/JointState`` naming ``names`` at ``positions`` (rad)."""
+    from sensor_msgs.msg import JointState
+
+    msg = JointState()
+    msg.name, msg.position = list(names), [float(p) for p in positions]
+    return msg
+
+
+@experiment
+def _applied(cls, sent) -> tuple[dict, object] | None:
+    """A fresh ``cls()`` configured on a fresh tank, given a JointState of each ``(names, positions)`` of ``sent``
+    on this thread: ``(the tank's joint positions rounded to 1e-9 rad, its summary())``; None when its
+    ``configure()`` returned False."""
+    import rclpy
+
+    from tutorial.core.controller import ControllerConfig
+
+    body = _tank()
+    node = rclpy.create_node("exercise_check_wrong_model")
+    try:
+        controller = cls()
+        if not controller.configure(ControllerConfig(name="Strict", body=body, node=node)):
+            return None
+        for names, positions in sent:
+            controller.update_joint_state(_message(names, positions))
+        summary = controller.summary()
+        controller.unconfigure()
+    finally:
+        node.destroy_node()
+    return {k: round(v, 9) for k, v in body.joint_positions().items()}, summary

@@ -34,8 +34,18 @@ import math
 
 import numpy as np
 
-from tutorial.exercises.capture import CapturingNode, scripted_drive
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, show
+from tutorial.exercises.capture import CapturingNode, RecordedNode, publishers_record, scripted_drive
+from tutorial.exercises.grader import (
+    Case,
+    CaseFailed,
+    Result,
+    expect_qos,
+    experiment,
+    grade,
+    hidden_random,
+    observe,
+    show,
+)
 
 DURATION = 3.0  # s of simulated time per checked run: the tank hits the wall at about 2.05 s
 TIME_STEP_NS = 1_000_000  # the tank world's 1 ms step
@@ -61,10 +71,6 @@ class _Probe:
 
         self.controller = ImuProbe()
 
-    @property
-    def readings(self) -> list:
-        return self.controller.readings
-
 
 class _NotingNode(CapturingNode):
     """A :class:`CapturingNode` that also notes, in ``order``, the topic of each message published, in turn."""
@@ -86,15 +92,27 @@ class _NotingNode(CapturingNode):
 
 
 def _drive(name: str, cls, parameters: dict, script: str = "wall", duration: float = DURATION):
-    """:func:`~tutorial.exercises.capture.scripted_drive` by the demo script ``script``, with the probe;
-    ``(capturing node, probe)``."""
+    """The learner's ``cls`` in a drive by the demo script ``script`` (:func:`_drive_record`, where ``cls`` lives:
+    :func:`observe`): ``(its publishers, with the topic of each message in turn as their ``order``, every step's
+    accelerometer reading)``."""
+    record = observe(_drive_record, cls, name, parameters, script, duration)
+    node = RecordedNode(record["publishers"])
+    node.order = [str(topic) for topic in record["order"]]
+    return node, list(record["readings"])
+
+
+@experiment
+def _drive_record(cls, name: str, parameters: dict, script: str, duration: float) -> dict:
+    """:func:`~tutorial.exercises.capture.scripted_drive` by the demo script ``script`` with ``cls`` and the probe,
+    as data: ``{"publishers"`` (:func:`~tutorial.exercises.capture.publishers_record`), ``"order"`` (the topic of
+    each message published, in turn), ``"readings"`` (every step's accelerometer reading, (3,) m/s^2)``}``."""
     import rclpy
 
     from tutorial.joystick.demo import SCRIPTS
 
     node, probe = _NotingNode(rclpy.create_node("exercise_check_imu")), _Probe()
     scripted_drive(name, cls, parameters, node, SCRIPTS[script], duration, probe.controller)
-    return node, probe
+    return {"publishers": publishers_record(node), "order": node.order, "readings": probe.controller.readings}
 
 
 def _stamp_ns(msg) -> int:
@@ -189,12 +207,12 @@ def check_peak_publisher(cls) -> Result:
     """
     from std_msgs.msg import Float64
 
-    runs: dict = {}  # rate -> (Imu messages, peaks, probe, publisher, node): one run serves several cases
+    runs: dict = {}  # rate -> (Imu messages, peaks, readings, publisher, node): one run serves several cases
 
     def run(rate: float):
         if rate not in runs:
             call = "it"  # each case names the controller, its rate and the drive
-            node, probe = _drive("PeakImuPublisher", cls, {"rate": rate})
+            node, readings = _drive("PeakImuPublisher", cls, {"rate": rate})
             imu = _imu_messages(node, call)
             peaks = _one_publisher(
                 node,
@@ -211,15 +229,14 @@ def check_peak_publisher(cls) -> Result:
                     "publish the peak in publish(), right after super().publish().",
                 )
             publisher = node.published("/Tank/peak_acceleration")[0]
-            runs[rate] = (imu, [p.data for p in peaks], probe, publisher, node)
+            runs[rate] = (imu, [p.data for p in peaks], readings, publisher, node)
         return runs[rate]
 
     def compare(label: str, rate: float, chosen, hint: str, hidden: bool = False):
         call = label if hidden else f"{cls.__name__} with rate={rate}, the wall script for {DURATION} s ({label})"
 
         def check():
-            imu, peaks, probe, *_ = run(rate)
-            readings = probe.readings
+            imu, peaks, readings, *_ = run(rate)
             for k, ((first, last), got) in enumerate(zip(_windows(imu), peaks)):
                 t = _stamp_ns(imu[k]) * 1e-9
                 if not chosen(t):
@@ -402,8 +419,7 @@ def check_collision_reporter(cls) -> Result:
         outcome({"threshold": _y_threshold(imu), "holdoff": holdoff}, cls.__name__)
 
     def defaults():
-        declared = getattr(cls, "PARAMETERS", {})
-        got = {name: declared.get(name, (None, None))[1] for name in ("threshold", "holdoff")}
+        got = observe(_defaults, cls)
         if got != {"threshold": 20.0, "holdoff": 0.5}:
             raise CaseFailed(
                 f"its defaults are {got}, expected threshold 20.0 and holdoff 0.5.",
@@ -467,6 +483,13 @@ def check_collision_reporter(cls) -> Result:
             *hidden,
         ],
     )
+
+
+@experiment
+def _defaults(cls) -> dict:
+    """The defaults ``cls.PARAMETERS`` declares for threshold and holdoff (None for one it lacks)."""
+    declared = getattr(cls, "PARAMETERS", {})
+    return {name: declared.get(name, (None, None))[1] for name in ("threshold", "holdoff")}
 
 
 def _hidden_collision_parameters(rng) -> tuple[dict, dict, float]:

@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, grade, hidden_random, show
+from tutorial.exercises.grader import Case, CaseFailed, Result, experiment, grade, hidden_random, observe, show
 
 GREEN = (0.2, 0.8, 0.2)
 ARROW = "Tank/horizontal_acceleration"
@@ -106,13 +106,17 @@ def _turn_left(app, controller, angle: float) -> None:
 
 
 def _place(app, controller, position=None, orientation=None) -> None:
-    """Put the viewer's tank's root at ``position`` (m), turned by the quaternion ``orientation`` (w, x, y, z)."""
-    root = controller.body.root_qpos_address  # the tank's free joint: its position (3,), then its orientation (4,)
+    """Put the viewer's tank's root at ``position`` (m), turned by the quaternion ``orientation`` (w, x, y, z).
+
+    The tank's body is the app's (``controller.body`` is the learner's attribute, which a class could replace).
+    """
+    body = app.bodies["Tank"]
+    root = body.root_qpos_address  # the tank's free joint: its position (3,), then its orientation (4,)
     if position is not None:
         app.data.qpos[root : root + 3] = position
     if orientation is not None:
         app.data.qpos[root + 3 : root + 7] = np.asarray(orientation) / np.linalg.norm(orientation)
-    controller.body.notify_kinematic_state_change()
+    body.notify_kinematic_state_change()
 
 
 def check_horizontal_arrow(cls) -> Result:
@@ -128,102 +132,86 @@ def check_horizontal_arrow(cls) -> Result:
     """
     name = cls.__name__
 
-    def arrow_of(app):
-        arrow = app.overlays.arrows.get(ARROW)
-        if arrow is None:
+    def arrow_of(seen: dict) -> dict:
+        if "arrow" not in seen:
             raise CaseFailed(
-                f"{name} made the arrows {sorted(app.overlays.arrows)}, expected also {ARROW!r}.",
+                f"{name} made the arrows {seen['arrows']}, expected also {ARROW!r}.",
                 "in configure, after super().configure(config): "
                 'config.overlays.arrow(f"{config.body_name}/horizontal_acceleration", '
                 "(0.2, 0.8, 0.2)).",
             )
-        return arrow
+        return seen["arrow"]
 
     def shows(label, accel, vector, visible, turn=0.0, hint=""):
         call = f"{name}.update_imu(acceleration {show(list(accel))} m/s^2) ({label})"
 
         def run():
-            with _viewer(cls, "HorizontalArrow") as (app, controller, _):
-                arrow = arrow_of(app)
-                if tuple(round(c, 6) for c in arrow.color) != GREEN:
-                    raise CaseFailed(
-                        f"{call}: the arrow's color is {arrow.color}, expected {GREEN}.", "green: (0.2, 0.8, 0.2)."
-                    )
-                if turn:
-                    _turn_left(app, controller, turn)
-                controller.update_imu(_imu(accel), controller.clock())
-                origin = app.data.site_xpos[controller.site]
-                if not np.allclose(arrow.origin, origin, atol=1e-9):
-                    raise CaseFailed(
-                        f"{call}: the arrow starts at {show(arrow.origin.tolist())}, the IMU "
-                        f"is at {show(origin.tolist())} m.",
-                        "start it at self.data.site_xpos[self.site].",
-                    )
-                if not np.allclose(arrow.vector, vector, atol=1e-9) or arrow.visible != visible:
-                    raise CaseFailed(
-                        f"{call}: the arrow is {show(arrow.vector.tolist())} m, visible="
-                        f"{arrow.visible}; expected {show(list(vector))} m, visible={visible}.",
-                        hint,
-                    )
-                red = controller.accel_arrow.vector
-                expected_red = 0.1 * (np.array(accel) + [0.0, 0.0, -9.8])
-                if not turn and not np.allclose(red, expected_red, atol=1e-9):
-                    raise CaseFailed(
-                        f"{call}: the red arrow became {show(red.tolist())} m, expected "
-                        f"{show(expected_red.tolist())} as before.",
-                        "keep the other two arrows: call super().draw_arrows().",
-                    )
+            seen = observe(_arrow_shown, cls, list(accel), turn)
+            arrow = arrow_of(seen)
+            if tuple(round(c, 6) for c in arrow["color"]) != GREEN:
+                raise CaseFailed(
+                    f"{call}: the arrow's color is {arrow['color']}, expected {GREEN}.", "green: (0.2, 0.8, 0.2)."
+                )
+            origin = seen["imu"]
+            if not np.allclose(arrow["origin"], origin, atol=1e-9):
+                raise CaseFailed(
+                    f"{call}: the arrow starts at {show(arrow['origin'].tolist())}, the IMU "
+                    f"is at {show(origin.tolist())} m.",
+                    "start it at self.data.site_xpos[self.site].",
+                )
+            if not np.allclose(arrow["vector"], vector, atol=1e-9) or arrow["visible"] != visible:
+                raise CaseFailed(
+                    f"{call}: the arrow is {show(arrow['vector'].tolist())} m, visible="
+                    f"{arrow['visible']}; expected {show(list(vector))} m, visible={visible}.",
+                    hint,
+                )
+            red = seen["red"]
+            expected_red = 0.1 * (np.array(accel) + [0.0, 0.0, -9.8])
+            if not turn and not np.allclose(red, expected_red, atol=1e-9):
+                raise CaseFailed(
+                    f"{call}: the red arrow became {show(red.tolist())} m, expected "
+                    f"{show(expected_red.tolist())} as before.",
+                    "keep the other two arrows: call super().draw_arrows().",
+                )
 
         return Case(call, run, hint)
 
     def keeps_after_rejection():
         call = f"{name}.update_imu() of (3, 4, 11.8) m/s^2, then of a NaN"
-        with _viewer(cls, "HorizontalArrow") as (app, controller, _):
-            arrow = arrow_of(app)
-            controller.update_imu(_imu((3.0, 4.0, 11.8)), controller.clock())
-            before = arrow.vector.copy(), arrow.visible
-            controller.update_imu(_imu((math.nan, 0.0, 9.8)), controller.clock())
-            if not np.array_equal(arrow.vector, before[0]) or arrow.visible != before[1]:
-                raise CaseFailed(
-                    f"{call}: the arrow changed to {show(arrow.vector.tolist())} m.",
-                    "a rejected message changes nothing: draw from self.accel, which only an accepted message sets.",
-                )
+        before, after = (arrow_of(seen) for seen in observe(_arrow_after_rejection, cls))
+        if not np.array_equal(after["vector"], before["vector"]) or after["visible"] != before["visible"]:
+            raise CaseFailed(
+                f"{call}: the arrow changed to {show(after['vector'].tolist())} m.",
+                "a rejected message changes nothing: draw from self.accel, which only an accepted message sets.",
+            )
 
     def follows_the_shake():
         call = f"{name}: a hit of (-30, 0, 9.8) m/s^2, then a shake tick 20 ms later"
-        with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
-            arrow = arrow_of(app)
-            home = app.data.site_xpos[controller.site].copy()
-            controller.update_imu(_imu((-30.0, 0.0, 9.8)), clock())
-            clock.now += 0.02
-            controller.shake_tick()
-            moved = app.data.site_xpos[controller.site]
-            if np.array_equal(moved, home):
-                raise CaseFailed(
-                    f"{call}: the view did not shake.", "keep the viewer's behaviour: call super().update_imu()."
-                )
-            if not np.allclose(arrow.origin, moved, atol=1e-12):
-                raise CaseFailed(
-                    f"{call}: the IMU moved to {show(moved.tolist())} m, but the green "
-                    f"arrow still starts at {show(arrow.origin.tolist())}.",
-                    "draw it in draw_arrows(), which the shake tick calls too, not in update_imu().",
-                )
+        home, seen = observe(_arrow_shaken, cls)
+        arrow, moved = arrow_of(seen), seen["imu"]
+        if np.array_equal(moved, home):
+            raise CaseFailed(
+                f"{call}: the view did not shake.", "keep the viewer's behaviour: call super().update_imu()."
+            )
+        if not np.allclose(arrow["origin"], moved, atol=1e-12):
+            raise CaseFailed(
+                f"{call}: the IMU moved to {show(moved.tolist())} m, but the green "
+                f"arrow still starts at {show(arrow['origin'].tolist())}.",
+                "draw it in draw_arrows(), which the shake tick calls too, not in update_imu().",
+            )
 
     def readings(poses, accels):
         """Each reading with the tank placed at its pose: the arrow, by the statement's rule."""
-        with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
-            arrow = arrow_of(app)
-            for (position, orientation), accel in zip(poses, accels):
-                _place(app, controller, position, orientation)
-                controller.update_imu(_imu(accel), clock())
-                horizontal = 0.1 * np.array([accel[0], accel[1], 0.0])
-                to_world = app.data.site_xmat[controller.site].reshape(3, 3)
-                if not (
-                    np.allclose(arrow.origin, app.data.site_xpos[controller.site], atol=1e-9)
-                    and np.allclose(arrow.vector, to_world @ horizontal, atol=1e-9)
-                    and arrow.visible == (np.linalg.norm(horizontal) >= 0.05)
-                ):
-                    raise CaseFailed(f"{name}: the arrow of a reading is wrong.")
+        for seen, accel in zip(observe(_arrows_placed, cls, poses, accels), accels):
+            arrow = arrow_of(seen)
+            horizontal = 0.1 * np.array([accel[0], accel[1], 0.0])
+            to_world = seen["imu_axes"].reshape(3, 3)
+            if not (
+                np.allclose(arrow["origin"], seen["imu"], atol=1e-9)
+                and np.allclose(arrow["vector"], to_world @ horizontal, atol=1e-9)
+                and arrow["visible"] == (np.linalg.norm(horizontal) >= 0.05)
+            ):
+                raise CaseFailed(f"{name}: the arrow of a reading is wrong.")
 
     hint_turn = (
         "the reading is in the IMU's axes: turn the vector into the world with "
@@ -289,6 +277,89 @@ def check_horizontal_arrow(cls) -> Result:
     )
 
 
+def _seen(app, controller) -> dict:
+    """What 5.1's check reads of a viewer: ``{"arrows"`` (the names drawn), ``"arrow"`` (the green one's
+    ``color``, ``origin`` m, ``vector`` m and ``visible``, if drawn), ``"imu"`` (the IMU site's position, m),
+    ``"imu_axes"`` (its orientation, 3 x 3, flat)``}``."""
+    from tutorial.interfaces.imu import find_imu
+
+    arrows, body = app.overlays.arrows, app.bodies["Tank"]
+    site = find_imu(body.model, body.body_ids)[2]  # the IMU's site, from the model (not the class's self.site)
+    seen = {
+        "arrows": sorted(arrows),
+        "imu": app.data.site_xpos[site].copy(),
+        "imu_axes": app.data.site_xmat[site].copy(),
+    }
+    arrow = arrows.get(ARROW)
+    if arrow is not None:
+        seen["arrow"] = {"color": arrow.color, "origin": arrow.origin.copy(), "vector": arrow.vector.copy()}
+        seen["arrow"]["visible"] = arrow.visible
+    return seen
+
+
+def _red(app):
+    """The viewer's red arrow (the acceleration's), as the app's overlays hold it (not the class's attribute).
+
+    Raises:
+        KeyError: the viewer drew none.
+    """
+    return app.overlays.arrows["Tank/acceleration"]
+
+
+@experiment
+def _arrow_shown(cls, accel, turn: float) -> dict:
+    """A viewer of ``cls``, its tank yawed ``turn`` rad, given one reading ``accel`` (m/s^2): :func:`_seen`, and
+    the red arrow's vector (``"red"``, m)."""
+    with _viewer(cls, "HorizontalArrow") as (app, controller, _):
+        if ARROW not in app.overlays.arrows:
+            return _seen(app, controller)
+        if turn:
+            _turn_left(app, controller, turn)
+        controller.update_imu(_imu(accel), controller.clock())
+        return {**_seen(app, controller), "red": _red(app).vector.copy()}
+
+
+@experiment
+def _arrow_after_rejection(cls) -> tuple[dict, dict]:
+    """A viewer of ``cls`` given (3, 4, 11.8) m/s^2, then a NaN: :func:`_seen` after each."""
+    with _viewer(cls, "HorizontalArrow") as (app, controller, _):
+        if ARROW not in app.overlays.arrows:
+            return _seen(app, controller), _seen(app, controller)
+        controller.update_imu(_imu((3.0, 4.0, 11.8)), controller.clock())
+        before = _seen(app, controller)
+        controller.update_imu(_imu((math.nan, 0.0, 9.8)), controller.clock())
+        return before, _seen(app, controller)
+
+
+@experiment
+def _arrow_shaken(cls) -> tuple:
+    """A viewer of ``cls`` hit by (-30, 0, 9.8) m/s^2, then shaken 20 ms later: ``(the IMU's position before, m,
+    :func:`_seen` after)``."""
+    with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
+        home = _seen(app, controller)["imu"]
+        if ARROW not in app.overlays.arrows:
+            return home, _seen(app, controller)
+        controller.update_imu(_imu((-30.0, 0.0, 9.8)), clock())
+        clock.now += 0.02
+        controller.shake_tick()
+        return home, _seen(app, controller)
+
+
+@experiment
+def _arrows_placed(cls, poses, accels) -> list[dict]:
+    """A viewer of ``cls``, its tank placed at each pose of ``poses`` (:func:`_place`) and given the reading of
+    ``accels`` there: :func:`_seen` after each."""
+    seen = []
+    with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
+        for (position, orientation), accel in zip(poses, accels):
+            if ARROW not in app.overlays.arrows:
+                return [*seen, _seen(app, controller)]
+            _place(app, controller, position, orientation)
+            controller.update_imu(_imu(accel), clock())
+            seen.append(_seen(app, controller))
+    return seen
+
+
 def _hidden_poses(rng) -> list[tuple[list[float], list[float]]]:
     """Four random poses of the tank ``(position m, quaternion w, x, y, z)``: anywhere within 2 m of the origin
     on each axis, turned and tilted any way (four normal components; :func:`_place` normalizes them)."""
@@ -329,40 +400,28 @@ def check_in_order(cls) -> Result:
         call = f"{name}.update_imu() of messages stamped {sent} s ({label})"
 
         def run():
-            with _viewer(cls, "InOrder") as (_, controller, _clock):
-                for k, t in enumerate(stamps):
-                    if k in nan:
-                        accel = (math.nan, 0.0, 9.8)
-                    elif k in hits:
-                        accel = (-30.0, 0.0, 9.8)
-                    else:
-                        accel = (k + 1.0, 0.0, 9.8)  # message k shows a red arrow of 0.1 (k + 1) m
-                    controller.update_imu(_imu(accel, stamp=t), controller.clock())
-                summary = controller.summary()
-                got = (summary["accepted"], summary["rejected"])
-                if got != (accepted, rejected):
-                    raise CaseFailed(
-                        f"{call} gave accepted={got[0]}, rejected={got[1]}; expected "
-                        f"accepted={accepted}, rejected={rejected}.",
-                        hint,
-                    )
-                if shown is not None:
-                    x = controller.accel_arrow.vector[0]
-                    if not abs(x - 0.1 * (shown + 1)) <= 1e-9:  # a NaN arrow fails
-                        which = round(x / 0.1) - 1  # message k's arrow is 0.1 (k + 1) m long in x
-                        shows = (
-                            f"the message stamped {stamps[which]:.2f} s"
-                            if abs(x - 0.1 * (which + 1)) < 1e-9 and 0 <= which < len(stamps)
-                            else f"none of them (x = {x:.3f} m)"
-                        )
-                        raise CaseFailed(
-                            f"{call}: the arrow shows {shows}, expected the one stamped {stamps[shown]:.2f} s.",
-                            hint,
-                        )
-                if shakes is not None and summary["shakes"] != shakes:
-                    got = summary["shakes"]
-                    times = "once" if got == 1 else f"{got} times"
-                    raise CaseFailed(f"{call} shook the view {times}, expected {shakes}.", hint)
+            summary, x = observe(_sequence_shown, cls, list(stamps), list(nan), list(hits), shown is not None)
+            got = (summary["accepted"], summary["rejected"])
+            if got != (accepted, rejected):
+                raise CaseFailed(
+                    f"{call} gave accepted={got[0]}, rejected={got[1]}; expected "
+                    f"accepted={accepted}, rejected={rejected}.",
+                    hint,
+                )
+            if shown is not None and not abs(x - 0.1 * (shown + 1)) <= 1e-9:  # a NaN arrow fails
+                which = round(x / 0.1) - 1  # message k's arrow is 0.1 (k + 1) m long in x
+                shows = (
+                    f"the message stamped {stamps[which]:.2f} s"
+                    if abs(x - 0.1 * (which + 1)) < 1e-9 and 0 <= which < len(stamps)
+                    else f"none of them (x = {x:.3f} m)"
+                )
+                raise CaseFailed(
+                    f"{call}: the arrow shows {shows}, expected the one stamped {stamps[shown]:.2f} s.", hint
+                )
+            if shakes is not None and summary["shakes"] != shakes:
+                got = summary["shakes"]
+                times = "once" if got == 1 else f"{got} times"
+                raise CaseFailed(f"{call} shook the view {times}, expected {shakes}.", hint)
 
         return Case(call, run, hint)
 
@@ -371,20 +430,17 @@ def check_in_order(cls) -> Result:
 
         def run():
             newest, accel_x, hits, counts = None, None, 0, {}
-            with _viewer(cls, "InOrder") as (_, controller, clock):
-                for k, (stamp, kind) in enumerate(messages):
-                    accel = {"nan": math.nan, "hit": -30.0 - k}.get(kind, 1.0 + k)
-                    got = controller.update_imu(_imu((accel, 0.0, 9.8), stamp_ns=stamp), clock())
-                    reason, newest = _judge(newest, stamp, kind)
-                    if reason is None:
-                        accel_x, hits = 0.1 * accel, hits + (kind == "hit")
-                    else:
-                        counts[reason] = counts.get(reason, 0) + 1
-                    if not (got is None if reason is None else type(got) is str and got == reason):
-                        raise CaseFailed(f"{name}.update_imu() returned {got!r}, expected {reason!r}.")
-                    if accel_x is not None and not abs(controller.accel_arrow.vector[0] - accel_x) <= 1e-9:
-                        raise CaseFailed(f"{name}: the arrow does not show the newest message shown.")
-                summary = controller.summary()
+            returned, summary = observe(_messages_shown, cls, messages)
+            for k, ((stamp, kind), (got, arrow_x)) in enumerate(zip(messages, returned)):
+                reason, newest = _judge(newest, stamp, kind)
+                if reason is None:
+                    accel_x, hits = 0.1 * _message_accel(k, kind), hits + (kind == "hit")
+                else:
+                    counts[reason] = counts.get(reason, 0) + 1
+                if not (got is None if reason is None else type(got) is str and got == reason):
+                    raise CaseFailed(f"{name}.update_imu() returned {got!r}, expected {reason!r}.")
+                if accel_x is not None and not (arrow_x is not None and abs(arrow_x - accel_x) <= 1e-9):
+                    raise CaseFailed(f"{name}: the arrow does not show the newest message shown.")
             want = (len(messages) - sum(counts.values()), dict(sorted(counts.items())), hits)
             if (summary["accepted"], summary["rejected"], summary["hits"]) != want:
                 raise CaseFailed(f"{name}: the summary {summary} counts otherwise.")
@@ -470,6 +526,46 @@ def check_in_order(cls) -> Result:
             *hidden,
         ],
     )
+
+
+def _sequence_accel(k: int, nan, hits) -> tuple[float, float, float]:
+    """Message ``k``'s acceleration (m/s^2) in a visible run of 5.2: a NaN, a hit, or (k + 1, 0, 9.8), which
+    shows a red arrow of 0.1 (k + 1) m in x."""
+    if k in nan:
+        return (math.nan, 0.0, 9.8)
+    return (-30.0, 0.0, 9.8) if k in hits else (k + 1.0, 0.0, 9.8)
+
+
+@experiment
+def _sequence_shown(cls, stamps, nan, hits, arrow: bool) -> tuple:
+    """A viewer of ``cls`` given a message stamped each of ``stamps`` (s; :func:`_sequence_accel`):
+    ``(its summary(), the red arrow's x in m if ``arrow`` else None)``."""
+    with _viewer(cls, "InOrder") as (app, controller, _clock):
+        for k, t in enumerate(stamps):
+            controller.update_imu(_imu(_sequence_accel(k, nan, hits), stamp=t), controller.clock())
+        summary = controller.summary()
+        return summary, (_red(app).vector[0] if arrow else None)
+
+
+def _message_accel(k: int, kind: str) -> float:
+    """Message ``k``'s acceleration in x (m/s^2) in a hidden run of 5.2: a NaN, a hit of its own, or k + 1."""
+    return {"nan": math.nan, "hit": -30.0 - k}.get(kind, 1.0 + k)
+
+
+@experiment
+def _messages_shown(cls, messages) -> tuple[list, object]:
+    """A viewer of ``cls`` given each of ``messages`` (``(stamp ns, kind)``; :func:`_message_accel`):
+    ``([(what update_imu returned, the red arrow's x in m or None if unread), ...], its summary())``."""
+    returned = []
+    with _viewer(cls, "InOrder") as (app, controller, clock):
+        for k, (stamp, kind) in enumerate(messages):
+            got = controller.update_imu(_imu((_message_accel(k, kind), 0.0, 9.8), stamp_ns=stamp), clock())
+            try:
+                x = float(_red(app).vector[0])
+            except Exception:  # noqa: BLE001 - no arrow to read: the check says the arrow is wrong
+                x = None
+            returned.append((got, x))
+        return returned, controller.summary()
 
 
 def _judge(newest: int | None, stamp: int, kind: str) -> tuple[str | None, int | None]:

@@ -17,12 +17,24 @@ random poses.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
-from tutorial.exercises.camera_rig import KINECT, Camera, drive, references
-from tutorial.exercises.grader import Case, CaseFailed, Result, expect_qos, grade, hidden_random, show
+from tutorial.exercises.camera_rig import KINECT, Camera, drive, image_publisher, references
+from tutorial.exercises.capture import RecordedNode, publishers_record
+from tutorial.exercises.grader import (
+    Case,
+    CaseFailed,
+    Result,
+    expect_qos,
+    experiment,
+    grade,
+    hidden_random,
+    observe,
+    show,
+)
 
 LUMA = (0.299, 0.587, 0.114)  # ITU-R BT.601 weights of R, G, B
 OFF_BY_ONE = 0.01  # share of a gray picture's pixels that may be off by one (rounding at .5 done otherwise)
@@ -129,11 +141,11 @@ def check_gray_camera(cls) -> Result:
 
     def shots(camera: Camera, poses):
         if camera not in runs:
-            rig = drive(cls, camera, poses)
+            rig = _Drove(cls.__name__, camera, observe(_drove, cls, dataclasses.asdict(camera), poses, True))
             pub = rig.images()
             if pub.msg_type is not Image:
                 raise CaseFailed(f"{rig.name} publishes {pub.msg_type.__name__} on {pub.topic}, expected an Image.")
-            runs[camera] = [(m, t, c) for m, (t, _), c in zip(pub.messages(), rig.poses, references(rig))]
+            runs[camera] = [(m, t, c) for m, t, c in zip(pub.messages(), rig.times, rig.references)]
         return runs[camera]
 
     def picture(k: int, label: str) -> Case:
@@ -168,6 +180,35 @@ def check_gray_camera(cls) -> Result:
         ]:
             cases.append(hidden_case(camera, poses, rule, call, hint))
     return grade("Exercise 6.1, a gray camera", cases)
+
+
+@experiment
+def _drove(cls, camera: dict, poses, pictures: bool) -> dict:
+    """:func:`~tutorial.exercises.camera_rig.drive` of ``cls`` with ``camera`` (its fields) at ``poses``, as data:
+    ``{"publishers"`` (:func:`~tutorial.exercises.capture.publishers_record`), ``"destroyed"`` (their indices, in
+    the order they were destroyed), ``"times"`` (s, of each picture due), ``"references"`` (each picture's own
+    rendering, (H, W, 3) uint8, if ``pictures``)``}``."""
+    rig = drive(cls, Camera(**camera), poses)
+    return {
+        "publishers": publishers_record(rig.node),
+        "destroyed": [rig.node.publishers.index(p) for p in rig.node.destroyed],
+        "times": [t for t, _ in rig.poses],
+        "references": references(rig) if pictures else [],
+    }
+
+
+class _Drove:
+    """A drive of the learner's camera controller as :func:`_drove` recorded it: what a check reads of a rig."""
+
+    def __init__(self, name: str, camera: Camera, record: dict):
+        self.name, self.camera = name, camera
+        self.node = RecordedNode(record["publishers"])
+        self.destroyed = [self.node.publishers[int(k)] for k in record["destroyed"]]  # as the rig's node has them
+        self.times, self.references = list(record["times"]), list(record["references"])
+
+    def images(self):
+        """The publisher of the camera's Image topic (the first one made); CaseFailed when there is none."""
+        return image_publisher(self.node, self.camera, self.name)
 
 
 def expected_camera_info(width: int, height: int, fovy_deg: float) -> dict:
@@ -205,7 +246,7 @@ def check_camera_info(cls) -> Result:
 
     def published(camera: Camera):
         if camera not in runs:
-            rig = drive(cls, camera, POSES)
+            rig = _Drove(name, camera, observe(_drove, cls, dataclasses.asdict(camera), POSES, False))
             pubs = rig.node.published(camera.topic("camera_info"))
             if len(pubs) != 1:
                 raise CaseFailed(
@@ -214,7 +255,7 @@ def check_camera_info(cls) -> Result:
                     'name it after the body: f"/{config.body_name}/camera/camera_info".',
                 )
             image = rig.images()  # destroyed by super().unconfigure(), after the render thread has ended
-            first = next((p for p in rig.node.destroyed if p is image or p is pubs[0]), None)
+            first = next((p for p in rig.destroyed if p is image or p is pubs[0]), None)
             runs[camera] = (image.messages(), pubs[0], pubs[0].messages(), first is image)
         return runs[camera]
 
@@ -224,7 +265,7 @@ def check_camera_info(cls) -> Result:
             raise CaseFailed(f"{call}: it publishes {pub.msg_type.__name__} on {pub.topic}, expected a CameraInfo.")
         expect_qos(
             f"{call}: the CameraInfo",
-            pub.real.qos_profile,
+            pub.qos_profile,
             camera_image_qos(),
             "a subscriber takes the Image and its CameraInfo together: use camera_image_qos().",
         )

@@ -8,7 +8,7 @@ module              job
 ``seal``            the grading kernel's verdicts, signed only when the teacher's own
                     check made them
 ``sealed_kernel``   the kernel the sandbox starts, sealed before any cell runs
-``judge``           the checks of data-only exercises, in a process of their own
+``judge``           every exercise's check, in a process of its own
 ``judged``          the kernel's side: each judged check asks the judge
 ``wire``            what crosses between them: data, built back only from listed types
 ``keyrings``        the kernel keyrings refused to the kernel and all it starts

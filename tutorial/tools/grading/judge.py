@@ -2,8 +2,7 @@
 
 An answer and a check in one process are no wall: the answer can reach the
 check's memory (:mod:`tutorial.tools.grading.seal` says how).  So, while
-grading, the checks of :data:`JUDGED` (the exercises whose answer is a
-function of data) run here, in the judge, which
+grading, the checks of :data:`JUDGED` (every exercise's) run here, in the judge, which
 :class:`tutorial.tools.grading.sandbox.SandboxedKernelManager` starts beside
 each graded kernel, outside its sandbox.  The judge imports the teacher's
 checks (those of the assignment's check ``MODULES``, comma-separated) before the kernel runs any cell, keeps the
@@ -17,7 +16,11 @@ and shares with the kernel only a socket (``FD``), over which data crosses
 2. the judge runs the teacher's check with a stand-in for the answer
    (:class:`Answer`): each call of it sends the arguments, ``{"call": [...]}``,
    and the kernel runs the learner's function on them and sends back what it
-   returned or raised;
+   returned or raised; a class's check observes it instead
+   (:func:`tutorial.exercises.grader.observe`): ``{"observe": experiment,
+   "args": [...]}``, and the kernel runs that experiment (a function of the
+   checks' module) on the learner's class and sends back what it saw, as
+   data, or what it raised;
 3. the judge writes the verdict to ``VERDICTS`` (which the grader alone reads:
    ``course/sandboxing.py``) and sends the kernel the check's line to show.
 
@@ -44,17 +47,22 @@ import socket
 import sys
 import threading
 
+from tutorial.exercises.grader import CaseFailed, Result
 from tutorial.tools.grading import wire
 
-# The checks the judge runs, by module: those whose answer is a function of data, with no class and no state a
-# check must watch from inside.  The other exercises' checks run in the kernel, sealed.
+# The checks the judge runs, by module: every exercise's.  A function's check calls it across the socket; a
+# class's check has the kernel run its experiments on the class (tutorial.exercises.grader.observe).
 JUDGED = {
-    "tutorial.exercises.step1_tank_controller": ("check_dpad_steering",),
-    "tutorial.exercises.step3_viewer": ("check_own_matcher",),
+    "tutorial.exercises.step1_tank_controller": ("check_dpad_steering", "check_shot_counter"),
+    "tutorial.exercises.step2_joint_state_publisher": ("check_selected_joints", "check_pose_publisher"),
+    "tutorial.exercises.step3_viewer": ("check_own_matcher", "check_wrong_model"),
+    "tutorial.exercises.step4_imu_publisher": ("check_peak_publisher", "check_collision_reporter"),
+    "tutorial.exercises.step5_imu_viewer": ("check_horizontal_arrow", "check_in_order"),
+    "tutorial.exercises.step6_camera": ("check_gray_camera", "check_camera_info"),
     "tutorial.exercises.record_and_replay": ("check_release_times", "check_peak_speed"),
     "tutorial.exercises.across_machines": ("check_lossy_link_qos", "check_camera_settings"),
     "tutorial.exercises.stock_ros2_tools": ("check_lookup",),
-    "tutorial.exercises.parameters_and_services": ("check_judge_rate",),
+    "tutorial.exercises.parameters_and_services": ("check_judge_rate", "check_switch_tracks"),
     "tutorial.exercises.managed_nodes_and_actions": ("check_after",),
 }
 JUDGED_NAMES = frozenset(n for names in JUDGED.values() for n in names)
@@ -83,7 +91,17 @@ class Answer:
         self.__name__ = self.__qualname__ = name
 
     def __call__(self, *args):
-        reply = self._channel.ask({"id": self._run, "call": [wire.encode(a) for a in args]})
+        return self._reply(self._channel.ask({"id": self._run, "call": [wire.encode(a) for a in args]}))
+
+    def observe(self, experiment, *args):
+        """What ``experiment(the learner's class, *args)`` gave in the kernel (a check's
+        :func:`~tutorial.exercises.grader.observe`, while the judge runs it), or what it raised, as a call's."""
+        name = f"{experiment.__module__}:{experiment.__qualname__}"
+        return self._reply(
+            self._channel.ask({"id": self._run, "observe": name, "args": [wire.encode(a) for a in args]})
+        )
+
+    def _reply(self, reply: dict):
         if "check" in reply:  # the kernel went on to another check (this one's cell was interrupted)
             self._channel.push_back(reply)
             raise Interrupted
@@ -115,6 +133,9 @@ def _exception(said) -> Exception:
     args = tuple(a if type(a) in (str, int, float, bool) or a is None else repr(a)[: wire.MAX_TEXT] for a in args)
     if said.get("not_done") is True:
         return NotImplementedError(*args)
+    failed = said.get("case_failed")
+    if type(failed) is list and len(failed) == 2:  # the experiment's run failed: the case fails, as it said
+        return CaseFailed(*(str(text)[: wire.MAX_CASE_TEXT] for text in failed))
     builtin = getattr(builtins, name, None)
     if said.get("builtin") is True and isinstance(builtin, type) and issubclass(builtin, Exception):
         try:
@@ -139,6 +160,7 @@ class Channel:
         self.notes: list[str] = []  # what the kernel did wrong during it (tampering): the first MAX_NOTES
         self.noted = 0  # notes in all, written or not
         self.more = 0  # notes of the check now running past its first MAX_NOTES, only counted
+        self.answer: Answer | None = None  # the stand-in of the check now running, whose experiments it observes
 
     def send(self, message: dict) -> None:
         self._sock.sendall(wire.dumps(message))
@@ -155,6 +177,8 @@ class Channel:
         if not line:
             return None
         if not line.endswith(b"\n"):
+            while line and not line.endswith(b"\n"):  # the rest of it read and dropped: the next line is a message
+                line = self._reader.readline(wire.MAX_LINE + 1)
             raise wire.WireError(f"a message of more than {wire.MAX_LINE} bytes")
         return wire.loads(line)
 
@@ -240,13 +264,16 @@ def serve(channel: Channel, found: dict) -> None:
             continue
         done.add(name)
         channel.number, channel.notes, channel.more = None, [], 0
-        answer = Answer(channel, _answer_name(request.get("answer")), run)
+        answer = channel.answer = Answer(channel, _answer_name(request.get("answer")), run)
         try:
             result = found[name](answer)
         except Interrupted:
             continue  # no verdict: the exercise gets 0 (the cell's timeout is flagged from the notebook)
         except ConnectionError:
             return
+        except Exception as exc:  # noqa: BLE001 - the check's own error outside its cases: it fails, the rest run
+            said = f"the check could not judge this answer ({type(exc).__name__}: {exc})."
+            result = Result(name, False, said)
         why = "; ".join(channel.notes) + (f" (and {channel.more} more)" if channel.more else "")
         channel.write("verdict", channel.number, int(result.passed), int(not channel.notes), why)
         try:
@@ -290,6 +317,8 @@ def main(argv: list[str] | None = None) -> int:
         written down (a check that never ends, its cell stopped, leaves its begin without a verdict)."""
         if event == "rtt.seed" and seed and type(args[0]) is list:
             args[0].append(seed)
+        elif event == "rtt.observe" and channel.answer is not None and type(args[0]) is list:
+            args[0].append(channel.answer.observe)  # a class's experiment: run where the class is, the kernel
         elif event == "rtt.check_begin":
             found = NUMBER.match(str(args[0]))
             channel.number = found.group(1) if found else "?"

@@ -4,25 +4,31 @@
 cell runs, when the grader gave the kernel a socket to the judge
 (``RTT_JUDGE_FD``).  The check functions of those modules are then stand-ins:
 ``check_dpad_steering(dpad_track_velocities)`` asks the judge to run the
-teacher's check, runs the answer on each input the judge sends and sends back
-what it returned or raised (:mod:`tutorial.tools.grading.wire`), and gives the
+teacher's check, runs the answer on each input the judge sends (or, for a
+class, each experiment the judge names, on the class) and sends back what it
+returned or raised (:mod:`tutorial.tools.grading.wire`), and gives the
 check's line as a :class:`JudgedResult`.  Nothing here decides a grade: the
 judge writes the verdict, so an answer that replaces this code only loses its
-own points.  The kernel's main thread (a cell's).
+own points.  Each run begins and ends with an ``rtt.judged`` audit event, at
+which the kernel's seal compares the checks' modules and experiments with its
+snapshot (an experiment replaced could report what a right class would).
+The kernel's main thread (a cell's).
 """
 
 from __future__ import annotations
 
+import functools
 import importlib
 import os
 import shutil
 import socket
+import sys
 import tempfile
 import threading
 
-from tutorial.exercises.grader import Result, not_done
+from tutorial.exercises.grader import EXPERIMENTS, CaseFailed, Result, not_done
 from tutorial.tools.grading import wire
-from tutorial.tools.grading.judge import GONE, JUDGED
+from tutorial.tools.grading.judge import JUDGED
 
 ENV = "RTT_JUDGE_FD"
 
@@ -64,21 +70,26 @@ class Judge:
         with self._lock:
             self._runs += 1
             run = self._runs
+            sys.audit("rtt.judged", "begin", name)  # the seal compares the teacher's code with its snapshot
             try:
                 self._send({"check": name, "id": run, "answer": getattr(answer, "__name__", "answer")})
                 while True:
                     line = self._reader.readline(wire.MAX_LINE + 1)
                     if not line:
-                        raise ConnectionError(GONE)
+                        raise ConnectionError("the judge is gone")
                     message = wire.loads(line)
                     if message.get("id") != run:
                         continue  # the judge's for a check interrupted before
                     if "result" in message:
+                        sys.audit("rtt.judged", "end", name)  # and again now that its experiments have run
                         got = dict(message["result"])
                         passed, case = got.get("passed") is True, got.get("case")
                         exercise, said = str(got.get("exercise")), str(got.get("message"))
                         return JudgedResult(exercise, passed, said, case if type(case) is str else None)
-                    self._send({"id": run, **_called(answer, message.get("call"))})
+                    if "observe" in message:  # a class's check: one of its experiments, on the class
+                        self._send({"id": run, **_called(_experiment(answer, message["observe"]), message.get("args"))})
+                    else:
+                        self._send({"id": run, **_called(answer, message.get("call"))})
             except (OSError, wire.WireError) as exc:  # the judge gone or broken: no verdict, so 0 points
                 return JudgedResult(name, False, f"the grader's judge could not run this check ({exc}).")
             except BaseException:
@@ -96,6 +107,8 @@ def _called(answer, call) -> dict:
         value = answer(*wire.decode(call, folder=folder))
     except Exception as exc:  # noqa: BLE001 - the answer's bug, said to the judge with its class's name
         said = {"type": type(exc).__name__, "builtin": type(exc).__module__ == "builtins", "not_done": not_done(exc)}
+        if isinstance(exc, CaseFailed):  # an experiment's own failure (the run failed): it fails the case, as said
+            said["case_failed"] = [str(exc.what)[: wire.MAX_CASE_TEXT], str(exc.hint)[: wire.MAX_CASE_TEXT]]
         try:
             said["args"] = wire.encode(list(exc.args))
         except wire.WireError:
@@ -107,6 +120,24 @@ def _called(answer, call) -> dict:
         return {"return": wire.encode(value)}
     except wire.WireError as exc:
         return {"return": {"opaque": [type(value).__name__, f"<a value the grader cannot read: {exc}>", False]}}
+
+
+def _experiment(cls, name):
+    """Experiment ``name`` ("module:function", marked :func:`~tutorial.exercises.grader.experiment`) on ``cls``.
+
+    Raises (when called): ``LookupError`` for a name that is no experiment.
+    """
+    found = EXPERIMENTS.get(name) if type(name) is str else None
+    if found is None:
+        return _no_experiment(name)
+    return functools.partial(found, cls)
+
+
+def _no_experiment(name):
+    def refused(*args):
+        raise LookupError(f"no such experiment of the checks: {str(name)[:80]}")
+
+    return refused
 
 
 def install(fd: int, modules: list[str] | None = None) -> None:
@@ -128,4 +159,5 @@ def _asking(judge: Judge, name: str, teachers):
 
     check.__name__ = check.__qualname__ = name
     check.__doc__ = teachers.__doc__
+    check.__wrapped__ = teachers  # the seal reads what the teacher's check uses from it, when it is installed
     return check

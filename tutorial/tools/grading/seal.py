@@ -47,9 +47,16 @@ comes from the seal's signed verdicts, not from the cell's output:
   a key only the grader and the hook hold (HMAC-SHA256), on a pipe of the
   grader's; :mod:`tutorial.tools.grading.sandbox` reads and checks it.
 
-What the seal does not stop (one process is no wall; the checks of
-:data:`tutorial.tools.grading.judge.JUDGED` run in a process of their own,
-the judge, exchanging only data with the answer's; the others run here):
+While grading, the checks of :data:`tutorial.tools.grading.judge.JUDGED` (every
+exercise's) run in a process of their own, the judge, exchanging only data
+with the answer's, so the seal's verdicts decide no exercise of the course.
+What it does for them: as each judged check begins and ends asking the
+kernel (an ``rtt.judged`` event from :mod:`tutorial.tools.grading.judged`),
+it compares what the teacher's check and its experiments use (their
+module's names, the experiments by name, the grader, the standard modules)
+with the snapshot, and notes a change as tampering, for that check.
+
+What the seal does not stop (one process is no wall):
 
 * reading or writing the process's memory without an audit event: NumPy's
   array interface (``__array_interface__`` with any address) and
@@ -125,6 +132,9 @@ NOTED = frozenset({"socket.connect", "socket.sendto", "os.fork", "os.forkpty", "
 # snapshotted too (``random.Random = ...`` once left every check with no hidden case; ``numpy.allclose = ...``
 # would make a comparison say yes).  Other libraries the lessons run (rclpy, MuJoCo) are not.
 STANDARD_MODULES = ("math", "random", "numpy", "numpy.linalg")
+# What the kernel's side of the judge and the wire call (their code, not their data: tempfile sets a global of its
+# own on first use): replaced, they could send the judge what a right answer's experiment would
+JUDGE_MODULES = ("functools", "socket", "tempfile", "shutil", "json", "base64", "dataclasses")
 NOT_COMPARED = frozenset(
     {"_", "input", "exit", "quit", "display", "get_ipython", "__IPYTHON__", "copyright", "credits"}
 )
@@ -227,6 +237,7 @@ def install(
 
     modules = trusted_modules(checks)
     modules += [sys.modules[name] for name in STANDARD_MODULES if name in sys.modules]  # the checks imported them
+    modules += [importlib.import_module(name) for name in JUDGE_MODULES]
     package = os.path.dirname(os.path.dirname(os.path.realpath(grader.__file__)))  # tutorial/
     roots = tuple(os.path.realpath(p) + os.sep for p in {sys.prefix, sys.base_prefix, package})
     repository = os.path.dirname(package)
@@ -324,6 +335,8 @@ def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, b
     for name, value in list(builtin_names.items()):
         if name not in NOT_COMPARED:
             snapshot.append(("builtins", builtin_names, name, value))
+    for name, value in list(grader.EXPERIMENTS.items()):  # what a judged check has the kernel run, by name
+        snapshot.append((name.partition(":")[0], grader.EXPERIMENTS, name, value))
     check_codes = {  # each check's code -> (its module, the module's names it uses)
         id(f.__code__): (f.__code__, m.__name__, uses(f.__code__, m.__dict__), m.__dict__)
         for m in modules
@@ -332,6 +345,37 @@ def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, b
         if n.startswith("check_") and isinstance(f, types.FunctionType)
     }
     grade_code, require_code = grader.grade.__code__, grader.Result.require.__code__
+    judged = loaded.get("tutorial.tools.grading.judged")  # noqa: F821 - the kernel's side of the judge, if any
+    judged_run = (judged.Judge.run.__code__, judged.__dict__) if judged is not None else (None, None)
+    stand_ins = {  # each judged check's stand-in (judged._asking's): name -> (module, the stand-in)
+        n: (m, f)
+        for m in modules
+        if m.__name__ in check_modules
+        for n, f in m.__dict__.items()
+        if n.startswith("check_") and isinstance(getattr(f, "__wrapped__", None), types.FunctionType)
+    }
+    # each judged check's name -> (its module, the names the teacher's check and its experiments use)
+    judged_scopes = {n: (m.__name__, uses(f.__wrapped__.__code__, m.__dict__)) for n, (m, f) in stand_ins.items()}
+    # what the stand-ins hold (the kernel's Judge, the check's name, the teacher's check), and that Judge's own
+    # attributes (its socket, its reader, its lock; not its count of runs): an object's, which no snapshot of a
+    # module compares
+    judge_parts = [(f, tuple(c.cell_contents for c in f.__closure__ or ())) for _, f in stand_ins.values()]
+    judges = {id(v): v for _, cells in judge_parts for v in cells if judged is not None and type(v) is judged.Judge}
+    judge_attributes = [(j, dict(vars(j))) for j in judges.values()]
+
+    def judge_changed():
+        """What differs in the stand-ins' closures and their Judge's attributes since the seal was installed."""
+        out = []
+        for f, cells in judge_parts:
+            now = tuple(c.cell_contents for c in f.__closure__ or ())
+            if len(now) != len(cells) or any(a is not b for a, b in zip(now, cells)):
+                out.append(f"{f.__name__}'s closure was changed")
+        for j, was in judge_attributes:
+            now = vars(j)
+            if set(now) != set(was) or any(now[k] is not v for k, v in was.items() if k != "_runs"):
+                out.append("the kernel's end of the judge was changed")
+        return out
+
     grader_globals = grader.__dict__
     frame_type = type(getframe(0))
 
@@ -352,20 +396,21 @@ def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, b
     modules_now = [(m.__name__, m) for m in modules]
     frame_holders = (types.TracebackType, types.GeneratorType, types.CoroutineType, types.AsyncGeneratorType)
     result_type = grader.Result
-    state = {"checks": 0, "refused": [], "results": {}, "number": ""}
+    state = {"checks": 0, "refused": [], "results": {}, "number": "", "judged": ""}
     suspecting = {grader._suspect.__code__}
     seed_code = grader.hidden_random.__code__
     missing = object()
 
-    def changed(check=None):
-        """What differs from the snapshot; of the check modules, only what ``check`` (a code id) uses."""
-        module, used = check_codes[check][1:3] if check in check_codes else (None, ())
+    def changed(check=None, scope=None):
+        """What differs from the snapshot; of the check modules, only what ``check`` (a code id) uses, or what
+        ``scope`` names: ``(module, names)``, a judged check's (its experiments and what they use)."""
+        module, used = scope or (check_codes[check][1:3] if check in check_codes else (None, ()))
         out = [f"{name} was replaced in sys.modules" for name, m in modules_now if loaded.get(name) is not m]  # noqa: F821
         for where, space, name, value in snapshot:
-            if where in check_modules and (where != module or name not in used):
-                continue  # another check's module, or a name this check does not use
+            if where in check_modules and (where != module or name.rpartition(":")[2] not in used):
+                continue  # another check's module, or a name this check does not use (an experiment: by its own)
             if space.get(name, missing) is not value:
-                out.append(f"{where}.{name} was replaced")
+                out.append(f"the experiment {name} was replaced" if ":" in name else f"{where}.{name} was replaced")
         for where, f, code, defaults, kwdefaults, cells in function_parts:
             owner, _, short = where.rpartition(".")
             if owner in check_modules and (owner != module or short not in used):
@@ -531,8 +576,9 @@ def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, b
         return False
 
     def here():
-        """The exercise whose check is running, or "" (then the grader gives a note to the next check)."""
-        return state["number"] if state["checks"] else ""
+        """The exercise whose check is running, the judged check asking the judge (its name), or "" (then the
+        grader gives a note to the next check)."""
+        return state["number"] if state["checks"] else state["judged"]
 
     class Refused(Exception):  # noqa: N818 - what act() says to refuse; the hook raises the RuntimeError
         pass
@@ -650,6 +696,14 @@ def _make_hook(key, fd, modules, roots, readable, hidden, seed, calls, grader, b
                 if answers_handlers():
                     state["begin_changes"].append("a signal handler not the kernel's")
                 send(BEGIN, number_of(args[0]))
+        elif event == "rtt.judged":  # judged.Judge.run: a check the judge runs begins or ends asking this kernel
+            if caller.f_code is judged_run[0] and caller.f_globals is judged_run[1] and type(args[1]) is str:
+                state["judged"] = args[1] if args[0] == "begin" else ""
+                # the experiments it runs here are the check module's own functions, compared with what they use
+                reasons = changed(scope=judged_scopes.get(args[1], ("", ()))) + judge_changed()
+                reasons += ["a signal handler not the kernel's"] if answers_handlers() else []
+                if reasons:
+                    send(NOTE, "tampering", "; ".join(dict.fromkeys(reasons[:3])), args[1])
         elif event == "rtt.check_end":
             if caller.f_code is grade_code and ours(caller):
                 state["checks"] = max(0, state["checks"] - 1)  # also after an interrupt (a cell's timeout)

@@ -5,8 +5,8 @@ process of its own; the kernel (:mod:`tutorial.tools.grading.judged`) runs the
 answer.  Between them goes data, never an object: :func:`encode` turns a value
 into JSON's types, :func:`decode` builds it back, and builds only these:
 
-* ``None``, ``bool``, ``int``, ``float`` (NaN and the infinities too), ``str``;
-  ``list``, ``tuple``, ``dict``; NumPy's arrays and scalars of booleans and numbers;
+* ``None``, ``bool``, ``int``, ``float`` (NaN and the infinities too), ``str``, ``bytes``;
+  ``list``, ``tuple``, ``dict``; NumPy's arrays (as their bytes) and scalars of booleans and numbers;
 * the checks' own data classes and the ROS messages they name (:func:`_classes`, :func:`_messages`),
   ``rclpy``'s ``Parameter``, ``QoSProfile`` and ``Duration``;
 * a file a check made for the answer to read (a ``Path``): its bytes cross, and the kernel's side writes them
@@ -26,11 +26,13 @@ import functools
 import json
 import math
 import re
+import sys
 from pathlib import Path, PurePath
 
 MAX_LINE = 8 << 20  # bytes of one message: a longer one is refused, not read
 MAX_DEPTH = 64  # nesting of one value
 MAX_TEXT = 300  # characters of an Opaque's repr or an exception's message
+MAX_CASE_TEXT = 2000  # characters of what an experiment's failed case says, and of its hint
 
 
 class WireError(ValueError):
@@ -66,9 +68,17 @@ def _classes() -> dict:
 
 @functools.cache
 def _messages() -> dict:
+    """The ROS messages that cross: 10.1's answer, and what the checks' experiments record (with every message
+    type nested in them)."""
+    from builtin_interfaces.msg import Time
+    from geometry_msgs.msg import Point, Pose, PoseStamped, Quaternion, Vector3, Vector3Stamped
     from rcl_interfaces.msg import SetParametersResult
+    from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, RegionOfInterest
+    from std_msgs.msg import Float64, Header
 
-    return {"rcl_interfaces/msg/SetParametersResult": SetParametersResult}
+    kinds = (SetParametersResult, JointState, PoseStamped, Pose, Point, Quaternion, Imu, Vector3, Vector3Stamped)
+    kinds += (Float64, Image, CameraInfo, RegionOfInterest, Header, Time)
+    return {_message_name(kind): kind for kind in kinds}
 
 
 NUMPY_KINDS = "biuf"  # NumPy dtypes the wire carries: booleans, integers, floats
@@ -95,12 +105,15 @@ def encode(value, depth: int = 0):
         return {"tuple": [encode(v, depth + 1) for v in value]}
     if kind is dict:
         return {"dict": [[encode(k, depth + 1), encode(v, depth + 1)] for k, v in dict.items(value)]}
+    if kind is bytes:
+        return {"bytes": base64.b64encode(value).decode()}
     module = getattr(kind, "__module__", "")
     if module == "numpy":
         import numpy as np
 
-        if kind is np.ndarray and value.dtype.kind in NUMPY_KINDS:
-            return {"ndarray": [value.dtype.str, list(value.shape), encode(value.ravel().tolist(), depth + 1)]}
+        if kind is np.ndarray and value.dtype.kind in NUMPY_KINDS:  # its bytes: a picture is 230,400 numbers
+            raw = np.ascontiguousarray(value).tobytes()
+            return {"raw": [value.dtype.str, list(value.shape), base64.b64encode(raw).decode()]}
         if isinstance(value, np.generic) and value.dtype.kind in NUMPY_KINDS:
             return {"scalar": [value.dtype.str, encode(value.item(), depth + 1)]}
     key = f"{module}:{getattr(kind, '__qualname__', '')}"
@@ -143,8 +156,10 @@ def _policy(value):
 
 
 def _plain(value):
-    """A message field's value as the wire's types: an ``array.array`` as a list."""
-    return value.tolist() if type(value).__module__ == "array" else value
+    """A message field's value as the wire's types: an ``array.array`` as a list, of bytes as ``bytes``."""
+    if type(value).__module__ == "array":
+        return value.tobytes() if value.typecode == "B" else value.tolist()
+    return value
 
 
 def _message_name(kind) -> str | None:
@@ -173,7 +188,8 @@ def _short_repr(value) -> str:
 def _own_eq(kind) -> bool:
     try:
         classes = [*kind.__mro__[:-1], *type(kind).__mro__[:-1]]
-        return any("__eq__" in vars(k) for k in classes) and kind.__module__ not in ("builtins", "numpy")
+        library = kind.__module__ == "numpy" or str(kind.__module__).split(".")[0] in sys.stdlib_module_names
+        return any("__eq__" in vars(k) for k in classes) and not library  # a deque, an OrderedDict: not its own
     except Exception:  # noqa: BLE001 - a class too strange to read: say it may compare as it likes
         return True
 
@@ -236,6 +252,17 @@ def _ndarray(body, depth, folder):
     dtype, shape, values = body
     shape = [int(n) for n in shape]
     return np.array(decode(values, depth, folder), dtype=_numpy_dtype(dtype)).reshape(shape)
+
+
+def _raw(body, depth, folder):
+    import numpy as np
+
+    dtype, shape, content = body
+    dtype, shape = _numpy_dtype(dtype), [int(n) for n in shape]
+    raw = base64.b64decode(str(content), validate=True)
+    if any(n < 0 for n in shape) or len(raw) != dtype.itemsize * math.prod(shape):
+        raise WireError(f"an array of shape {shape} and {len(raw)} bytes")
+    return np.frombuffer(raw, dtype).reshape(shape).copy()
 
 
 def _scalar(body, depth, folder):
@@ -308,6 +335,8 @@ _DECODERS = {
     "dict": lambda body, depth, folder: {decode(k, depth, folder): decode(v, depth, folder) for k, v in _list(body)},
     "file": _file,
     "ndarray": _ndarray,
+    "raw": _raw,
+    "bytes": lambda body, depth, folder: base64.b64decode(str(body), validate=True),
     "scalar": _scalar,
     "object": _object,
     "message": _message,
