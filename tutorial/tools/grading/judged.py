@@ -81,7 +81,6 @@ class Judge:
                     if message.get("id") != run:
                         continue  # the judge's for a check interrupted before
                     if "result" in message:
-                        sys.audit("rtt.judged", "end", name)  # and again now that its experiments have run
                         got = dict(message["result"])
                         passed, case = got.get("passed") is True, got.get("case")
                         exercise, said = str(got.get("exercise")), str(got.get("message"))
@@ -97,6 +96,8 @@ class Judge:
                     self._send({"abort": run})  # the judge drops the check: no verdict
                 finally:
                     raise
+            finally:
+                sys.audit("rtt.judged", "end", name)  # again, its experiments run, however it ended
 
 
 def _called(answer, call) -> dict:
