@@ -100,15 +100,15 @@ def _imu(accel, gyro=(0.0, 0.0, 0.0), stamp: float = 0.0, frame_id: str = "CHASS
     return msg
 
 
-def _turn_left(app, controller, angle: float) -> None:
+def _turn_left(app, angle: float) -> None:
     """Yaw the viewer's tank by ``angle`` rad about z (its root's orientation), main thread."""
-    _place(app, controller, orientation=[math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)])
+    _place(app, orientation=[math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2)])
 
 
-def _place(app, controller, position=None, orientation=None) -> None:
+def _place(app, position=None, orientation=None) -> None:
     """Put the viewer's tank's root at ``position`` (m), turned by the quaternion ``orientation`` (w, x, y, z).
 
-    The tank's body is the app's (``controller.body`` is the learner's attribute, which a class could replace).
+    The tank's body is the app's (the controller's ``body`` is the learner's attribute, which a class could replace).
     """
     body = app.bodies["Tank"]
     root = body.root_qpos_address  # the tank's free joint: its position (3,), then its orientation (4,)
@@ -277,7 +277,7 @@ def check_horizontal_arrow(cls) -> Result:
     )
 
 
-def _seen(app, controller) -> dict:
+def _seen(app) -> dict:
     """What 5.1's check reads of a viewer: ``{"arrows"`` (the names drawn), ``"arrow"`` (the green one's
     ``color``, ``origin`` m, ``vector`` m and ``visible``, if drawn), ``"imu"`` (the IMU site's position, m),
     ``"imu_axes"`` (its orientation, 3 x 3, flat)``}``."""
@@ -312,11 +312,11 @@ def _arrow_shown(cls, accel, turn: float) -> dict:
     the red arrow's vector (``"red"``, m)."""
     with _viewer(cls, "HorizontalArrow") as (app, controller, _):
         if ARROW not in app.overlays.arrows:
-            return _seen(app, controller)
+            return _seen(app)
         if turn:
-            _turn_left(app, controller, turn)
+            _turn_left(app, turn)
         controller.update_imu(_imu(accel), controller.clock())
-        return {**_seen(app, controller), "red": _red(app).vector.copy()}
+        return {**_seen(app), "red": _red(app).vector.copy()}
 
 
 @experiment
@@ -324,11 +324,11 @@ def _arrow_after_rejection(cls) -> tuple[dict, dict]:
     """A viewer of ``cls`` given (3, 4, 11.8) m/s^2, then a NaN: :func:`_seen` after each."""
     with _viewer(cls, "HorizontalArrow") as (app, controller, _):
         if ARROW not in app.overlays.arrows:
-            return _seen(app, controller), _seen(app, controller)
+            return _seen(app), _seen(app)
         controller.update_imu(_imu((3.0, 4.0, 11.8)), controller.clock())
-        before = _seen(app, controller)
+        before = _seen(app)
         controller.update_imu(_imu((math.nan, 0.0, 9.8)), controller.clock())
-        return before, _seen(app, controller)
+        return before, _seen(app)
 
 
 @experiment
@@ -336,13 +336,13 @@ def _arrow_shaken(cls) -> tuple:
     """A viewer of ``cls`` hit by (-30, 0, 9.8) m/s^2, then shaken 20 ms later: ``(the IMU's position before, m,
     :func:`_seen` after)``."""
     with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
-        home = _seen(app, controller)["imu"]
+        home = _seen(app)["imu"]
         if ARROW not in app.overlays.arrows:
-            return home, _seen(app, controller)
+            return home, _seen(app)
         controller.update_imu(_imu((-30.0, 0.0, 9.8)), clock())
         clock.now += 0.02
         controller.shake_tick()
-        return home, _seen(app, controller)
+        return home, _seen(app)
 
 
 @experiment
@@ -353,10 +353,10 @@ def _arrows_placed(cls, poses, accels) -> list[dict]:
     with _viewer(cls, "HorizontalArrow") as (app, controller, clock):
         for (position, orientation), accel in zip(poses, accels):
             if ARROW not in app.overlays.arrows:
-                return [*seen, _seen(app, controller)]
-            _place(app, controller, position, orientation)
+                return [*seen, _seen(app)]
+            _place(app, position, orientation)
             controller.update_imu(_imu(accel), clock())
-            seen.append(_seen(app, controller))
+            seen.append(_seen(app))
     return seen
 
 

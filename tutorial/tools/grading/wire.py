@@ -246,14 +246,6 @@ def _numpy_dtype(text):
     return dtype
 
 
-def _ndarray(body, depth, folder):
-    import numpy as np
-
-    dtype, shape, values = body
-    shape = [int(n) for n in shape]
-    return np.array(decode(values, depth, folder), dtype=_numpy_dtype(dtype)).reshape(shape)
-
-
 def _raw(body, depth, folder):
     import numpy as np
 
@@ -334,7 +326,6 @@ _DECODERS = {
     "tuple": lambda body, depth, folder: tuple(decode(_list(body), depth, folder)),
     "dict": lambda body, depth, folder: {decode(k, depth, folder): decode(v, depth, folder) for k, v in _list(body)},
     "file": _file,
-    "ndarray": _ndarray,
     "raw": _raw,
     "bytes": lambda body, depth, folder: base64.b64decode(str(body), validate=True),
     "scalar": _scalar,
