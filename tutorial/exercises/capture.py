@@ -135,8 +135,9 @@ def scripted_drive(name: str, cls, parameters: dict, node: CapturingNode, script
 
 
 def publishers_record(node: CapturingNode) -> list[dict]:
-    """What each capturing publisher of ``node`` saw, as data (an experiment's, :func:`~tutorial.exercises.grader.
-    experiment`): ``{"topic", "type"`` (``pkg/msg/Name``), ``"qos"``, ``"destroyed"``, ``"messages"}``.
+    """What each capturing publisher of ``node`` saw, as data (an experiment's, see
+    :func:`~tutorial.exercises.grader.experiments`): ``{"topic", "type"`` (``pkg/msg/Name``), ``"qos"``,
+    ``"destroyed"``, ``"messages"}``.
 
     The QoS is the real publisher's, and destroyed means gone from the real node too: a class can write
     ``qos_profile`` or ``destroyed`` on the capturing publisher it was handed, not make rclpy's say so.

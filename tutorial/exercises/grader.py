@@ -129,22 +129,23 @@ def grade(exercise: str, cases: Iterable[Case]) -> Result:
         logger.propagate = propagate
 
 
-EXPERIMENTS: dict[str, Callable] = {}  # "module:name" -> every function marked @experiment
+EXPERIMENTS: dict[str, Callable] = {}  # "module:name" -> every function listed by experiments()
 
 
-def experiment(func: Callable) -> Callable:
-    """Mark ``func(cls, *args)`` as one of a check's experiments on a learner's class: what it returns is data
-    (the wire's types: numbers, text, lists, tuples, dicts, arrays), which the check then judges.
+def experiments(*funcs: Callable) -> None:
+    """List each ``func(cls, *args)`` of ``funcs`` as one of a check's experiments on a learner's class: what it
+    returns is data (the wire's types: numbers, text, lists, tuples, dicts, arrays), which the check then judges.
+    A check module lists its own at its end, when it is imported.
 
     While grading, the check runs in the judge (:mod:`tutorial.tools.grading.judge`), and :func:`observe` has
     the graded kernel, where the class lives, run the experiment by this name.
     """
-    EXPERIMENTS[f"{func.__module__}:{func.__qualname__}"] = func
-    return func
+    for func in funcs:
+        EXPERIMENTS[f"{func.__module__}:{func.__qualname__}"] = func
 
 
 def observe(func: Callable, cls, *args):
-    """What experiment ``func(cls, *args)`` (marked :func:`experiment`) gives: run here, or while grading in the
+    """What experiment ``func(cls, *args)`` (listed by :func:`experiments`) gives: run here, or while grading in the
     kernel that holds the learner's class, whose reply is built back from data.  The caller's thread.
 
     Raises:

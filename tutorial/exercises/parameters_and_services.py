@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import threading
 
-from tutorial.exercises.grader import Case, CaseFailed, Result, experiment, grade, hidden_random, observe
+from tutorial.exercises.grader import Case, CaseFailed, Result, experiments, grade, hidden_random, observe
 
 RATE = "RttJointStatePublisher.rate"
 MAX_RATE = 1000.0  # Hz: the simulation's steps per second
@@ -343,7 +343,6 @@ def _answer(switch: _WatchedSwitch, got, was) -> dict:
     return seen
 
 
-@experiment
 def _switched(func, start: bool, steps) -> list[dict]:
     """``func`` asked each request of ``steps`` (``(data, turned)``: the switch turned over first, under its lock,
     by this thread), on one switch from ``start``: each answer as :func:`_answer` reads it."""
@@ -359,7 +358,6 @@ def _switched(func, start: bool, steps) -> list[dict]:
     return seen
 
 
-@experiment
 def _switched_by_a_service(func) -> dict:
     """A SetBool client asking a service whose callback is ``func`` to turn a switch off, on this thread's executor:
     the answer as :func:`_answer` reads it, with ``done`` (it came within :data:`ROUND_TRIP_TIMEOUT`) and ``refused``
@@ -386,3 +384,8 @@ def _switched_by_a_service(func) -> dict:
     finally:
         executor.shutdown()
         node.destroy_node()
+
+
+# The experiments these checks have the kernel that holds the class run while grading (grader.EXPERIMENTS),
+# listed here rather than decorated: make mutate leaves a decorated function alone.
+experiments(_switched, _switched_by_a_service)
