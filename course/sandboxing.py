@@ -318,7 +318,9 @@ def judge(
 def settle(course: Path, assignment: str, learner: str, job: Job, log: str, died: bool) -> str | None:
     """After ``nbgrader autograde`` of one submission in ``job``'s sandbox: its exercises judged
     (:func:`judge`), the points the seal did not let stand taken back, its flags in the feedback and in
-    ``flags.json``, and the seal's lines kept beside the autograded notebook (``seal.txt``, why).
+    ``flags.json``, and the seal's lines kept for the teacher, why, in ``seal/<learner>/<assignment>.txt`` (not
+    beside the autograded notebook: ``nbgrader generate_feedback`` copies every other file there into the
+    learner's feedback).
 
     Returns:
         None, or why the submission was not graded in the sandbox (no kernel of the sandbox ever ran).
@@ -329,8 +331,11 @@ def settle(course: Path, assignment: str, learner: str, job: Job, log: str, died
         return f"not graded in the sandbox (nbgrader's log: {log[-500:]})"
     notebook = course / "autograded" / learner / assignment / f"{assignment}.ipynb"
     judged = judge(notebook, verdicts, log, died, job.judge_key)
-    if notebook.parent.is_dir() and verdicts.exists():  # what the seal said, and why, for the teacher
-        shutil.copyfile(verdicts, notebook.parent / "seal.txt")
+    if verdicts.exists():  # what the seal said, and why, for the teacher alone
+        notes = course / "seal" / learner
+        notes.mkdir(parents=True, exist_ok=True)
+        (course / "seal").chmod(0o700)
+        shutil.copyfile(verdicts, notes / f"{assignment}.txt")
     if notebook.is_file():
         apply(f"sqlite:///{course / 'gradebook.db'}", assignment, learner, judged)
         say_in_feedback(notebook, judged)

@@ -216,6 +216,11 @@ def grade_all(
     for (name, learner), points in expected.items():
         assert rows[(name, learner)] == sum(points.values()), (name, learner, rows[(name, learner)])
         assert (course / "feedback" / learner / name / f"{name}.html").is_file(), f"no feedback for {learner}"
+        # the seal's notes are the teacher's, never in the learner's feedback (nbgrader copies what is beside
+        # the autograded notebook there)
+        assert not list((course / "feedback" / learner).rglob("seal*")), f"the seal's notes went to {learner}"
+    honest = getpass.getuser() if exchange else "solutions"  # graded in the sandbox: the seal's notes are kept
+    assert not ROOT_USER or (course / "seal" / honest / f"{names[0]}.txt").is_file(), "no seal notes kept"
     assert {name for name, _ in rows} == set(names), "the CSV has rows for an assignment not given to the class"
     flags = {(r["assignment"], r["student_id"]): r["flags"] for r in csv.DictReader(csv_path.open())}
     for cheat in cheats:  # its target flagged; the honest submissions not at all
