@@ -575,6 +575,7 @@ MISTAKES = [
     ),
     ("10.1", "    return SetParametersResult(successful=True)\n", "    return True\n", "rate=100.0]"),
     ("10.2", "    return response\n", "", "a switch on, SetBool.Request(data=False)"),
+    ("10.2", "    return response\n", "    return response.success\n", "a switch on, SetBool.Request(data=False)"),
     (
         "10.2",
         "    with switch.lock:  # the simulation thread reads enabled\n"
@@ -982,6 +983,69 @@ def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wro
     if "speeds.max() == 0" in wrong:
         assert "stood still" in result.message, str(result)
     assert str(result) == snapshot  # its case, its values and its hint, word for word
+
+
+@pytest.mark.parametrize(
+    "written, said",
+    [
+        (
+            "            type(self).__shots__ += 1\n",
+            "on_joy() changes ShotCountingTankController.__shots__ on the class, which every controller shares.",
+        ),
+        ("            self.__presses__.append(1)\n", "reads self.__presses__ outside `with self._lock:`"),
+    ],
+    ids=["a number written on the class", "a list on the class changed in place"],
+)
+def test_1_2_a_count_kept_on_the_class_is_found(ros, written, said):
+    """A count kept on the class, reset for each controller (``type(self).__shots__ = 0``), which no instance's
+    write shows: a new number there is a change of the class (every controller would share it); a list changed in
+    place is read through ``self`` by both threads outside the lock, though no instance holds it (found by make
+    mutate: the name of such a read went unchecked, and every other answer's writes gave it away first)."""
+    ex = exercise("1.2")
+    wrong = put_in(
+        ex["solution"],
+        (
+            "    shots = 0  # presses of A so far (written under self._lock)\n",
+            "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
+            "            self.a_down = down\n",
+            "        with self._lock:\n            shots = self.shots\n",
+        ),
+        (
+            "    __shots__ = 0\n\n    def __init__(self, *args, **kwargs):\n        super().__init__(*args, **kwargs)\n"
+            "        type(self).__shots__ = 0\n        type(self).__presses__ = []\n        self.was = False\n\n",
+            "        if down and not self.was:\n" + written + "        self.was = down\n",
+            "        shots = self.__shots__ + len(self.__presses__)\n",
+        ),
+    )
+    result = grade(ex, ex["stub"], wrong)
+    assert not result.passed and said in str(result), str(result)
+
+
+def test_1_2_a_dunder_name_is_the_answers_own_only_where_a_class_below_rtt_tank_controller_defines_it():
+    """What 1.2's watch takes for Python's own (``__class__``) and what for the answer's state (its class's
+    ``__shots__``, above the check's own subclass, below ``RttTankController``)."""
+    from tutorial.exercises.step1_tank_controller import _answers_own
+
+    class RttTankController:
+        __base_state__ = 0
+
+    class Answer(RttTankController):
+        __shots__ = 0
+
+    class Watched(Answer):  # the check's own subclass, first in the MRO
+        __watched__ = 0
+
+    assert _answers_own(Watched, "__shots__")
+    assert not _answers_own(Watched, "__watched__") and not _answers_own(Watched, "__base_state__")
+    assert not _answers_own(Watched, "__class__") and not _answers_own(Watched, "__nothing__")
+
+    class Loose:  # no RttTankController at all: what the classes define, up to object
+        pass
+
+    class WatchedLoose(Loose):
+        pass
+
+    assert not _answers_own(WatchedLoose, "__nothing__") and _answers_own(WatchedLoose, "__class__")
 
 
 @pytest.mark.parametrize("mixin", [False, True], ids=["its own class", "a class after RttTankController"])
@@ -1820,3 +1884,32 @@ def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
         past_a_limit = {"within the tolerance past the upper limit", "past the tolerance below the lower limit"}
         expected = {"in range", "not finite, or huge"} | (past_a_limit if limited else set())
         assert expected <= drawn, (kind, limited, bands)
+
+
+def test_10_2_the_round_trip_reads_what_rclpy_made_of_the_answer(ros):
+    """10.2's experiment through a real service (found by make mutate: the check's direct cases come first, so no
+    whole answer reached what the round trip reports): a right answer's reply as the check reads it, and an answer
+    rclpy cannot send, refused with its TypeError."""
+    from tutorial.exercises import parameters_and_services as step10
+
+    def switch_tracks(switch, request, response):
+        with switch.lock:
+            was, switch.enabled = switch.enabled, request.data
+        response.success, response.message = True, step10._said(request.data, was)
+        return response
+
+    assert step10._switched_by_a_service(switch_tracks) == {
+        "refused": None,
+        "done": True,
+        "was": True,
+        "locked": False,
+        "enabled": False,
+        "response": True,
+        "returned": None,
+        "success": True,
+        "message": "tracks off",
+        "unlocked_writes": 0,
+    }
+    refused = step10._switched_by_a_service(lambda switch, request, response: None)
+    assert set(refused) == {"refused", "done"} and refused["done"] is False, refused
+    assert refused["refused"].startswith("TypeError("), refused

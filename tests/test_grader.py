@@ -317,7 +317,8 @@ def test_same_value(got, expected, same):
 def test_a_value_of_a_class_that_compares_as_it_likes_is_refused_and_told_to_the_seal():
     """same_numbers and same_value refuse a value whose class is not exactly a number type or the expected one,
     and tell the seal (``rtt.suspect``) when that class is an answer's own with a comparison of its own (its own
-    ``__eq__``, or a subclass of a number or a string): not a plain class, not a builtin or NumPy's own."""
+    ``__eq__``, its metaclass's, or a subclass of a number or a string): not a plain class, not a builtin or NumPy's
+    own."""
 
     class AlwaysEqual:
         def __eq__(self, other):
@@ -338,12 +339,28 @@ def test_a_value_of_a_class_that_compares_as_it_likes_is_refused_and_told_to_the
     class AClassWhoseNameIsLongerThanFortyCharactersByFar(int):
         pass
 
+    class Meta(type):  # a metaclass's comparison makes `type(got) == float` say yes
+        def __eq__(cls, other):
+            return True
+
+        __hash__ = type.__hash__
+
+    class MetaOfMeta(Meta):
+        pass
+
+    class Sly(metaclass=Meta):
+        pass
+
+    class Slier(metaclass=MetaOfMeta):  # the comparison one metaclass further up
+        pass
+
     heard = hear_the_checks()
     assert not grader.same_numbers(AlwaysEqual(), 1.0) and not grader.same_value(AlwaysEqual(), "a")
     assert not grader.same_numbers(MyFloat(1.0), 1.0) and not grader.same_value(MyFloat(2.0), 2)
     assert not grader.same_value(AClassWhoseNameIsLongerThanFortyCharactersByFar(3), 3)
     assert not grader.same_value(MyStr("a"), "a") and not grader.same_value(Child(), "a")
     assert not grader.same_value(Plain(), "a")  # refused, but no comparison of its own: untold
+    assert not grader.same_value(Sly(), 1.0) and not grader.same_numbers(Slier(), 1.0)
     assert not grader.same_numbers("1.0", 1.0) and not grader.same_value("1", 1)  # builtins: untold
     assert not grader.same_numbers(None, 1.0) and not grader.same_value(np.str_("a"), "a")  # NumPy's own: untold
     assert grader.same_numbers(np.float32(1.0), 1.0) and grader.same_value(np.int64(2), 2)
@@ -357,6 +374,8 @@ def test_a_value_of_a_class_that_compares_as_it_likes_is_refused_and_told_to_the
         f"a AClassWhoseNameIsLongerThanFortyCharacte, {own}",
         f"a MyStr, {own}",
         f"a Child, {own}",
+        f"a Sly, {own}",
+        f"a Slier, {own}",
     ], heard
 
 

@@ -200,6 +200,13 @@ def check_shot_counter(cls) -> Result:
 
     def under_the_lock():
         own, watched = observe(_state_touched, cls, [A, NONE, A])
+        on_the_class = [(phase, name) for phase, what, name, _ in watched if what == "class write"]
+        if on_the_class:
+            phase, name = on_the_class[0]
+            raise CaseFailed(
+                f"{cls.__name__}: {phase}() changes {name} on the class, which every controller shares.",
+                "keep the count on self (self.shots = ...), read and written under self._lock.",
+            )
         seen = [row for row in watched if row[2] not in own]
         # what both threads touch: read by summary() (the main thread), read or written by on_joy (the spin thread)
         shared = {n for p, w, n, _ in seen if p == "summary" and w == "read"} & {
@@ -261,9 +268,26 @@ def _state_touched(cls, presses) -> tuple[list, list]:
     object.__setattr__(controller, "_lock", _WatchedLock(controller._lock))  # the learner's lock, watched
     object.__setattr__(controller, "_watch", [])
     for phase, run in (("on_joy", lambda: [controller.on_joy(_joy(b)) for b in presses]), ("summary", None)):
+        before = _class_state(type(controller))
         object.__setattr__(controller, "_phase", phase)
         (run or controller.summary)()
+        after = _class_state(type(controller))
+        controller.__dict__["_watch"] += [
+            (phase, "class write", key[1], False) for key in after if before.get(key, after) is not after[key]
+        ]
     return own, [tuple(row) for row in controller.__dict__["_watch"]]
+
+
+def _class_state(kind: type) -> dict:
+    """``{(place, "Class.name"): value}`` of what the answer's classes (``kind``'s MRO below
+    ``RttTankController``, the check's subclass, of the answer's name, first) hold themselves: a count kept there,
+    which no instance's write shows, changes it."""
+    state = {}
+    for place, k in enumerate(kind.__mro__):
+        if k.__name__ == "RttTankController":
+            break
+        state.update({(place, f"{k.__name__}.{name}"): value for name, value in vars(k).items()})
+    return state
 
 
 SHORT = [1]  # a Joy with button A alone: pressed
