@@ -1886,18 +1886,23 @@ def test_the_hidden_messages_of_3_2_follow_the_statements_rules():
         assert expected <= drawn, (kind, limited, bands)
 
 
+def _switch_tracks_10_2(switch, request, response):
+    """A right answer of 10.2."""
+    from tutorial.exercises.parameters_and_services import _said
+
+    with switch.lock:
+        was, switch.enabled = switch.enabled, request.data
+    response.success, response.message = True, _said(request.data, was)
+    return response
+
+
 def test_10_2_the_round_trip_reads_what_rclpy_made_of_the_answer(ros):
     """10.2's experiment through a real service (found by make mutate: the check's direct cases come first, so no
     whole answer reached what the round trip reports): a right answer's reply as the check reads it, and an answer
     rclpy cannot send, refused with its TypeError."""
     from tutorial.exercises import parameters_and_services as step10
 
-    def switch_tracks(switch, request, response):
-        with switch.lock:
-            was, switch.enabled = switch.enabled, request.data
-        response.success, response.message = True, step10._said(request.data, was)
-        return response
-
+    switch_tracks = _switch_tracks_10_2
     assert step10._switched_by_a_service(switch_tracks) == {
         "refused": None,
         "done": True,
@@ -1913,3 +1918,109 @@ def test_10_2_the_round_trip_reads_what_rclpy_made_of_the_answer(ros):
     refused = step10._switched_by_a_service(lambda switch, request, response: None)
     assert set(refused) == {"refused", "done"} and refused["done"] is False, refused
     assert refused["refused"].startswith("TypeError("), refused
+
+
+ROUND_TRIP_10_2 = "a SetBool client asking a service whose callback is switch_tracks to turn a switch off"
+
+
+@pytest.mark.parametrize(
+    "reply, said",
+    [
+        (
+            {"refused": "TypeError('no')", "done": False},
+            ": rclpy could not send the answer (TypeError('no')). Hint: return the response.",
+        ),
+        ({"refused": None, "done": False}, ": no answer within 5 s. Hint: return the response."),
+        (
+            {"refused": None, "done": True, "enabled": False, "success": True, "message": "tracks already off"},
+            " answered 'tracks already off', expected 'tracks off'. Hint: rclpy sends what the callback returns.",
+        ),
+    ],
+    ids=["refused by rclpy", "never answered", "answered otherwise"],
+)
+def test_10_2_the_round_trips_lines_name_what_went_wrong(monkeypatch, reply, said):
+    """What 10.2 says of a round trip that went wrong after every direct case passed, from a stand-in experiment
+    (found by make mutate: no whole answer gets that far and fails)."""
+    from tutorial.exercises import parameters_and_services as step10
+
+    real = step10.observe
+
+    def observe(func, cls, *args):
+        if func is step10._switched_by_a_service:
+            return {"was": True, "locked": False, "response": True, "returned": None, "unlocked_writes": 0, **reply}
+        return real(func, cls, *args)
+
+    monkeypatch.setattr(step10, "observe", observe)
+    result = step10.check_switch_tracks(_switch_tracks_10_2)
+    assert not result.passed and str(result) == f"✗ Exercise 10.2, switch the tracks: {ROUND_TRIP_10_2}{said}", str(
+        result
+    )
+
+
+def test_10_2_the_hidden_sequences_start_where_they_were_drawn(ros, grading_seed, monkeypatch):
+    """Each hidden sequence of 10.2 runs from its drawn start, on or off (found by make mutate: a start of None
+    passed, since the check reads each answer against the switch as it was)."""
+    from tutorial.exercises import parameters_and_services as step10
+
+    real, starts = step10.observe, []
+
+    def observe(func, cls, *args):
+        if func is step10._switched and len(args[1]) > 1:  # a hidden sequence: 4 to 8 requests
+            starts.append(args[0])
+        return real(func, cls, *args)
+
+    monkeypatch.setattr(step10, "observe", observe)
+    assert step10.check_switch_tracks(_switch_tracks_10_2).passed
+    assert len(starts) == 2 and all(type(start) is bool for start in starts), starts
+
+
+@pytest.mark.parametrize(
+    "shaken, said",
+    [
+        ("still", "then a shake tick 20 ms later: the view did not shake."),
+        ("the arrow left behind", "m, but the green arrow still starts at"),
+    ],
+)
+def test_5_1_a_view_that_does_not_shake_or_leaves_its_arrow_behind_is_told(ros, monkeypatch, shaken, said):
+    """5.1's shake case on what its experiment reports (found by make mutate: no answer of the tables gets past
+    the cases before it without shaking, so the view's place before the hit went unread)."""
+    from tutorial.exercises import step5_imu_viewer as step5
+
+    real = step5.observe
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        if func is not step5._arrow_shaken:
+            return got
+        home, seen = got
+        if shaken == "still":
+            return home, {**seen, "imu": home.copy()}
+        return home, {**seen, "arrow": {**seen["arrow"], "origin": home.copy()}}
+
+    monkeypatch.setattr(step5, "observe", observe)
+    ex = exercise("5.1")
+    result = grade(ex, ex["stub"], ex["solution"])
+    assert not result.passed and said in str(result), str(result)
+
+
+def test_5_1_the_hidden_readings_are_taken_where_the_tank_was_placed(ros, grading_seed, monkeypatch):
+    """Each hidden reading of 5.1 is given with the tank at its drawn place (found by make mutate: the check
+    reads the arrow against the IMU wherever it is, so a tank left where it stood passed as well)."""
+    from tutorial.exercises import step5_imu_viewer as step5
+
+    real, placed = step5.observe, []
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        if func is step5._arrows_placed:
+            placed.extend((position, seen["imu"]) for (position, _), seen in zip(args[0], got) if position is not None)
+        return got
+
+    monkeypatch.setattr(step5, "observe", observe)
+    ex = exercise("5.1")
+    assert grade(ex, ex["stub"], ex["solution"]).passed
+    import numpy as np
+
+    assert len(placed) == 12, placed  # three hidden runs of four poses
+    for position, imu in placed:  # the IMU is on the tank, within a metre of its root
+        assert np.linalg.norm(np.asarray(imu) - np.asarray(position)) < 1.0, (position, imu)
