@@ -2024,3 +2024,29 @@ def test_5_1_the_hidden_readings_are_taken_where_the_tank_was_placed(ros, gradin
     assert len(placed) == 12, placed  # three hidden runs of four poses
     for position, imu in placed:  # the IMU is on the tank, within a metre of its root
         assert np.linalg.norm(np.asarray(imu) - np.asarray(position)) < 1.0, (position, imu)
+
+
+@pytest.mark.parametrize("changed", ["visible", "vector"])
+def test_5_1_a_rejected_message_that_changes_the_arrow_at_all_is_told(ros, monkeypatch, changed):
+    """5.1's rejection case fails an arrow that a NaN only hid, or only moved (found by make mutate: every answer
+    of the tables that draws from the message changes both)."""
+    from tutorial.exercises import step5_imu_viewer as step5
+
+    real = step5.observe
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        if func is not step5._arrow_after_rejection:
+            return got
+        before, after = got
+        arrow = dict(after["arrow"])
+        if changed == "visible":
+            arrow["visible"] = not arrow["visible"]
+        else:
+            arrow["vector"] = arrow["vector"] * 2
+        return before, {**after, "arrow": arrow}
+
+    monkeypatch.setattr(step5, "observe", observe)
+    ex = exercise("5.1")
+    result = grade(ex, ex["stub"], ex["solution"])
+    assert not result.passed and "then of a NaN: the arrow changed to" in str(result), str(result)
