@@ -1977,8 +1977,15 @@ def test_10_2_the_hidden_sequences_start_where_they_were_drawn(ros, grading_seed
 @pytest.mark.parametrize(
     "shaken, said",
     [
-        ("still", "then a shake tick 20 ms later: the view did not shake."),
-        ("the arrow left behind", "m, but the green arrow still starts at"),
+        (
+            "still",
+            "then a shake tick 20 ms later: the view did not shake. "
+            "Hint: keep the viewer's behaviour: call super().update_imu().",
+        ),
+        (
+            "the arrow left behind",
+            "Hint: draw it in draw_arrows(), which the shake tick calls too, not in update_imu().",
+        ),
     ],
 )
 def test_5_1_a_view_that_does_not_shake_or_leaves_its_arrow_behind_is_told(ros, monkeypatch, shaken, said):
