@@ -2057,3 +2057,23 @@ def test_5_1_a_rejected_message_that_changes_the_arrow_at_all_is_told(ros, monke
     ex = exercise("5.1")
     result = grade(ex, ex["stub"], ex["solution"])
     assert not result.passed and "then of a NaN: the arrow changed to" in str(result), str(result)
+
+
+@pytest.mark.parametrize("moved", ["origin", "vector"])
+def test_5_1_a_hidden_reading_a_micrometre_off_fails(ros, grading_seed, monkeypatch, moved):
+    """5.1's hidden readings hold the arrow to the rule within 1e-9 m (and 1e-5 relative) (found by make mutate: every hidden mistake
+    of the tables is off by more than a metre somewhere, so a tolerance of a metre passed them as well)."""
+    from tutorial.exercises import step5_imu_viewer as step5
+
+    real = step5.observe
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        if func is step5._arrows_placed:
+            got[0]["arrow"] = {**got[0]["arrow"], moved: got[0]["arrow"][moved] + 1e-6}
+        return got
+
+    monkeypatch.setattr(step5, "observe", observe)
+    ex = exercise("5.1")
+    result = grade(ex, ex["stub"], ex["solution"])
+    assert not result.passed and "readings with the tank moved, tilted and turned any way" in str(result), str(result)
