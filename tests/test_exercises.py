@@ -2061,8 +2061,9 @@ def test_5_1_a_rejected_message_that_changes_the_arrow_at_all_is_told(ros, monke
 
 @pytest.mark.parametrize("moved", ["origin", "vector"])
 def test_5_1_a_hidden_reading_a_micrometre_off_fails(ros, grading_seed, monkeypatch, moved):
-    """5.1's hidden readings hold the arrow to the rule within 1e-9 m (and 1e-5 relative) (found by make mutate: every hidden mistake
-    of the tables is off by more than a metre somewhere, so a tolerance of a metre passed them as well)."""
+    """5.1's hidden readings hold the arrow to the rule within 1e-9 m and 1e-5 relative (found by make mutate:
+    every hidden mistake of the tables is off by more than a metre somewhere, so a tolerance of a metre passed them
+    as well)."""
     from tutorial.exercises import step5_imu_viewer as step5
 
     real = step5.observe
