@@ -990,7 +990,8 @@ def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wro
     [
         (
             "            type(self).__shots__ += 1\n",
-            "on_joy() changes ShotCountingTankController.__shots__ on the class, which every controller shares.",
+            "on_joy() changes ShotCountingTankController.__shots__ on the class, which every controller shares. "
+            "Hint: keep the count on self (self.shots = ...), read and written under self._lock.",
         ),
         ("            self.__presses__.append(1)\n", "reads self.__presses__ outside `with self._lock:`"),
     ],
@@ -1019,6 +1020,28 @@ def test_1_2_a_count_kept_on_the_class_is_found(ros, written, said):
     )
     result = grade(ex, ex["stub"], wrong)
     assert not result.passed and said in str(result), str(result)
+
+
+def test_1_2_a_count_set_up_in_init_and_counted_outside_the_lock_fails(ros):
+    """A count the answer's ``__init__`` sets on the instance is the answer's state, not ``RttTankController``'s
+    own, which its ``on_joy`` keeps under the lock (found by make mutate: the check took the answer's instance for
+    the base's, and no answer of the tables set its count up in ``__init__``)."""
+    ex = exercise("1.2")
+    wrong = put_in(
+        ex["solution"],
+        (
+            "    shots = 0  # presses of A so far (written under self._lock)\n",
+            "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
+            "            self.a_down = down\n",
+        ),
+        (
+            "    def __init__(self, *args, **kwargs):\n        super().__init__(*args, **kwargs)\n"
+            "        self.shots = 0\n\n",
+            "        if down and not self.a_down:\n            self.shots += 1\n        self.a_down = down\n",
+        ),
+    )
+    result = grade(ex, ex["stub"], wrong)
+    assert not result.passed and "on_joy() reads self.shots outside `with self._lock:`" in str(result), str(result)
 
 
 def test_1_2_a_dunder_name_is_the_answers_own_only_where_a_class_below_rtt_tank_controller_defines_it():
