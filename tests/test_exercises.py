@@ -2101,3 +2101,37 @@ def test_5_1_a_hidden_reading_a_micrometre_off_fails(ros, grading_seed, monkeypa
     ex = exercise("5.1")
     result = grade(ex, ex["stub"], ex["solution"])
     assert not result.passed and "readings with the tank moved, tilted and turned any way" in str(result), str(result)
+
+
+@pytest.mark.parametrize(
+    "x, shakes, said",
+    [
+        (0.1, None, "(in order): the arrow shows the message stamped 1.00 s, expected the one stamped 1.10 s."),
+        (0.26, None, "(in order): the arrow shows none of them (x = 0.260 m), expected the one stamped 1.10 s."),
+        (0.4, None, "(in order): the arrow shows none of them (x = 0.400 m), expected the one stamped 1.10 s."),
+        (None, 2, "(a late hit) shook the view 2 times, expected 0."),
+    ],
+    ids=["the first message's", "between two", "past the last", "shaken twice"],
+)
+def test_5_2_a_wrong_arrow_or_shake_is_told_as_what_it_shows(ros, monkeypatch, x, shakes, said):
+    """5.2's lines for an arrow that shows another message or none, and for a view shaken more than once (found by
+    make mutate: every answer of the tables shows the right message or fails an earlier line)."""
+    from tutorial.exercises import step5_imu_viewer as step5
+
+    real = step5.observe
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        if func is not step5._sequence_shown:
+            return got
+        summary, red_x = got
+        if x is not None and args[0] == [1.0, 1.05, 1.1]:  # the first case, in order
+            return summary, x
+        if shakes is not None and args[2]:  # the case with a hit
+            return {**summary, "shakes": shakes}, red_x
+        return got
+
+    monkeypatch.setattr(step5, "observe", observe)
+    ex = exercise("5.2")
+    result = grade(ex, ex["stub"], ex["solution"])
+    assert not result.passed and said in str(result), str(result)
