@@ -2135,3 +2135,24 @@ def test_5_2_a_wrong_arrow_or_shake_is_told_as_what_it_shows(ros, monkeypatch, x
     ex = exercise("5.2")
     result = grade(ex, ex["stub"], ex["solution"])
     assert not result.passed and said in str(result), str(result)
+
+
+def test_5_2_a_hidden_run_whose_arrow_is_a_micrometre_off_fails(ros, grading_seed, monkeypatch):
+    """5.2's hidden runs read the arrow after every message, within 1e-9 m (found by make mutate: every hidden
+    mistake of the tables also miscounts, so the arrow's rule went unchecked)."""
+    from tutorial.exercises import step5_imu_viewer as step5
+
+    real = step5.observe
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        if func is not step5._messages_shown:
+            return got
+        returned, summary = got
+        last, x = returned[-1]
+        return [*returned[:-1], (last, x + 1e-6)], summary
+
+    monkeypatch.setattr(step5, "observe", observe)
+    ex = exercise("5.2")
+    result = grade(ex, ex["stub"], ex["solution"])
+    assert not result.passed and "a hidden case failed: a stamp exactly a second older" in str(result), str(result)
