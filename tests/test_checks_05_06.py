@@ -515,3 +515,19 @@ def test_6_1_each_hidden_case_fails_on_its_own_rule_on_the_hidden_camera(monkeyp
     monkeypatch.setattr(step6, "hidden_random", lambda exercise: random.Random(f"test/{exercise}"))
     result = step6.check_gray_camera(type("Gray", (), {}))
     assert not result.passed and result.case == told and result.message.startswith(f"a hidden case failed: {told}.")
+
+
+def test_6_a_drive_of_the_judge_with_no_image_publisher_names_the_class():
+    """A drive as the judge builds it back from the kernel's record (:class:`_Drove`): with no publisher of the
+    camera's Image topic, the line names the learner's class (found by make mutate: only the rig's own drive,
+    in the kernel's process, was tried)."""
+    from tutorial.exercises.camera_rig import Camera
+    from tutorial.exercises.grader import CaseFailed
+    from tutorial.exercises.step6_camera import _Drove
+
+    drove = _Drove(
+        "RttGrayCameraPublisher", Camera(), {"publishers": [], "destroyed": [], "times": [], "references": []}
+    )
+    with pytest.raises(CaseFailed) as failed:
+        drove.images()
+    assert str(failed.value).startswith("RttGrayCameraPublisher made no publisher of /Tank/camera/image"), failed.value
