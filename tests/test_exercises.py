@@ -985,6 +985,14 @@ def test_a_wrong_answer_fails_naming_the_input(ros, snapshot, number, right, wro
     assert str(result) == snapshot  # its case, its values and its hint, word for word
 
 
+# The worked solution of 1.2's count: its class attribute, and its on_joy's update under the lock.
+SOLUTION_1_2_COUNT = (
+    "    shots = 0  # presses of A so far (written under self._lock)\n",
+    "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
+    "            self.a_down = down\n",
+)
+
+
 @pytest.mark.parametrize(
     "written, said",
     [
@@ -1006,9 +1014,7 @@ def test_1_2_a_count_kept_on_the_class_is_found(ros, written, said):
     wrong = put_in(
         ex["solution"],
         (
-            "    shots = 0  # presses of A so far (written under self._lock)\n",
-            "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
-            "            self.a_down = down\n",
+            *SOLUTION_1_2_COUNT,
             "        with self._lock:\n            shots = self.shots\n",
         ),
         (
@@ -1029,11 +1035,7 @@ def test_1_2_a_count_set_up_in_init_and_counted_outside_the_lock_fails(ros):
     ex = exercise("1.2")
     wrong = put_in(
         ex["solution"],
-        (
-            "    shots = 0  # presses of A so far (written under self._lock)\n",
-            "        with self._lock:\n            if down and not self.a_down:\n                self.shots += 1\n"
-            "            self.a_down = down\n",
-        ),
+        SOLUTION_1_2_COUNT,
         (
             "    def __init__(self, *args, **kwargs):\n        super().__init__(*args, **kwargs)\n"
             "        self.shots = 0\n\n",
