@@ -5,6 +5,11 @@ subclass that refuses, whole, a JointState naming a joint this body does not
 have (or none of its joints), counting it as ``wrong_model``.
 Exercise 3.2, your own joint matcher: ``my_match(joints, names, positions)``
 returning what to apply, checked against the hostile messages.
+
+The module is over 400 lines and still one job: both checks judge the joint
+matching of notebook 03 on the same tank (``_tank``): 3.2 a matcher of the
+learner's own, 3.1 a subscriber by what it applied to that tank (its
+experiment, ``_applied``, run where the class lives).
 """
 
 from __future__ import annotations
