@@ -1999,6 +1999,24 @@ def test_10_2_the_hidden_sequences_start_where_they_were_drawn(ros, grading_seed
     assert len(starts) == 2 and all(type(start) is bool for start in starts), starts
 
 
+def solution_graded_with(monkeypatch, number: str, experiment: str, change):
+    """Exercise ``number``'s worked solution graded with what its check's experiment ``experiment`` (a name in
+    its checks' module) reports passed through ``change(got, args)`` first: a stand-in for a class that reports
+    otherwise.  Its Result."""
+    import importlib
+
+    ex = exercise(number)
+    module = importlib.import_module(f"tutorial.exercises.{ex['checks']}")
+    real, wanted = module.observe, getattr(module, experiment)
+
+    def observe(func, cls, *args):
+        got = real(func, cls, *args)
+        return change(got, args) if func is wanted else got
+
+    monkeypatch.setattr(module, "observe", observe)
+    return grade(ex, ex["stub"], ex["solution"])
+
+
 @pytest.mark.more  # 5.2's hidden arrow and 10.2's round-trip lines, on stand-in experiments, stay
 @pytest.mark.parametrize(
     "shaken, said",
@@ -2017,22 +2035,14 @@ def test_10_2_the_hidden_sequences_start_where_they_were_drawn(ros, grading_seed
 def test_5_1_a_view_that_does_not_shake_or_leaves_its_arrow_behind_is_told(ros, monkeypatch, shaken, said):
     """5.1's shake case on what its experiment reports (found by make mutate: no answer of the tables gets past
     the cases before it without shaking, so the view's place before the hit went unread)."""
-    from tutorial.exercises import step5_imu_viewer as step5
 
-    real = step5.observe
-
-    def observe(func, cls, *args):
-        got = real(func, cls, *args)
-        if func is not step5._arrow_shaken:
-            return got
+    def shaken_as(got, args):
         home, seen = got
         if shaken == "still":
             return home, {**seen, "imu": home.copy()}
         return home, {**seen, "arrow": {**seen["arrow"], "origin": home.copy()}}
 
-    monkeypatch.setattr(step5, "observe", observe)
-    ex = exercise("5.1")
-    result = grade(ex, ex["stub"], ex["solution"])
+    result = solution_graded_with(monkeypatch, "5.1", "_arrow_shaken", shaken_as)
     assert not result.passed and said in str(result), str(result)
 
 
@@ -2040,20 +2050,15 @@ def test_5_1_a_view_that_does_not_shake_or_leaves_its_arrow_behind_is_told(ros, 
 def test_5_1_the_hidden_readings_are_taken_where_the_tank_was_placed(ros, grading_seed, monkeypatch):
     """Each hidden reading of 5.1 is given with the tank at its drawn place (found by make mutate: the check
     reads the arrow against the IMU wherever it is, so a tank left where it stood passed as well)."""
-    from tutorial.exercises import step5_imu_viewer as step5
+    import numpy as np
 
-    real, placed = step5.observe, []
+    placed = []
 
-    def observe(func, cls, *args):
-        got = real(func, cls, *args)
-        if func is step5._arrows_placed:
-            placed.extend((position, seen["imu"]) for (position, _), seen in zip(args[0], got) if position is not None)
+    def noted(got, args):
+        placed.extend((position, seen["imu"]) for (position, _), seen in zip(args[0], got) if position is not None)
         return got
 
-    monkeypatch.setattr(step5, "observe", observe)
-    ex = exercise("5.1")
-    assert grade(ex, ex["stub"], ex["solution"]).passed
-    import numpy as np
+    assert solution_graded_with(monkeypatch, "5.1", "_arrows_placed", noted).passed
 
     assert len(placed) == 12, placed  # three hidden runs of four poses
     for position, imu in placed:  # the IMU is on the tank, within a metre of its root
@@ -2065,14 +2070,8 @@ def test_5_1_the_hidden_readings_are_taken_where_the_tank_was_placed(ros, gradin
 def test_5_1_a_rejected_message_that_changes_the_arrow_at_all_is_told(ros, monkeypatch, changed):
     """5.1's rejection case fails an arrow that a NaN only hid, or only moved (found by make mutate: every answer
     of the tables that draws from the message changes both)."""
-    from tutorial.exercises import step5_imu_viewer as step5
 
-    real = step5.observe
-
-    def observe(func, cls, *args):
-        got = real(func, cls, *args)
-        if func is not step5._arrow_after_rejection:
-            return got
+    def changed_after(got, args):
         before, after = got
         arrow = dict(after["arrow"])
         if changed == "visible":
@@ -2081,9 +2080,7 @@ def test_5_1_a_rejected_message_that_changes_the_arrow_at_all_is_told(ros, monke
             arrow["vector"] = arrow["vector"] * 2
         return before, {**after, "arrow": arrow}
 
-    monkeypatch.setattr(step5, "observe", observe)
-    ex = exercise("5.1")
-    result = grade(ex, ex["stub"], ex["solution"])
+    result = solution_graded_with(monkeypatch, "5.1", "_arrow_after_rejection", changed_after)
     assert not result.passed and "then of a NaN: the arrow changed to" in str(result), str(result)
 
 
@@ -2093,19 +2090,12 @@ def test_5_1_a_hidden_reading_a_micrometre_off_fails(ros, grading_seed, monkeypa
     """5.1's hidden readings hold the arrow to the rule within 1e-9 m and 1e-5 relative (found by make mutate:
     every hidden mistake of the tables is off by more than a metre somewhere, so a tolerance of a metre passed them
     as well)."""
-    from tutorial.exercises import step5_imu_viewer as step5
 
-    real = step5.observe
-
-    def observe(func, cls, *args):
-        got = real(func, cls, *args)
-        if func is step5._arrows_placed:
-            got[0]["arrow"] = {**got[0]["arrow"], moved: got[0]["arrow"][moved] + 1e-6}
+    def first_moved(got, args):
+        got[0]["arrow"] = {**got[0]["arrow"], moved: got[0]["arrow"][moved] + 1e-6}
         return got
 
-    monkeypatch.setattr(step5, "observe", observe)
-    ex = exercise("5.1")
-    result = grade(ex, ex["stub"], ex["solution"])
+    result = solution_graded_with(monkeypatch, "5.1", "_arrows_placed", first_moved)
     assert not result.passed and "readings with the tank moved, tilted and turned any way" in str(result), str(result)
 
 
@@ -2123,14 +2113,8 @@ def test_5_1_a_hidden_reading_a_micrometre_off_fails(ros, grading_seed, monkeypa
 def test_5_2_a_wrong_arrow_or_shake_is_told_as_what_it_shows(ros, monkeypatch, x, shakes, said):
     """5.2's lines for an arrow that shows another message or none, and for a view shaken more than once (found by
     make mutate: every answer of the tables shows the right message or fails an earlier line)."""
-    from tutorial.exercises import step5_imu_viewer as step5
 
-    real = step5.observe
-
-    def observe(func, cls, *args):
-        got = real(func, cls, *args)
-        if func is not step5._sequence_shown:
-            return got
+    def shown_as(got, args):
         summary, red_x = got
         if x is not None and args[0] == [1.0, 1.05, 1.1]:  # the first case, in order
             return summary, x
@@ -2138,28 +2122,18 @@ def test_5_2_a_wrong_arrow_or_shake_is_told_as_what_it_shows(ros, monkeypatch, x
             return {**summary, "shakes": shakes}, red_x
         return got
 
-    monkeypatch.setattr(step5, "observe", observe)
-    ex = exercise("5.2")
-    result = grade(ex, ex["stub"], ex["solution"])
+    result = solution_graded_with(monkeypatch, "5.2", "_sequence_shown", shown_as)
     assert not result.passed and said in str(result), str(result)
 
 
 def test_5_2_a_hidden_run_whose_arrow_is_a_micrometre_off_fails(ros, grading_seed, monkeypatch):
     """5.2's hidden runs read the arrow after every message, within 1e-9 m (found by make mutate: every hidden
     mistake of the tables also miscounts, so the arrow's rule went unchecked)."""
-    from tutorial.exercises import step5_imu_viewer as step5
 
-    real = step5.observe
-
-    def observe(func, cls, *args):
-        got = real(func, cls, *args)
-        if func is not step5._messages_shown:
-            return got
+    def last_moved(got, args):
         returned, summary = got
         last, x = returned[-1]
         return [*returned[:-1], (last, x + 1e-6)], summary
 
-    monkeypatch.setattr(step5, "observe", observe)
-    ex = exercise("5.2")
-    result = grade(ex, ex["stub"], ex["solution"])
+    result = solution_graded_with(monkeypatch, "5.2", "_messages_shown", last_moved)
     assert not result.passed and "a hidden case failed: a stamp exactly a second older" in str(result), str(result)
