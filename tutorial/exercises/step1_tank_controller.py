@@ -7,6 +7,7 @@ Exercise 1.2, count the shots: a ``RttTankController`` subclass whose
 
 from __future__ import annotations
 
+import itertools
 import math
 from types import SimpleNamespace
 
@@ -279,15 +280,19 @@ def _state_touched(cls, presses) -> tuple[list, list]:
 
 
 def _class_state(kind: type) -> dict:
-    """``{(place, "Class.name"): value}`` of what the answer's classes (``kind``'s MRO below
-    ``RttTankController``, the check's subclass, of the answer's name, first) hold themselves: a count kept there,
-    which no instance's write shows, changes it."""
-    state = {}
-    for place, k in enumerate(kind.__mro__):
-        if k.__name__ == "RttTankController":
-            break
-        state.update({(place, f"{k.__name__}.{name}"): value for name, value in vars(k).items()})
-    return state
+    """``{(place, "Class.name"): value}`` of what the answer's classes (:func:`_answers_classes`, the check's
+    subclass first) hold themselves: a count kept there, which no instance's write shows, changes it."""
+    return {
+        (place, f"{k.__name__}.{name}"): value
+        for place, k in enumerate(_answers_classes(kind))
+        for name, value in vars(k).items()
+    }
+
+
+def _answers_classes(kind: type) -> list[type]:
+    """``kind``'s MRO up to ``RttTankController``, which it leaves out (all of it, for a class that is none): the
+    answer's classes, the check's subclass first if any."""
+    return list(itertools.takewhile(lambda k: k.__name__ != "RttTankController", kind.__mro__))
 
 
 SHORT = [1]  # a Joy with button A alone: pressed
@@ -370,12 +375,7 @@ def _watched(cls):
 
 def _answers_own(kind: type, name: str) -> bool:
     """Whether a class of the answer's (below ``RttTankController`` in ``kind``'s MRO) defines ``name`` itself."""
-    for k in kind.__mro__[1:]:  # [0] is the check's Watched
-        if k.__name__ == "RttTankController":
-            return False
-        if name in vars(k):
-            return True
-    return False
+    return any(name in vars(k) for k in _answers_classes(kind)[1:])  # [0] is the check's Watched
 
 
 # The experiments these checks have the kernel that holds the class run while grading (grader.EXPERIMENTS),
