@@ -150,6 +150,7 @@ def pytest_collection_modifyitems(config, items):
 
 HEARD: list = []  # what the grading kernel's seal would hear of the checks (an audit hook: one per process)
 SEED: list = []  # while it holds a seed, the hook puts it in the checks' seed box (rtt.seed), as the seal does
+KERNEL: list = []  # while it holds a callable, the hook puts it in observe()'s box (rtt.observe), as the judge does
 
 
 def _hear(event: str, args: tuple) -> None:
@@ -157,6 +158,8 @@ def _hear(event: str, args: tuple) -> None:
         HEARD.append((event, args))
         if event == "rtt.seed" and SEED:
             args[0].append(SEED[0])
+        if event == "rtt.observe" and KERNEL:
+            args[0].append(KERNEL[0])
 
 
 def hear_the_checks() -> list:

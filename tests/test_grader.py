@@ -19,7 +19,7 @@ import pytest
 from tutorial.exercises import grader
 from tutorial.exercises.grader import Case, CaseFailed, Result
 
-from conftest import SEED, hear_the_checks
+from conftest import KERNEL, SEED, hear_the_checks
 
 
 def failing(what: str, hint: str = ""):
@@ -216,6 +216,74 @@ def test_require_returns_a_pass_and_raises_a_failure_in_lines_of_at_most_88_char
             failed.require()
         said = str(raised.value).splitlines()
         assert len(said) == lines and said[-1] in ("  end", str(failed)), said
+
+
+# ---- an experiment, run here or in the kernel that holds the class ----
+
+
+def _experiment(cls, *args):
+    return ("ran here", cls, args)
+
+
+def test_an_experiment_runs_here_on_the_class_outside_grading():
+    hear_the_checks()
+    assert grader.observe(_experiment, int, 1, "two") == ("ran here", int, (1, "two"))
+    assert grader.observe(_experiment, int) == ("ran here", int, ())
+
+
+def test_while_grading_an_experiment_goes_to_the_kernel_by_the_judges_way_without_the_class():
+    """The judge's way to the kernel (put in the box by its audit hook) gets the experiment and its arguments; the
+    class is the kernel's, never sent."""
+    asked = []
+    hear_the_checks()
+    KERNEL[:] = [lambda func, *args: asked.append((func, args)) or "the kernel's reply"]
+    try:
+        assert grader.observe(_experiment, int, 1, "two") == "the kernel's reply"
+    finally:
+        KERNEL.clear()
+    assert asked == [(_experiment, (1, "two"))]
+    assert grader.observe(_experiment, int, 3) == ("ran here", int, (3,))  # and here again once the judge is gone
+
+
+# ---- a failed case's frames, let go ----
+
+
+def _raised(exc: BaseException) -> BaseException:
+    """``exc`` raised and caught here: it has a traceback, as a case's failure has."""
+    try:
+        raise exc
+    except BaseException as caught:  # noqa: BLE001 - the test's own
+        return caught
+
+
+def _chain() -> list[BaseException]:
+    """A case's failure and all it chains to: its context (no cause), an exception group with a cause and a
+    context of its own and two members, and a cycle back to the failure."""
+    failure, context = _raised(CaseFailed("wrong", "hint")), _raised(ValueError("the answer's own"))
+    members = [_raised(KeyError("first")), _raised(TypeError("second"))]
+    group = _raised(ExceptionGroup("two", members))
+    group_cause, group_context = _raised(OSError("cause")), _raised(RuntimeError("context"))
+    group.__cause__, group.__context__ = group_cause, group_context
+    context.__context__ = group
+    group_context.__context__ = failure  # a cycle: the chain is walked once
+    failure.__context__ = context
+    return [failure, context, group, *members, group_cause, group_context]
+
+
+@pytest.mark.timeout(20)
+@pytest.mark.parametrize("hidden", [False, True])
+def test_a_failed_case_keeps_no_traceback_anywhere_in_its_chain(hidden):
+    """An answer can keep what it raised inside a case; once the check returns, no exception of the chain holds a
+    frame (a cycle in the chain is walked once, and ends)."""
+    chain = _chain()
+    assert all(e.__traceback__ is not None for e in chain)
+
+    def run():
+        raise chain[0]
+
+    result = grader._run_cases("9.9", [Case("the case", run, hidden=hidden)])
+    assert not result.passed
+    assert [type(e).__name__ for e in chain if e.__traceback__ is not None] == []
 
 
 # ---- the hidden cases' random source ----
