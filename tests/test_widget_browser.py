@@ -76,6 +76,11 @@ DELIVER = """([msg, b64s]) => window.deliver(msg, b64s.map((b) => {
 }))"""
 
 
+def told(page, since: int = 0) -> list[dict]:
+    """What the view sent the kernel from message ``since`` on, less its ``here`` (sent on a clock of its own)."""
+    return [m for m in page.evaluate("window.sent")[since:] if m["type"] != "here"]
+
+
 def b64(buffers: list) -> list[str]:
     return [b if isinstance(b, str) else base64.b64encode(b).decode("ascii") for b in buffers]
 
@@ -153,12 +158,12 @@ def test_two_frames_drawn_together_are_answered_once_and_a_lone_frame_on_its_own
         "[new DataView(Uint8Array.from(atob(m), (c) => c.charCodeAt(0)).buffer)]); }",
         b64([pack_batch([move(1.0)]), pack_batch([move(1.5)])]),
     )
-    page.wait_for_function(f"window.sent.length > {before}", timeout=10_000)
+    page.wait_for_function(f"window.sent.slice({before}).some((m) => m.type === 'drawn')", timeout=10_000)
     page.wait_for_timeout(200)  # a second answer, were there one, would have come by now
     answers = [m for m in page.evaluate("window.sent")[before:] if m["type"] == "drawn"]
     assert answers == [{"type": "drawn", "frames": 2}], answers
     stats = frame(page, [pack_batch([move(0.0)])])  # a lone frame: answered on its own
-    assert page.evaluate("window.sent")[-1] == {"type": "drawn", "frames": 1}
+    assert told(page)[-1] == {"type": "drawn", "frames": 1}
     assert stats["dropped"] == 0 and not errors, errors
 
 
@@ -191,8 +196,8 @@ def test_a_bad_message_drops_that_frame_whole_and_the_view_goes_on(view, bad, re
     assert stats["dropped"] == before["dropped"] + 1 and stats["frames"] == before["frames"], stats
     assert reason in stats["errors"][-1], stats["errors"][-1]
     assert any("dropped a frame" in e and reason in e for e in errors), errors
-    told = [m["type"] for m in page.evaluate("window.sent")[before["sent"] :]]
-    assert "rejected" in told, told
+    types = [m["type"] for m in told(page, before["sent"])]
+    assert "rejected" in types, types
     page.wait_for_timeout(200)  # a frame was not drawn: nothing to wait on but the next animation frame
     assert abs(red_x(page) - x0) < 2, "part of a dropped frame was drawn"
     after = frame(page, [pack_batch([move(1.5)])])
@@ -217,8 +222,8 @@ def test_a_frame_that_draws_and_moves_a_new_body_draws_and_a_dropped_frame_asks_
     page.wait_for_timeout(3000)  # past the view's 2 s between asking for the scene again
     n = page.evaluate("window.sent.length")
     frame(page, [pack_batch([move(0.0, ("meshcat", "not", "drawn"))])])
-    told = [m["type"] for m in page.evaluate("window.sent")[n:]]
-    assert told[:2] == ["rejected", "hello"], f"a dropped frame did not ask for the whole scene again: {told}"
+    types = [m["type"] for m in told(page, n)]
+    assert types[:2] == ["rejected", "hello"], f"a dropped frame did not ask for the whole scene again: {types}"
 
 
 def test_a_scene_with_a_bad_command_draws_the_rest(view):
