@@ -146,14 +146,21 @@ def run_first_cell(page, url: str, most_s: float = 90.0, run_all: bool = False) 
     if run_all:
         run_all_cells(page)
         return
-    cells.first.click()
-    page.keyboard.press("Control+Enter")
+    kernel_ready(page, most_s)
+    run_cell(page, cells.first, lambda: page.keyboard.press("Control+Enter"))
 
 
 # The page's notebook has a kernel, started and idle, by the server's own word (JupyterLab's and Notebook 7's
 # indicators read idle before a kernel exists, and Run All then asks which kernel to start).
+# The server's base URL is the page's own (a hub's learner: /user/<name>/).
 KERNEL_READY = """async () => {
-    const sessions = await (await fetch('/api/sessions', {credentials: 'same-origin'})).json();
+    const config = document.getElementById('jupyter-config-data');
+    const base = (config && JSON.parse(config.textContent).baseUrl) || '/';
+    const xsrf = (document.cookie.match(/(?:^|; )_xsrf=([^;]*)/) || [])[1];  // a hub's server asks for it
+    const headers = xsrf ? {'X-XSRFToken': decodeURIComponent(xsrf)} : {};
+    const answer = await fetch(base + 'api/sessions', {credentials: 'same-origin', headers});
+    if (!answer.ok) throw new Error(`${base}api/sessions: ${answer.status} ${await answer.text()}`);
+    const sessions = await answer.json();
     return sessions.some(s => s.kernel && s.kernel.execution_state === 'idle');
 }"""
 

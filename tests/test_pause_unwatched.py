@@ -26,13 +26,14 @@ def test_a_run_no_page_shows_pauses_and_goes_on_when_one_does(ros, monkeypatch):
         # Never shown by a page (a notebook run without a browser, as tests and nbval run them): never paused.
         assert not wait_until(lambda: run.app.sim.paused, 1.5)
         page_says(run, {"type": "hello", "id": "page-1"})  # a page shows it, then goes away
-        assert wait_until(lambda: run.app.sim.paused, 10), run.status
-        assert run.status.startswith("paused at t = ") and "no page showed this view for 0 s" in run.status
+        # the status is set by the run's thread just after it paused the simulation: wait for the status
+        assert wait_until(lambda: run.status.startswith("paused at t = "), 10), run.status
+        assert run.app.sim.paused and "no page showed this view for 0 s" in run.status, run.status
         held = run.sim_time()
         assert not wait_until(lambda: run.sim_time() != held, 1.0), "simulated time went on while paused"
         page_says(run, {"type": "here"})  # a page again (a view on a visible page says so every 10 s)
+        assert wait_until(lambda: run.status.startswith(f"running (paused at t = {held:.2f} s for "), 10), run.status
         assert wait_until(lambda: not run.app.sim.paused and run.sim_time() > held + 0.1, 10), run.status
-        assert run.status.startswith(f"running (paused at t = {held:.2f} s for "), run.status
     finally:
         run.close()
     assert run.summary is not None and run.summary.get("error") is None, run.summary

@@ -302,7 +302,7 @@ def test_cut_off_from_its_kernel_the_view_says_it_is_not_live_and_an_answer_take
     before = page.evaluate("window.sent.length")
     page.evaluate("window.trigger('comm_live_update')")
     # one ping for the cut-off (a frame's lone answer, six animation frames late, may be sent beside it)
-    asked = page.evaluate(f"window.sent.slice({before}).map(m => m.type)")
+    asked = [m["type"] for m in told(page, before)]
     assert asked.count("ping") == 1 and set(asked) <= {"ping", "drawn"}, asked
     notice = page.locator(".rtt-not-live")
     notice.wait_for(timeout=10_000)
