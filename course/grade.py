@@ -183,6 +183,8 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
                     job.judge_key = secrets.token_hex(32)  # the judge's lines', which no kernel holds
                     Path(job.verdicts).unlink(missing_ok=True)
                     env["RTT_SANDBOX"] = job.to_env()
+                else:
+                    env["RTT_UNSANDBOXED"] = "1"  # the teacher's --unsandboxed (nbgrader_config.py refuses otherwise)
                 try:
                     log = nbgrader(course, "autograde", assignment, "--student", learner, "--force", env=env)
                 except RuntimeError as error:
@@ -285,6 +287,12 @@ def main(argv=None) -> int:
             if not names:
                 print("no assignment is released into the exchange yet: nothing to collect", file=sys.stderr)
                 return 1
+        unknown = [n for n in names if not (course / "source" / n / f"{n}.ipynb").is_file()]
+        if unknown:  # a typo, or make assignments not run yet: said before anything is collected or graded
+            made = sorted(p.name for p in (course / "source").glob("*") if p.is_dir())
+            print(f"not graded: no assignment {', '.join(unknown)} in {course / 'source'} (`make assignments` "
+                  f"makes them; there: {', '.join(made) or 'none'})", file=sys.stderr)  # fmt: skip
+            return 2
         ids = domains(args.domains) if args.domains else free_domains()
         csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=ids, sandboxed=not args.unsandboxed)
     except GradingError as error:

@@ -40,6 +40,7 @@ import ast
 import contextlib
 import csv
 import hmac
+import io
 import json
 import os
 import pwd
@@ -48,6 +49,7 @@ import secrets
 import shutil
 import subprocess
 import threading
+import tokenize
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -211,6 +213,26 @@ def number(grade_id: str) -> str:
     return grade_id.split("_", 1)[1].replace("_", ".")
 
 
+def names_the_checks(source: str) -> bool:
+    """Whether an answer's code names the checks' package (``tutorial.exercises``) other than to import a public
+    name from it: as a name, or as a module or file path in a string.  Comments and prose do not count (an
+    honest answer may say "like the other exercises").  A hint for the teacher, not a proof: code can spell the
+    name in pieces, and the judge and the seal decide the points."""
+    code = PUBLIC_IMPORT.sub("", source)
+    try:
+        tokens = [
+            t
+            for t in tokenize.generate_tokens(io.StringIO(code).readline)
+            if t.type in (tokenize.NAME, tokenize.STRING)
+        ]
+    except (tokenize.TokenError, SyntaxError):  # not Python (a cell cut short): its lines less their comments
+        return bool(re.search(r"\bexercises\b", re.sub(r"#.*", "", code)))
+    return any(
+        t.string == "exercises" if t.type == tokenize.NAME else re.search(r"[./]exercises\b|\bexercises[./]", t.string)
+        for t in tokens
+    )
+
+
 def judge(
     autograded: Path, verdicts: Path, log: str, died: bool = False, judge_key: str = ""
 ) -> dict[str, tuple[bool, list[str]]]:
@@ -228,7 +250,8 @@ def judge(
     exercises: dict[str, dict] = {}
     current = None
     before: list[dict] = []  # the code cells before the first exercise: a death there counts with the first
-    for cell in notebook["cells"]:
+    of_cell: dict[str, str] = {}  # a cell's index (the grader's marks on the seal's pipe): its exercise
+    for index, cell in enumerate(notebook["cells"]):
         gid = grade_id(cell)
         if gid.startswith(("exercise_", "check_")):
             current = number(gid)
@@ -239,12 +262,15 @@ def judge(
                 exercises[current]["check"] = "".join(cell["source"])
         if cell["cell_type"] == "code":
             (exercises[current]["cells"] if current else before).append(cell)
+        if current:
+            of_cell[str(index)] = current
     passed: dict[str, bool] = {}
     flags: dict[str, list[str]] = {n: [] for n in exercises}
     called = {n: set(re.findall(r"\b(check_\w+)\(", found["check"])) for n, found in exercises.items()}
     judged = {n for n, names in called.items() if JUDGED_NAMES & names}
     by_check = {name: n for n, names in called.items() for name in names}  # a note of the seal's names the check
-    pending: list[str] = []  # notes before a check: the answer cell's, which comes before it
+    pending: list[str] = []  # notes of no exercise's cell (none marked yet, or a cell before the first exercise)
+    in_cell = None  # the exercise of the cell the grader last marked as starting
     # lines split at "\n" alone, as the seal's pipe reader and the judge write them (str.splitlines() would also
     # split at "\r", "\x1c" or U+2028, which a body the kernel signed may hold)
     lines = verdicts.read_text().split("\n") if verdicts.is_file() else []
@@ -267,8 +293,12 @@ def judge(
             ex = by_check.get(rest[2], rest[2]) if len(rest) > 2 else None
             if ex in flags:  # a note that names its exercise, or the judged check it ran in the kernel for
                 flags[ex].append(flag)
+            elif in_cell:  # made while a cell of an exercise ran (its answer cell: before any check of it began)
+                flags[in_cell].append(flag)
             else:
                 pending.append(flag)
+        elif kind == "cell" and rest and not by_judge:
+            in_cell = of_cell.get(rest[0])
         elif kind == "begin" and rest:
             passed[rest[0]] = False  # the last begin of an exercise must be followed by its verdict
             flags.setdefault(rest[0], []).extend(pending)
@@ -278,6 +308,8 @@ def judge(
             passed[ex] = ok and intact
             flags.setdefault(ex, []).extend(pending + ([] if intact else ["tampering"]))
             pending = []
+    if pending and exercises:  # a note of no exercise's cell, none begun after it: the last exercise's, not lost
+        flags.setdefault(list(exercises)[-1], []).extend(pending)
     for match in re.finditer(r"Attribute '\w+' for cell (\w+) has changed", log):
         flags.setdefault(number(match.group(1)), []).append("changed cell")
     out = {}
@@ -305,7 +337,7 @@ def judge(
             mine.append("tampering")
         if "NBGRADER" in found["source"]:
             mine.append("grader-aware")
-        if re.search(r"\bexercises\b", PUBLIC_IMPORT.sub("", found["source"])):  # the checks' private rules
+        if names_the_checks(found["source"]):
             mine.append("the checks' code")
         if check_ok and not passed.get(ex, False):  # the notebook passed what the seal did not see pass
             mine.append("tampering")

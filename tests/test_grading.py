@@ -37,6 +37,7 @@ import json
 import os
 import re
 import sys
+import types
 from pathlib import Path
 
 import pytest
@@ -308,6 +309,17 @@ def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
     assert "nothing in" in capsys.readouterr().err
 
 
+def test_grading_an_assignment_the_course_does_not_have_says_so_before_anything_is_graded(tmp_path, capsys):
+    """make grade ARGS=01_step1_tank_controler (a typo), or before make assignments: which ones there are."""
+    (tmp_path / "source" / "01_step1_tank_controller").mkdir(parents=True)
+    (tmp_path / "source" / "01_step1_tank_controller" / "01_step1_tank_controller.ipynb").write_text("{}")
+    args = ["--course", str(tmp_path), "--domains", "232", "01_step1_tank_controler"]
+    assert grade.main(args) == 2
+    said = capsys.readouterr().err
+    assert "no assignment 01_step1_tank_controler" in said and "there: 01_step1_tank_controller" in said, said
+    assert not (tmp_path / "staged-exchange").exists() and not (tmp_path / "submitted").exists()
+
+
 def exchange_and_course(tmp_path: Path) -> tuple[Path, Path]:
     """An exchange with this course's folder (the teacher's, as nbgrader's release makes it) and a course
     whose nbgrader configuration names it."""
@@ -555,9 +567,11 @@ def test_a_dead_kernel_is_flagged_where_it_died_and_an_answer_cannot_say_so_itse
     executor = sandbox.SandboxedExecute()
     executor.preprocess(nb, {})
     assert not any(sandbox.KERNEL_MARK in c.metadata for c in nb.cells)
+    marked = []  # each cell's start, said on the seal's pipe (the manager's mark_cell) before it runs
+    executor.km = types.SimpleNamespace(mark_cell=marked.append)
     for index, cell in enumerate(nb.cells):
         executor.preprocess_cell(cell, {}, index)
-    assert ran == [0, 1]  # none after the kernel died
+    assert ran == [0, 1] and marked == [0, 1]  # none after the kernel died
     marks = [c.metadata.get(sandbox.KERNEL_MARK) for c in nb.cells]
     assert marks == [None, sandbox.DIED] + [sandbox.NOT_RUN_MARK] * 6
     assert nb.cells[1].outputs[-1]["evalue"] == sandbox.KERNEL_DIED
@@ -630,6 +644,24 @@ CHEATS = {
         "tampering",
     ),
     "patch-grader": ("1.2", GRADER + "grader.Result.require = lambda self: self\n", "tampering"),
+    # a file read in an answer whose check then never begins (rebound): flagged on that exercise, not the next
+    "read-and-rebind": (
+        "1.1",
+        "try:\n    open('{root}/course/grade.py').read()\nexcept OSError:\n    pass\n"
+        + GRADER
+        + "import tutorial.exercises.step1_tank_controller as m\n"
+        "m.check_dpad_steering = lambda f: grader.Result('Exercise 1.1, steer with the D-pad', True, 'passed')\n",
+        "outside its folder",
+    ),
+    # ... and in the last exercise's answer, nothing beginning after it: flagged all the same, not lost
+    "read-and-rebind-last": (
+        "1.2",
+        "try:\n    open('{root}/course/grade.py').read()\nexcept OSError:\n    pass\n"
+        + GRADER
+        + "import tutorial.exercises.step1_tank_controller as m\n"
+        "m.check_shot_counter = lambda c: grader.Result('Exercise 1.2, count the shots', True, 'passed')\n",
+        "outside its folder",
+    ),
     "always-equal": (
         "1.1",
         "class Anything(float):\n    def __eq__(self, other):\n        return True\n"
@@ -971,3 +1003,28 @@ def test_a_rebound_check_gets_0_and_is_flagged_in_every_assignment(tmp_path, mon
     flags = dict(part.split(": ", 1) for part in row["flags"].split("; ") if part)
     assert flags == {target: "tampering, the checks' code"}, row["flags"]  # it names the checks' package too
     assert float(row["score"]) == sum(float(assignments.POINTS[n]) for n in numbers[1:]), row
+
+
+def test_nbgrader_autograde_by_hand_runs_no_answer_and_says_what_to_run(tmp_path):
+    """A teacher regrading one learner with nbgrader's own command: refused (the answer would run as the teacher,
+    unsealed), nothing of the submission run, and the refusal names ``make grade``."""
+    name = IN_MAKE_TEST[0]
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    ran = tmp_path / "the-answer-ran"
+    solved = solution_of(course, name)
+    first = sorted(solved)[0]
+    answers = dict(solved, **{first: f"open({str(ran)!r}, 'w').close()\n" + solved[first]})
+    folder = course / "submitted" / "learner" / name
+    folder.mkdir(parents=True)
+    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, answers)))
+    env = {k: v for k, v in os.environ.items() if k not in ("RTT_SANDBOX", "RTT_UNSANDBOXED")}
+    with pytest.raises(RuntimeError) as refused:
+        assignments.nbgrader(course, "autograde", name, "--student", "learner", "--force", env=env)
+    assert "make grade" in str(refused.value) and "sandbox" in str(refused.value), str(refused.value)[-3000:]
+    assert not ran.exists(), "the answer ran"
+    from nbgrader.api import Gradebook
+
+    with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
+        assert gb.find_submission(name, "learner").score == 0

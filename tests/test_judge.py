@@ -318,8 +318,21 @@ def cell(gid, source, grade=False):
         ("import tutorial.exercises.step1_tank_controller as m\n", True),
         ("from tutorial.exercises.parameters_and_services import TrackSwitch  # .enabled, .lock\n", False),
         ("import math\n", False),
+        ("import importlib\nm = importlib.import_module('tutorial.exercises.grader')\n", True),
+        ("print(open('/work/tutorial/exercises/grader.py').read())\n", True),
+        ("# Like the other exercises of this notebook, the D-pad\n", False),
+        ("print('all exercises done')\n", False),
     ],
-    ids=["a private rule imported", "the module imported", "a public name, as 10.2's stub", "no checks"],
+    ids=[
+        "a private rule imported",
+        "the module imported",
+        "a public name, as 10.2's stub",
+        "no checks",
+        "imported by its name in a string",
+        "its file read",
+        "the word in a comment",
+        "the word in prose",
+    ],
 )
 def test_an_answer_naming_the_checks_package_is_flagged_unless_it_imports_public_names(tmp_path, answer, flagged):
     graded = tmp_path / "graded.ipynb"
@@ -589,3 +602,39 @@ def test_a_check_that_raises_outside_its_cases_fails_the_exercise_and_the_judge_
     assert judge_process.lines()[-1][:4] == ["judged", "verdict", "2.2", "0"]
     again = judge_process.kernel.run("check_dpad_steering", lambda axes: (0.0, 0.0))
     assert not again.passed and "Exercise 1.1" in str(again)  # judged, not "the judge is gone"
+
+
+def test_a_note_of_the_seal_counts_for_the_exercise_whose_cell_made_it_and_is_never_lost(tmp_path):
+    """The grader marks each cell's start on the seal's pipe (``SandboxedExecute``): a note made in an exercise's
+    answer cell is that exercise's, also when its check never began (rebound in the answer) or when it is the
+    last exercise; a note of no marked cell goes to the next exercise that begins, else to the last one."""
+    notebook = {
+        "cells": [
+            {"cell_type": "code", "metadata": {}, "source": "import math", "outputs": []},
+            cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
+            cell("check_1_1", "check_dpad_steering(dpad_track_velocities).require()", True),
+            cell("exercise_1_2", "class ShotCountingTankController: ..."),
+            cell("check_1_2", "check_shot_counter(ShotCountingTankController).require()", True),
+        ]
+    }
+    graded = tmp_path / "graded.ipynb"
+    graded.write_text(json.dumps(notebook))
+    verdicts = tmp_path / "verdicts.txt"
+    outside = "note\toutside\topened /course/grade.py\t\n"
+    passes_1_2 = by_judge("begin\t1.2") + by_judge("verdict\t1.2\t1\t1\t")
+    # 1.1's answer reads a file and rebinds its check (no begin of 1.1); 1.2 is graded
+    verdicts.write_text("cell\t0\ncell\t1\n" + outside + "cell\t2\ncell\t3\ncell\t4\n" + passes_1_2)
+    flags = sandboxing.judge(graded, verdicts, "")
+    assert "outside its folder" in flags["1.1"][1] and flags["1.2"] == (True, []), flags
+    # the last exercise's answer reads a file and its check is rebound: nothing begins after it
+    verdicts.write_text("cell\t0\ncell\t1\ncell\t2\n" + "cell\t3\n" + outside + "cell\t4\n")
+    flags = sandboxing.judge(graded, verdicts, "")
+    assert "outside its folder" in flags["1.2"][1] and "outside its folder" not in flags["1.1"][1], flags
+    # a note made before any exercise's cell: the next exercise to begin's; with none after it, the last one's
+    verdicts.write_text("cell\t0\n" + outside + "cell\t3\n" + passes_1_2)
+    assert sandboxing.judge(graded, verdicts, "")["1.2"] == (True, ["outside its folder"])
+    verdicts.write_text(outside)
+    assert "outside its folder" in sandboxing.judge(graded, verdicts, "")["1.2"][1]
+    # a mark in a line the judge signed is not the grader's: it moves no note
+    verdicts.write_text("cell\t1\n" + by_judge("cell\t3") + outside)
+    assert "outside its folder" in sandboxing.judge(graded, verdicts, "")["1.1"][1]

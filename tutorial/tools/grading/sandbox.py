@@ -49,10 +49,11 @@ import threading
 from pathlib import Path
 
 from jupyter_client.manager import AsyncKernelManager
+from nbconvert.preprocessors import Preprocessor
 from nbgrader.preprocessors import Execute
 
 from tutorial.tools.grading import judged
-from tutorial.tools.grading.judge import genuine
+from tutorial.tools.grading.judge import genuine, signed
 
 ENV = "RTT_SANDBOX"
 PRIVATE = ("/tmp", "/var/tmp", "/dev/shm")  # the kernel's own, empty at its start
@@ -259,6 +260,8 @@ class SandboxedKernelManager(AsyncKernelManager):
             await super()._async_launch_kernel(kernel_cmd, **kw)
         finally:
             os.close(self._key_read)
+            # the grader's own end, for the cells' marks (:meth:`mark_cell`), closed before the reader's join
+            self._marks = os.dup(self._verdict_write)
             os.close(self._verdict_write)
             self._kernels_end.close()
         job = self._job
@@ -297,6 +300,9 @@ class SandboxedKernelManager(AsyncKernelManager):
         """After the kernel ended, shut down or dead (nbclient then only cleans up): every line it and its judge
         wrote is in the verdict file before nbgrader goes on."""
         await super()._async_cleanup_resources(restart=restart)
+        marks, self._marks = getattr(self, "_marks", None), None
+        if marks is not None:  # the pipe ends (and the reader with it) when the kernel's end and this one are closed
+            os.close(marks)
         reader = getattr(self, "_reader", None)
         if reader is not None:
             await asyncio.get_running_loop().run_in_executor(None, reader.join, 10.0)
@@ -310,6 +316,14 @@ class SandboxedKernelManager(AsyncKernelManager):
 
     # what nbclient calls (the base class binds its own function); shutdown_kernel calls the method above itself
     cleanup_resources = _async_cleanup_resources
+
+    def mark_cell(self, index: int) -> None:
+        """Say on the seal's pipe that cell ``index`` of the notebook starts: the seal's notes after it, which
+        name no exercise, are the notes of that cell's exercise (``course/sandboxing.py``'s ``judge``).  The
+        kernel's lines of the cell before are in the pipe already (the seal writes them before the cell ends), so
+        the reader keeps their order.  nbgrader's event loop's thread, between cells."""
+        if getattr(self, "_marks", None) is not None:
+            os.write(self._marks, (signed(self._key, f"cell\t{index}") + "\n").encode())
 
     def _read_verdicts(self) -> None:
         """The seal's pipe, line by line, to the job's verdict file (its reader thread, until the pipe closes).
@@ -345,6 +359,30 @@ NOT_RUN = "not run: the kernel died in an earlier cell"
 # outputs, never a cell's metadata; a submission's own is taken off first), read by course/sandboxing.py's judge.
 KERNEL_MARK = "rtt_grading_kernel"
 DIED, OUT_OF_CPU_TIME, NOT_RUN_MARK = "died", "out of CPU time", "not run"
+
+
+UNSANDBOXED = "RTT_UNSANDBOXED"  # "1": course/grade.py --unsandboxed, the teacher's own choice (not for a class)
+REFUSED = (
+    "this course grades learners' code only in its sandbox: run `make grade` (course/grade.py), which starts "
+    "nbgrader autograde there, or `make grade ARGS=--unsandboxed` to run submissions with your own rights "
+    "on purpose (not for a class). Plain `nbgrader autograde` would run every answer as you, unsealed."
+)
+
+
+class RefusedExecute(Preprocessor):
+    """``nbgrader autograde`` started by hand (or by the formgrader's button): it runs no learner's code.
+
+    The course's ``nbgrader_config.py`` puts it in place of nbgrader's preprocessors unless
+    ``course/grade.py`` started the run (:data:`ENV` or :data:`UNSANDBOXED`), so a teacher regrading one
+    learner with nbgrader's own command gets a refusal that says what to run, not a grade computed with the
+    teacher's rights by the answer's own code.
+
+    Raises:
+        RuntimeError: always (:data:`REFUSED`); nbgrader names the notebook and grades nothing of it.
+    """
+
+    def __call__(self, nb, resources):  # a Preprocessor not enabled would pass the notebook on: this one never does
+        raise RuntimeError(REFUSED)
 
 
 class SandboxedExecute(Execute):
@@ -384,6 +422,7 @@ class SandboxedExecute(Execute):
                 cell.metadata[KERNEL_MARK] = NOT_RUN_MARK
             return cell, resources
         try:
+            getattr(self.km, "mark_cell", lambda index: None)(index)  # the sandbox's manager (a test's has none)
             return super().preprocess_cell(cell, resources, index)
         except DeadKernelError:
             self._died = True
