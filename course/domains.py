@@ -36,6 +36,20 @@ def hub_state() -> Path:
     return Path(os.environ.get("RTT_HUB_STATE", Path(__file__).resolve().parent / ".hub")).resolve()
 
 
+def running_hub(state: Path) -> int | None:
+    """The process ID of a JupyterHub that runs with the state folder ``state`` (its ``jupyterhub.pid``), or None.
+
+    A second hub on the same state folder would stop the first one's proxy (JupyterHub stops the process a
+    proxy's pid file names) and take its database: ``course/jupyterhub_config.py`` refuses to start then."""
+    try:
+        pid = int((state / "jupyterhub.pid").read_text().strip())
+        command = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+    except (OSError, ValueError):  # no pid file, not a number, or no such process
+        return None
+    hub = any(os.path.basename(part) == b"jupyterhub" for part in command)  # not jupyterhub-singleuser, say
+    return pid if pid != os.getpid() and hub else None
+
+
 # Fast DDS's port arithmetic on Linux (see the module's text); 0 is the default everyone shares.
 LEARNER_DOMAINS = tuple(range(1, 102)) + tuple(range(215, 233))
 NAME = re.compile(r"^[a-z0-9][a-z0-9._@-]{0,63}$")  # JupyterHub's usual (normalized, lower-case) names

@@ -1,7 +1,9 @@
 """Grade the class: collect, autograde, feedback and the grades' CSV, with nbgrader's own commands.
 
     python course/grade.py [ASSIGNMENT ...] [--course DIR] [--no-collect] [--jobs N] [--domains 215-232]
+                           [--student NAME ...]
     make grade ARGS="01_step1_tank_controller --jobs 2"
+    make grade ARGS="01_step1_tank_controller --student learner1"    # one learner's, again
 
 For each assignment (default: every one released into the exchange; with
 ``--no-collect``, every one somebody has in ``submitted/``):
@@ -31,6 +33,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import os
 import queue
 import re
@@ -45,6 +48,8 @@ from assignments import HERE, nbgrader  # noqa: E402 - this folder is not a pack
 from domains import BOOK_NAME, LEARNER_DOMAINS, DomainBook, DomainError, hub_state  # noqa: E402
 from sandboxing import Sandboxes, add_flags_column, clear, course_seed, learner_seed, settle, test_calls  # noqa: E402
 from submissions import stage  # noqa: E402
+
+from tutorial.tools.grading.sandbox import UNSANDBOXED  # noqa: E402
 
 
 def domains(text: str) -> list[int]:
@@ -102,11 +107,36 @@ def stage_submissions(course: Path) -> tuple[Path, list[str], list[str]]:
         names whose author cannot be told)
     """
     from nbgrader.coursedir import CourseDirectory
-    from traitlets.config.loader import PyFileConfigLoader
 
-    config = PyFileConfigLoader("nbgrader_config.py", path=str(course)).load_config()
+    config = course_config(course)
     limit = 1000 * CourseDirectory(config=config).max_dir_size  # as nbgrader's collect computes it
     return stage(Path(config.Exchange.root) / config.CourseDirectory.course_id, course, limit)
+
+
+def course_config(course: Path):
+    """The course's nbgrader configuration (its ``nbgrader_config.py``), as nbgrader reads it."""
+    from traitlets.config.loader import PyFileConfigLoader
+
+    return PyFileConfigLoader("nbgrader_config.py", path=str(course)).load_config()
+
+
+def enrol(course: Path, names) -> None:
+    """The learners ``names`` in the course's gradebook, so that each has a row in the grades' CSV, with zeros
+    for an assignment they never submitted (nbgrader lists only the learners its gradebook knows)."""
+    from nbgrader.api import Gradebook
+
+    if names:
+        with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
+            for name in names:
+                gb.update_or_create_student(name)
+
+
+def the_class(book: Path) -> list[str]:
+    """The learners the hub's book of domains has (each who ever started a server), or none (no hub, no book)."""
+    try:
+        return sorted(json.loads(book.read_text()))
+    except (OSError, ValueError, TypeError):  # no book here, or one that free_domains() names
+        return []
 
 
 def learners(course: Path, assignment: str) -> list[str]:
@@ -116,13 +146,22 @@ def learners(course: Path, assignment: str) -> list[str]:
 
 
 def grade(
-    course: Path, assignments: list[str], collect: bool = True, jobs: int = 1, ids=(232,), sandboxed: bool = True
+    course: Path,
+    assignments: list[str],
+    collect: bool = True,
+    jobs: int = 1,
+    ids=(232,),
+    sandboxed: bool = True,
+    students: tuple[str, ...] = (),
+    class_list: tuple[str, ...] = (),
 ) -> Path:
     """Grade ``assignments`` in ``course``; the grades' CSV (with its ``flags`` column).
 
     ``collect``: from the exchange (then each learner's feedback is released into it).  ``sandboxed``: each
     submission runs as a user of its own, without network, limited and sealed (``sandboxing.py``); its
-    exercises' points stand only where the seal saw the teacher's check pass them.
+    exercises' points stand only where the seal saw the teacher's check pass them.  ``students``: these
+    learners' submissions alone (default: every learner's); one named with no submission is a failure.
+    ``class_list``: learners who get a row in the CSV whether or not they submitted anything (:func:`enrol`).
 
     Raises:
         ValueError: more ``jobs`` than domains in ``ids`` (checked before anything is graded).
@@ -134,10 +173,19 @@ def grade(
     if jobs > len(ids):
         raise ValueError(f"{jobs} jobs need {jobs} ROS domains, {len(ids)} given")
     with Sandboxes(course, jobs) if sandboxed else contextlib.nullcontext() as boxes:
-        return _grade(course, assignments, collect, jobs, ids, boxes)
+        return _grade(course, assignments, collect, jobs, ids, boxes, students, class_list)
 
 
-def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: list[int], boxes) -> Path:
+def _grade(
+    course: Path,
+    assignments: list[str],
+    collect: bool,
+    jobs: int,
+    ids: list[int],
+    boxes,
+    students: tuple[str, ...],
+    class_list: tuple[str, ...],
+) -> Path:
     failed: list[str] = []  # submissions nbgrader could not grade (the worker threads append)
     keep_private(course)
     staged = None
@@ -145,8 +193,9 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
         staged, refused, unchecked = stage_submissions(course)
         failed.extend(f"{line} (not graded)" for line in refused)
         if unchecked:
-            print(f"who handed in the submissions of {', '.join(unchecked)} cannot be told: no Unix user of this "
-                  "machine has their name", file=sys.stderr)  # fmt: skip
+            print(f"graded as handed in, unchecked: {', '.join(unchecked)} (no Unix user of this machine has their "
+                  "name, as on the trial's spawner, so whether another learner handed one in under that name "
+                  "cannot be told)", file=sys.stderr)  # fmt: skip
     if boxes:
         course_seed(course)  # made once, before the worker threads read it
     for assignment in assignments:
@@ -155,6 +204,9 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
             nbgrader(course, "collect", assignment, "--update", f"--Exchange.root={staged}",
                      "--ExchangeCollect.check_owner=False")  # fmt: skip
         who = learners(course, assignment)
+        if students:  # a regrade of some: those named, and a name with no submission said
+            failed.extend(f"{assignment}, {name}: no submission" for name in students if name not in who)
+            who = [w for w in who if w in students]
         calls, checks = test_calls(course, assignment) if boxes else ([], [])  # the seal's, for every learner
 
         todo: queue.SimpleQueue = queue.SimpleQueue()  # the learners left: each worker takes the next when free
@@ -184,7 +236,7 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
                     Path(job.verdicts).unlink(missing_ok=True)
                     env["RTT_SANDBOX"] = job.to_env()
                 else:
-                    env["RTT_UNSANDBOXED"] = "1"  # the teacher's --unsandboxed (nbgrader_config.py refuses otherwise)
+                    env[UNSANDBOXED] = "1"  # the teacher's --unsandboxed (nbgrader_config.py refuses otherwise)
                 try:
                     log = nbgrader(course, "autograde", assignment, "--student", learner, "--force", env=env)
                 except RuntimeError as error:
@@ -212,6 +264,7 @@ def _grade(course: Path, assignments: list[str], collect: bool, jobs: int, ids: 
                 exclude = [f"--CourseDirectory.student_id_exclude={','.join(by_hand)}"] if by_hand else []
                 nbgrader(course, "release_feedback", assignment, *exclude)
     csv = course / "grades.csv"
+    enrol(course, class_list)
     given = sorted(set(assignments) | set(released(course) if collect else ()))
     nbgrader(course, "export", "--to", str(csv), *(f"--assignment={name}" for name in given))
     flagged = add_flags_column(course, csv)
@@ -269,6 +322,9 @@ def main(argv=None) -> int:
         "--domains", help="ROS domains for the jobs, as 215-232 or 5,7,9 (default: those the hub gave no learner)"
     )
     p.add_argument(
+        "--student", action="append", default=[], help="grade this learner's submission alone (again for more)"
+    )
+    p.add_argument(
         "--unsandboxed", action="store_true", help="run submissions with your own rights, unsealed (not for a class)"
     )
     args = p.parse_args(argv)
@@ -283,6 +339,11 @@ def main(argv=None) -> int:
                 print(f"nothing in {course / 'submitted'} to grade", file=sys.stderr)
                 return 1
         else:
+            exchange = Path(course_config(course).Exchange.root)
+            if not exchange.is_dir():  # nbgrader would say "Unwritable directory, please contact your instructor"
+                said = f"no exchange at {exchange} yet: `make hub` makes it, and a release puts an assignment in it"
+                print(said + " (book/course.md); to grade what is in submitted/, ARGS=--no-collect", file=sys.stderr)
+                return 1
             names = released(course)
             if not names:
                 print("no assignment is released into the exchange yet: nothing to collect", file=sys.stderr)
@@ -294,7 +355,16 @@ def main(argv=None) -> int:
                   f"makes them; there: {', '.join(made) or 'none'})", file=sys.stderr)  # fmt: skip
             return 2
         ids = domains(args.domains) if args.domains else free_domains()
-        csv = grade(course, names, collect=not args.no_collect, jobs=args.jobs, ids=ids, sandboxed=not args.unsandboxed)
+        csv = grade(
+            course,
+            names,
+            collect=not args.no_collect,
+            jobs=args.jobs,
+            ids=ids,
+            sandboxed=not args.unsandboxed,
+            students=tuple(args.student),
+            class_list=tuple(the_class(hub_state() / BOOK_NAME)),
+        )
     except GradingError as error:
         print(f"graded {', '.join(names)}: {error.csv}, but {error}", file=sys.stderr)
         return 1

@@ -46,7 +46,7 @@ COURSE = Path(__file__).resolve().parent
 ROOT = COURSE.parent
 sys.path.insert(0, str(COURSE))
 
-from domains import BOOK_NAME, DomainBook, DomainError, hub_state  # noqa: E402
+from domains import BOOK_NAME, DomainBook, DomainError, hub_state, running_hub  # noqa: E402
 from idle_stops import IdleStops, remembering_last_use  # noqa: E402
 from learner_home import make_learner_home  # noqa: E402 - course/ is on the path only from here
 from limits import LimitedLocalProcessSpawner, LimitedSimpleLocalProcessSpawner  # noqa: E402
@@ -55,9 +55,15 @@ c = get_config()  # noqa: F821 - JupyterHub provides it
 
 STATE = hub_state()
 STATE.mkdir(parents=True, exist_ok=True)
+if (already := running_hub(STATE)) is not None:
+    sys.exit(
+        f"a hub already runs with the state folder {STATE} (process {already}): a second one would stop its proxy "
+        "and take its database. Stop that one first (Ctrl+C in its terminal), or give this one another folder "
+        "(RTT_HUB_STATE) and address (RTT_HUB_URL)."
+    )
 PYTHON = Path(os.environ.get("RTT_HUB_PYTHON", ROOT / ".venv" / "bin" / "python"))
 ENV_BIN = PYTHON.parent  # jupyterhub-singleuser and the rtt-* programs of the learners' environment
-LEARNERS = [n for n in os.environ.get("RTT_HUB_LEARNERS", "learner1,learner2,learner3").split(",") if n]
+LEARNERS = [n.strip() for n in os.environ.get("RTT_HUB_LEARNERS", "learner1,learner2,learner3").split(",") if n.strip()]
 SHOW_SOLUTIONS = os.environ.get("RTT_HUB_WORKED_SOLUTIONS") == "shown"
 
 # ---- where the hub listens: this machine only, unless a course puts it behind its own HTTPS front

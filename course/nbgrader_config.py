@@ -82,11 +82,12 @@ if os.environ.get("RTT_SANDBOX"):
     # Off unless a course turns it on; then it would take off the mark a dead kernel leaves in a cell, which the
     # crash, not run and CPU-time flags are read from (course/sandboxing.py), and nbgrader's own metadata.
     c.ClearMetadataPreprocessor.preserve_cell_metadata_mask = {"nbgrader", KERNEL_MARK}
-elif os.environ.get("RTT_UNSANDBOXED") != "1":
-    # nbgrader autograde by hand, or the formgrader's button: refused, with what to run instead (a learner's
-    # code would run with the teacher's rights, unsealed; tutorial/tools/grading/sandbox.py's RefusedExecute)
-    from tutorial.tools.grading.sandbox import RefusedExecute
+else:
+    from tutorial.tools.grading.sandbox import UNSANDBOXED, RefusedExecute
 
-    c.Autograde.autograde_preprocessors = [RefusedExecute]
+    if os.environ.get(UNSANDBOXED) != "1":
+        # nbgrader autograde by hand, or the formgrader's button: refused, with what to run instead (a learner's
+        # code would run with the teacher's rights, unsealed; course/grade.py --unsandboxed sets UNSANDBOXED)
+        c.Autograde.autograde_preprocessors = [RefusedExecute]
 c.Execute.raise_on_iopub_timeout = False
 c.Execute.iopub_timeout = 30

@@ -53,17 +53,28 @@ import tokenize
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tutorial.tools.grading import keyrings
+from tutorial.tools.grading import keyrings, sandbox
 from tutorial.tools.grading.judge import JUDGED_NAMES, genuine
 from tutorial.tools.grading.sandbox import DIED, KERNEL_MARK, NOT_RUN_MARK, OUT_OF_CPU_TIME, Job
 
 ROOT = Path(__file__).resolve().parent.parent
 JOBS = Path("/var/lib/rtt-grading")
+LIBRARY = Path(sandbox.__file__).resolve().parents[3]  # the clone whose tutorial/ the graded kernels import
 TEACHERS_ONLY = ("notebooks", "course", "book", ".git")  # the repository's folders with worked solutions
 LIMIT_ERRORS = re.compile(r"MemoryError|BlockingIOError|Resource temporarily unavailable|Cannot allocate memory")
 # An import of public names from the checks' package (10.2's stub imports TrackSwitch): what an answer may name
 PUBLIC_IMPORT = re.compile(r"^[ \t]*from tutorial\.exercises\.\w+ import (?!_)\w+(?:, *(?!_)\w+)*[ \t]*(?:#.*)?$", re.M)
 CPU_SECONDS = "RTT_GRADING_CPU_SECONDS"  # a kernel's CPU time, s (RLIMIT_CPU; default 600)
+
+
+def hidden_folders(course: Path, library: Path = LIBRARY) -> list[str]:
+    """The folders a graded kernel sees empty: the course, the teacher-only folders of this repository and of the
+    one the kernel imports ``tutorial`` from (``library``: another clone, when the environment is another's),
+    the homes, ``/srv`` and the learners' exchange (``RTT_NBGRADER_EXCHANGE``) wherever the course keeps it."""
+    hide = {str(course), *(str(root / f) for root in (ROOT, library) for f in TEACHERS_ONLY), "/home", "/root", "/srv"}
+    if os.environ.get("RTT_NBGRADER_EXCHANGE"):
+        hide.add(os.environ["RTT_NBGRADER_EXCHANGE"])
+    return sorted(hide)
 
 
 class SandboxError(RuntimeError):
@@ -99,10 +110,7 @@ class Sandboxes:
         remove_stale_users()
         self.folder = JOBS / secrets.token_hex(4)
         self.folder.mkdir(mode=0o711)
-        hide = {str(self.course), *(str(ROOT / f) for f in TEACHERS_ONLY), "/home", "/root", "/srv"}
-        if os.environ.get("RTT_NBGRADER_EXCHANGE"):  # the learners' exchange, wherever the course keeps it
-            hide.add(os.environ["RTT_NBGRADER_EXCHANGE"])
-        hide = sorted(hide)
+        hide = hidden_folders(self.course)
         for k in range(self.jobs):
             name = f"rttgrade{self.folder.name[:5]}{k}"
             subprocess.run(

@@ -309,6 +309,16 @@ def test_grading_what_was_submitted_says_when_nothing_was(tmp_path, capsys):
     assert "nothing in" in capsys.readouterr().err
 
 
+def test_grading_before_there_is_an_exchange_says_where_it_comes_from(tmp_path, capsys):
+    """make grade before make hub made the exchange: not nbgrader's "please contact your instructor"."""
+    from hub import teacher_course
+
+    course = teacher_course(tmp_path / "course", tmp_path / "no-exchange")
+    assert grade.main(["--course", str(course), "--domains", "232"]) == 1
+    said = capsys.readouterr().err
+    assert f"no exchange at {tmp_path / 'no-exchange'} yet: `make hub` makes it" in said, said
+
+
 def test_grading_an_assignment_the_course_does_not_have_says_so_before_anything_is_graded(tmp_path, capsys):
     """make grade ARGS=01_step1_tank_controler (a typo), or before make assignments: which ones there are."""
     (tmp_path / "source" / "01_step1_tank_controller").mkdir(parents=True)
@@ -318,6 +328,37 @@ def test_grading_an_assignment_the_course_does_not_have_says_so_before_anything_
     said = capsys.readouterr().err
     assert "no assignment 01_step1_tank_controler" in said and "there: 01_step1_tank_controller" in said, said
     assert not (tmp_path / "staged-exchange").exists() and not (tmp_path / "submitted").exists()
+
+
+def test_grading_one_learner_grades_theirs_alone_and_names_one_who_submitted_nothing(tmp_path, capsys):
+    """make grade ARGS="--student NAME": a regrade of one learner; a name with no submission is said."""
+    name = IN_MAKE_TEST[0]
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    folder = course / "submitted" / "someone" / name
+    folder.mkdir(parents=True)
+    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, {})))
+    args = ["--course", str(course), "--no-collect", "--domains", "232", "--unsandboxed", "--student", "nobody", name]
+    assert grade.main(args) == 1
+    assert f"{name}, nobody: no submission" in capsys.readouterr().err
+    assert not (course / "autograded" / "someone").exists(), "another learner's submission was graded"
+
+
+def test_every_learner_of_the_hubs_book_has_a_row_also_without_a_submission(tmp_path):
+    """grades.csv: a row per learner the hub knows, zeros for an assignment they never handed in."""
+    name = IN_MAKE_TEST[0]
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    book = tmp_path / "ros_domains.json"
+    book.write_text(json.dumps({"learner1": 3, "late": 4}))
+    assert grade.the_class(book) == ["late", "learner1"] and grade.the_class(tmp_path / "none.json") == []
+    grade.enrol(course, grade.the_class(book))
+    out = tmp_path / "grades.csv"
+    assignments.nbgrader(course, "export", "--to", str(out), f"--assignment={name}")
+    rows = {r["student_id"]: r for r in csv.DictReader(out.open())}
+    assert set(rows) == {"late", "learner1"} and all(float(r["score"]) == 0 for r in rows.values()), rows
 
 
 def exchange_and_course(tmp_path: Path) -> tuple[Path, Path]:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -26,7 +27,7 @@ from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "course"))
 
-from domains import LEARNER_DOMAINS, DomainBook, DomainError  # noqa: E402
+from domains import LEARNER_DOMAINS, DomainBook, DomainError, running_hub  # noqa: E402
 from hub import (  # noqa: E402
     PASSWORD,
     SUBMIT,
@@ -886,3 +887,22 @@ def test_a_kernel_stopped_at_the_memory_limit_is_told_once(tmp_path, monkeypatch
     assert memory_limit_note(root, seen) == ""  # the next kernel is not told again
     (root / "memory.oom_control").write_text("oom_kill_disable 0\nunder_oom 0\noom_kill 2\n")
     assert "more than its memory limit" in memory_limit_note(root, seen)  # a second stop is
+
+
+def test_a_second_hub_on_the_same_state_folder_is_refused_while_the_first_runs(tmp_path):
+    """A second make hub would stop the first one's proxy: the state folder's pid file names a running hub."""
+    assert running_hub(tmp_path) is None  # no pid file
+    (tmp_path / "jupyterhub.pid").write_text("not a pid")
+    assert running_hub(tmp_path) is None
+    hub = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)", str(tmp_path / "bin" / "jupyterhub")])
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)", "jupyterhub-singleuser"])
+    try:
+        (tmp_path / "jupyterhub.pid").write_text(str(other.pid))  # a learner's server, not a hub
+        assert running_hub(tmp_path) is None
+        (tmp_path / "jupyterhub.pid").write_text(f"{hub.pid}\n")
+        assert running_hub(tmp_path) == hub.pid
+    finally:
+        for p in (hub, other):
+            p.kill()
+            p.wait(10)
+    assert running_hub(tmp_path) is None  # the hub it names is gone: a stale pid file

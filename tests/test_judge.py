@@ -638,3 +638,12 @@ def test_a_note_of_the_seal_counts_for_the_exercise_whose_cell_made_it_and_is_ne
     # a mark in a line the judge signed is not the grader's: it moves no note
     verdicts.write_text("cell\t1\n" + by_judge("cell\t3") + outside)
     assert "outside its folder" in sandboxing.judge(graded, verdicts, "")["1.1"][1]
+
+
+def test_a_graded_kernel_sees_the_teachers_folders_empty_in_this_clone_and_in_its_librarys(tmp_path, monkeypatch):
+    """A teacher's environment may come from another clone: its notebooks (the worked solutions) are hidden too."""
+    monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "exchange"))
+    hidden = sandboxing.hidden_folders(tmp_path / "course", library=tmp_path / "other-clone")
+    for folder in ("notebooks", "course", "book", ".git"):
+        assert str(tmp_path / "other-clone" / folder) in hidden and str(ROOT / folder) in hidden
+    assert {str(tmp_path / "course"), str(tmp_path / "exchange"), "/home", "/root", "/srv"} <= set(hidden)

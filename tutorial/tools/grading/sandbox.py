@@ -29,6 +29,9 @@ The kernel talks to nbgrader over Unix sockets (ZeroMQ's ``ipc``), which
 cross the network namespace.  Needs root (Linux: ``unshare``, ``setpriv``,
 ``prlimit``, ``ip`` from util-linux and iproute2).  The manager runs in
 nbgrader's process, on its event loop's thread; its pipe reader on a thread of its own.
+
+The module is over 400 lines and still one job: how nbgrader runs a submission's kernel in this course (the
+sandboxed kernel, its executor, and :class:`RefusedExecute`, the refusal to run one any other way).
 """
 
 from __future__ import annotations
@@ -364,8 +367,9 @@ DIED, OUT_OF_CPU_TIME, NOT_RUN_MARK = "died", "out of CPU time", "not run"
 UNSANDBOXED = "RTT_UNSANDBOXED"  # "1": course/grade.py --unsandboxed, the teacher's own choice (not for a class)
 REFUSED = (
     "this course grades learners' code only in its sandbox: run `make grade` (course/grade.py), which starts "
-    "nbgrader autograde there, or `make grade ARGS=--unsandboxed` to run submissions with your own rights "
-    "on purpose (not for a class). Plain `nbgrader autograde` would run every answer as you, unsealed."
+    'nbgrader autograde there (one learner: `make grade ARGS="--student NAME"`), or `make grade '
+    "ARGS=--unsandboxed` to run submissions with your own rights on purpose (not for a class). Plain "
+    "`nbgrader autograde` would run every answer as you, unsealed."
 )
 
 
