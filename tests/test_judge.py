@@ -311,6 +311,16 @@ def cell(gid, source, grade=False):
     return {"cell_type": "code", "metadata": meta, "source": source, "outputs": []}
 
 
+def two_exercises(check_1_2: str) -> list[dict]:
+    """Assignment 01's answer and check cells as nbgrader leaves them, 1.2's test cell calling ``check_1_2``."""
+    return [
+        cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
+        cell("check_1_1", "check_dpad_steering(dpad_track_velocities).require()", True),
+        cell("exercise_1_2", "class ShotCountingTankController: ..."),
+        cell("check_1_2", f"{check_1_2}(ShotCountingTankController).require()", True),
+    ]
+
+
 @pytest.mark.parametrize(
     "answer, flagged",
     [
@@ -345,15 +355,8 @@ def test_an_answer_naming_the_checks_package_is_flagged_unless_it_imports_public
 
 
 def test_the_grader_takes_a_judged_exercises_verdict_from_the_judge_alone(tmp_path):
-    notebook = {
-        "cells": [
-            cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
-            cell("check_1_1", "check_dpad_steering(dpad_track_velocities).require()", True),
-            # a check the judge does not run (none of the course's): its verdict is the sealed kernel's
-            cell("exercise_1_2", "class ShotCountingTankController: ..."),
-            cell("check_1_2", "check_in_the_kernel(ShotCountingTankController).require()", True),
-        ]
-    }
+    # 1.2: a check the judge does not run (none of the course's): its verdict is the sealed kernel's
+    notebook = {"cells": two_exercises("check_in_the_kernel")}
     graded = tmp_path / "graded.ipynb"
     graded.write_text(json.dumps(notebook))
     verdicts = tmp_path / "verdicts.txt"
@@ -608,15 +611,8 @@ def test_a_note_of_the_seal_counts_for_the_exercise_whose_cell_made_it_and_is_ne
     """The grader marks each cell's start on the seal's pipe (``SandboxedExecute``): a note made in an exercise's
     answer cell is that exercise's, also when its check never began (rebound in the answer) or when it is the
     last exercise; a note of no marked cell goes to the next exercise that begins, else to the last one."""
-    notebook = {
-        "cells": [
-            {"cell_type": "code", "metadata": {}, "source": "import math", "outputs": []},
-            cell("exercise_1_1", "def dpad_track_velocities(axes): ..."),
-            cell("check_1_1", "check_dpad_steering(dpad_track_velocities).require()", True),
-            cell("exercise_1_2", "class ShotCountingTankController: ..."),
-            cell("check_1_2", "check_shot_counter(ShotCountingTankController).require()", True),
-        ]
-    }
+    setup = {"cell_type": "code", "metadata": {}, "source": "import math", "outputs": []}
+    notebook = {"cells": [setup, *two_exercises("check_shot_counter")]}
     graded = tmp_path / "graded.ipynb"
     graded.write_text(json.dumps(notebook))
     verdicts = tmp_path / "verdicts.txt"
