@@ -363,7 +363,7 @@ def main(argv=None) -> int:
             ids=ids,
             sandboxed=not args.unsandboxed,
             students=tuple(args.student),
-            class_list=tuple(the_class(hub_state() / BOOK_NAME)),
+            class_list=tuple(n for n in the_class(hub_state() / BOOK_NAME) if n != os.environ.get("RTT_HUB_TEACHER")),
         )
     except GradingError as error:
         print(f"graded {', '.join(names)}: {error.csv}, but {error}", file=sys.stderr)

@@ -10,6 +10,8 @@
 #                       homes in a trial (default course/.hub)
 #   RTT_HUB_LEARNERS    the trial's learner accounts, comma-separated (default learner1,learner2,learner3)
 #   RTT_HUB_PASSWORD    the trial's shared password (at least 8 characters; default tanktutorial)
+#   RTT_HUB_TEACHER, RTT_HUB_TEACHER_PASSWORD  the teacher's account, an admin of the hub (its admin page: the
+#                       learners' servers), and its own password (at least 32 characters); default none
 #   RTT_HUB_SPAWNER     "simple" (default: every learner's server runs as this user, homes under the state
 #                       folder; a trial only) or "users" (each learner a Unix user of this machine; the hub
 #                       runs as root; RTT_HUB_PYTHON then names an environment every user can run)
@@ -86,6 +88,14 @@ c.ConfigurableHTTPProxy.pid_file = str(STATE / "proxy.pid")
 c.JupyterHub.authenticator_class = "shared-password"
 c.SharedPasswordAuthenticator.user_password = os.environ.get("RTT_HUB_PASSWORD", "tanktutorial")
 c.Authenticator.allowed_users = set(LEARNERS)
+# The teacher's account, an admin of the hub: its admin page lists the learners' servers, and starts, stops and
+# opens them.  With the shared password, an admin logs in with a password of their own, of 32 characters or more.
+TEACHER = os.environ.get("RTT_HUB_TEACHER", "").strip()
+if TEACHER:
+    if len(os.environ.get("RTT_HUB_TEACHER_PASSWORD", "")) < 32:
+        sys.exit("RTT_HUB_TEACHER needs RTT_HUB_TEACHER_PASSWORD, at least 32 characters (the admin's own)")
+    c.Authenticator.admin_users = {TEACHER}
+    c.SharedPasswordAuthenticator.admin_password = os.environ["RTT_HUB_TEACHER_PASSWORD"]
 
 # ---- where a learner's server runs.  A trial: a process of this user per learner.  A course uses one of:
 #   every learner a Unix user of this machine (The Littlest JupyterHub):  RTT_HUB_SPAWNER=users below

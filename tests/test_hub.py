@@ -75,9 +75,13 @@ print(json.dumps({{"domain": os.environ.get("ROS_DOMAIN_ID"), "nodes": sorted(se
 """
 
 
+TEACHER_PASSWORD = "the-teachers-own-password-of-32-characters"
+
+
 @pytest.fixture
 def hub(tmp_path):
-    h = Hub(tmp_path / "hub", ["learner-a", "learner-b", "learner-c"], DOMAINS)  # two domains, three learners
+    teacher = {"RTT_HUB_TEACHER": "teacher", "RTT_HUB_TEACHER_PASSWORD": TEACHER_PASSWORD}
+    h = Hub(tmp_path / "hub", ["learner-a", "learner-b", "learner-c"], DOMAINS, teacher)  # two domains, three learners
     yield h
     h.close()
     assert h.cgroups_left == [], "a learner's server stopped without removing its cgroups (course/limits.py)"
@@ -135,6 +139,14 @@ def test_each_learners_robots_are_their_own(hub, in_browsers):
     assert "/rtt-run\r" in said and f"domain={env_a['ROS_DOMAIN_ID']}\r" in said, said
     assert "project/step1.yaml\r" in said and "No such file" not in said, said
     both_submit_under_their_own_names(hub, [a, b])
+    # The teacher's account sees the learners' servers on the hub's admin page; a learner is refused it, and the
+    # shared password is no teacher's.
+    teacher = Learner(hub, "teacher")
+    assert teacher.log_in().status_code != 302 and teacher.log_in(TEACHER_PASSWORD).status_code == 302
+    users = teacher.http.get(f"{hub.url}/hub/api/users", headers={"X-XSRFToken": teacher._xsrf()}, timeout=30)
+    servers = {u["name"]: bool(u["servers"]) for u in users.json()}
+    assert servers["learner-a"] and servers["learner-b"] and not servers["teacher"], servers
+    assert a.http.get(f"{hub.url}/hub/admin", timeout=30).status_code == 403
 
     # A third learner finds no domain left: told why, given no server, and A and B run on undisturbed.
     c = Learner(hub, "learner-c")
