@@ -36,6 +36,7 @@ import io
 import json
 import os
 import re
+import shutil
 import sys
 import types
 from pathlib import Path
@@ -359,6 +360,31 @@ def test_every_learner_of_the_hubs_book_has_a_row_also_without_a_submission(tmp_
     assignments.nbgrader(course, "export", "--to", str(out), f"--assignment={name}")
     rows = {r["student_id"]: r for r in csv.DictReader(out.open())}
     assert set(rows) == {"late", "learner1"} and all(float(r["score"]) == 0 for r in rows.values()), rows
+
+
+@pytest.mark.more  # make test grades through the exchange in test_grading_notebook_01s_assignment
+def test_a_regrade_of_what_was_collected_releases_its_new_feedback(tmp_path, monkeypatch):
+    """make grade ARGS=--no-collect after a collect: the learner fetches the regrade's feedback, not the old one."""
+    import getpass
+
+    name, me = IN_MAKE_TEST[0], getpass.getuser()
+    exchange, home = tmp_path / "exchange", tmp_path / "learner"
+    exchange.mkdir()
+    home.mkdir()
+    monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(exchange))
+    course = tmp_path / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    assignments.nbgrader(course, "release_assignment", name, "--force")
+    where = ["--course", "ros-tank-tutorial", f"--Exchange.root={exchange}"]
+    assignments.nbgrader(home, "fetch_assignment", name, *where)
+    assignments.nbgrader(home, "submit", name, *where)
+    released = exchange / "ros-tank-tutorial" / "feedback"
+    grade.grade(course, [name], collect=True, ids=DOMAINS[:1], sandboxed=False)
+    assert list(released.iterdir()), "the first grading released no feedback"
+    shutil.rmtree(released)
+    grade.grade(course, [name], collect=False, ids=DOMAINS[:1], sandboxed=False, students=(me,))
+    assert released.is_dir() and list(released.iterdir()), "the regrade's feedback was not released"
 
 
 def exchange_and_course(tmp_path: Path) -> tuple[Path, Path]:
