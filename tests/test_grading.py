@@ -135,6 +135,23 @@ def submissions(course: Path, name: str, every_mistake: bool = True) -> dict[str
     return out
 
 
+@pytest.fixture(scope="module")
+def generated_01(tmp_path_factory) -> Path:
+    """Assignment 01 made and generated once for this module's tests (its source, release and gradebook)."""
+    course = tmp_path_factory.mktemp("generated") / "course"
+    assignments.make(course, release=False)
+    assignments.nbgrader(course, "generate_assignment", IN_MAKE_TEST[0], "--force")
+    return course
+
+
+@pytest.fixture
+def course_01(generated_01, tmp_path) -> Path:
+    """A copy of :func:`generated_01`, this test's own to change."""
+    course = tmp_path / "course"
+    shutil.copytree(generated_01, course, symlinks=True)
+    return course
+
+
 def grade_all(
     tmp: Path, names: list[str], every_mistake: bool = True, exchange: bool = False, cheats: tuple[str, ...] = ()
 ) -> None:
@@ -331,12 +348,10 @@ def test_grading_an_assignment_the_course_does_not_have_says_so_before_anything_
     assert not (tmp_path / "staged-exchange").exists() and not (tmp_path / "submitted").exists()
 
 
-def test_grading_one_learner_grades_theirs_alone_and_names_one_who_submitted_nothing(tmp_path, capsys):
+def test_grading_one_learner_grades_theirs_alone_and_names_one_who_submitted_nothing(tmp_path, capsys, course_01):
     """make grade ARGS="--student NAME": a regrade of one learner; a name with no submission is said."""
     name = IN_MAKE_TEST[0]
-    course = tmp_path / "course"
-    assignments.make(course, release=False)
-    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    course = course_01
     folder = course / "submitted" / "someone" / name
     folder.mkdir(parents=True)
     (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, {})))
@@ -346,12 +361,10 @@ def test_grading_one_learner_grades_theirs_alone_and_names_one_who_submitted_not
     assert not (course / "autograded" / "someone").exists(), "another learner's submission was graded"
 
 
-def test_every_learner_of_the_hubs_book_has_a_row_also_without_a_submission(tmp_path):
+def test_every_learner_of_the_hubs_book_has_a_row_also_without_a_submission(tmp_path, course_01):
     """grades.csv: a row per learner the hub knows, zeros for an assignment they never handed in."""
     name = IN_MAKE_TEST[0]
-    course = tmp_path / "course"
-    assignments.make(course, release=False)
-    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    course = course_01
     book = tmp_path / "ros_domains.json"
     book.write_text(json.dumps({"learner1": 3, "late": 4}))
     assert grade.the_class(book) == ["late", "learner1"] and grade.the_class(tmp_path / "none.json") == []
@@ -363,7 +376,7 @@ def test_every_learner_of_the_hubs_book_has_a_row_also_without_a_submission(tmp_
 
 
 @pytest.mark.more  # make test grades through the exchange in test_grading_notebook_01s_assignment
-def test_a_regrade_of_what_was_collected_releases_its_new_feedback(tmp_path, monkeypatch):
+def test_a_regrade_of_what_was_collected_releases_its_new_feedback(tmp_path, monkeypatch, course_01):
     """make grade ARGS=--no-collect after a collect: the learner fetches the regrade's feedback, not the old one."""
     import getpass
 
@@ -372,9 +385,7 @@ def test_a_regrade_of_what_was_collected_releases_its_new_feedback(tmp_path, mon
     exchange.mkdir()
     home.mkdir()
     monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(exchange))
-    course = tmp_path / "course"
-    assignments.make(course, release=False)
-    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    course = course_01
     assignments.nbgrader(course, "release_assignment", name, "--force")
     where = ["--course", "ros-tank-tutorial", f"--Exchange.root={exchange}"]
     assignments.nbgrader(home, "fetch_assignment", name, *where)
@@ -1072,13 +1083,11 @@ def test_a_rebound_check_gets_0_and_is_flagged_in_every_assignment(tmp_path, mon
     assert float(row["score"]) == sum(float(assignments.POINTS[n]) for n in numbers[1:]), row
 
 
-def test_nbgrader_autograde_by_hand_runs_no_answer_and_says_what_to_run(tmp_path):
+def test_nbgrader_autograde_by_hand_runs_no_answer_and_says_what_to_run(tmp_path, course_01):
     """A teacher regrading one learner with nbgrader's own command: refused (the answer would run as the teacher,
     unsealed), nothing of the submission run, and the refusal names ``make grade``."""
     name = IN_MAKE_TEST[0]
-    course = tmp_path / "course"
-    assignments.make(course, release=False)
-    assignments.nbgrader(course, "generate_assignment", name, "--force")
+    course = course_01
     ran = tmp_path / "the-answer-ran"
     solved = solution_of(course, name)
     first = sorted(solved)[0]
