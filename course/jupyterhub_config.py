@@ -50,7 +50,7 @@ sys.path.insert(0, str(COURSE))
 
 from domains import BOOK_NAME, DomainBook, DomainError, hub_state, running_hub  # noqa: E402
 from idle_stops import IdleStops, remembering_last_use  # noqa: E402
-from learner_home import make_learner_home  # noqa: E402 - course/ is on the path only from here
+from learner_home import close_home, make_learner_home  # noqa: E402 - course/ is on the path only from here
 from limits import LimitedLocalProcessSpawner, LimitedSimpleLocalProcessSpawner  # noqa: E402
 
 c = get_config()  # noqa: F821 - JupyterHub provides it
@@ -281,6 +281,8 @@ def give_learner_their_domain_and_notebooks(spawner):
     make_learner_home(
         home, SHOW_SOLUTIONS, ENV_BIN / "jupyter", give=lambda path: _give_to_learner(path, name, unix_user)
     )
+    if unix_user and close_home(home):  # another learner could read their answers and feedback
+        spawner.log.info("learner %s: home %s made theirs alone (700)", name, home)
     IDLE_STOPS.before_spawn(spawner)
 
 

@@ -32,6 +32,16 @@ from assignments import learner_notebook  # noqa: E402 - course/ is on the path 
 COPIED = ("project", "model", "launch_py")
 
 
+def close_home(home: Path) -> bool:
+    """``home`` readable by its owner alone (mode 700; ``useradd`` makes homes 755 where ``UMASK`` is 022), so
+    that no learner reads another's answers or feedback; whether it changed.  Raises ``OSError`` when ``home``
+    cannot be changed.  Any thread."""
+    mode = home.stat().st_mode & 0o777
+    if mode & 0o077:
+        os.chmod(home, mode & 0o700)
+    return bool(mode & 0o077)
+
+
 def make_learner_home(
     home: Path, show_solutions: bool = False, jupyter: Path | None = None, give=lambda path: None
 ) -> list[Path]:

@@ -1,13 +1,14 @@
 """nbgrader's configuration for the class: the course is this folder (``make assignments``, ``make grade``).
 
-The exchange, where learners fetch and submit, is the trial hub's
-(``course/.hub/exchange``, which ``make hub`` gives its learners) unless
-``RTT_NBGRADER_EXCHANGE`` names another (a course's server: nbgrader's
+The exchange, where learners fetch and submit, is the hub's (its state
+folder's ``exchange/``: ``course/.hub/exchange``, or under ``RTT_HUB_STATE``,
+which ``make hub`` gives its learners) unless ``RTT_NBGRADER_EXCHANGE`` names another (a course's server: nbgrader's
 usual ``/srv/nbgrader/exchange``; a test's own folder).  Every learner must
 be able to write to it (``chmod 777``, as nbgrader's documentation says).
 """
 
 import os
+import sys
 from pathlib import Path
 
 from nbgrader.preprocessors import (
@@ -29,7 +30,12 @@ c = get_config()  # noqa: F821 - given by nbgrader when it reads this file
 
 c.CourseDirectory.root = str(Path(__file__).resolve().parent)
 c.CourseDirectory.course_id = "ros-tank-tutorial"
-c.Exchange.root = os.environ.get("RTT_NBGRADER_EXCHANGE", str(Path(__file__).resolve().parent / ".hub" / "exchange"))
+# The hub's: its state folder's exchange/, which RTT_HUB_STATE moves as it moves the hub's (course/domains.py's
+# hub_state(), written out: this file imports nothing of the course, whose copies elsewhere have no course/
+# modules beside them, and nbgrader would go on without this file after an error in it), unless
+# RTT_NBGRADER_EXCHANGE names one.
+STATE = Path(os.environ.get("RTT_HUB_STATE", Path(__file__).resolve().parent / ".hub")).resolve()
+c.Exchange.root = os.environ.get("RTT_NBGRADER_EXCHANGE", str(STATE / "exchange"))
 c.Exchange.path_includes_course = True
 
 # The release shows each exercise's own stub (tutorial/tools/grading/release.py), right after nbgrader's
@@ -83,8 +89,10 @@ if os.environ.get("RTT_SANDBOX"):
     # crash, not run and CPU-time flags are read from (course/sandboxing.py), and nbgrader's own metadata.
     c.ClearMetadataPreprocessor.preserve_cell_metadata_mask = {"nbgrader", KERNEL_MARK}
 else:
-    from tutorial.tools.grading.sandbox import UNSANDBOXED, RefusedExecute
+    from tutorial.tools.grading.sandbox import REFUSED, UNSANDBOXED, RefusedExecute
 
+    if os.environ.get(UNSANDBOXED) != "1" and sys.argv[1:2] == ["autograde"]:
+        sys.exit(f"nbgrader autograde: refused, nothing changed. {REFUSED}")  # before its --force removes anything
     if os.environ.get(UNSANDBOXED) != "1":
         # nbgrader autograde by hand, or the formgrader's button: refused, with what to run instead (a learner's
         # code would run with the teacher's rights, unsealed; course/grade.py --unsandboxed sets UNSANDBOXED)

@@ -361,6 +361,39 @@ def test_grading_one_learner_grades_theirs_alone_and_names_one_who_submitted_not
     assert not (course / "autograded" / "someone").exists(), "another learner's submission was graded"
 
 
+def test_the_formgraders_autograde_runs_no_answer_either(course_01, tmp_path, monkeypatch):
+    """The formgrader's Autograde button (nbgrader's API, in the Jupyter server's process): refused the same way,
+    by the executor the course's configuration puts in nbgrader's place."""
+    from nbgrader.apps import NbGraderAPI
+    from nbgrader.coursedir import CourseDirectory
+
+    name = IN_MAKE_TEST[0]
+    ran = tmp_path / "the-answer-ran"
+    solved = solution_of(course_01, name)
+    first = sorted(solved)[0]
+    answers = dict(solved, **{first: f"open({str(ran)!r}, 'w').close()\n" + solved[first]})
+    folder = course_01 / "submitted" / "learner" / name
+    folder.mkdir(parents=True)
+    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course_01, name, answers)))
+    for variable in ("RTT_SANDBOX", "RTT_UNSANDBOXED"):
+        monkeypatch.delenv(variable, raising=False)
+    monkeypatch.chdir(course_01)
+    config = grade.course_config(course_01)
+    api = NbGraderAPI(coursedir=CourseDirectory(config=config, root=str(course_01)), config=config)
+    result = api.autograde(name, "learner")
+    assert not result["success"] and "make grade" in result["error"] + result.get("log", ""), result
+    assert not ran.exists(), "the answer ran"
+
+
+def test_the_teachers_exchange_is_the_hubs_wherever_its_state_folder_is(tmp_path, monkeypatch):
+    """RTT_HUB_STATE moves the hub's exchange: the teacher's nbgrader (the course's configuration) follows it."""
+    monkeypatch.delenv("RTT_NBGRADER_EXCHANGE", raising=False)
+    monkeypatch.setenv("RTT_HUB_STATE", str(tmp_path / "state"))
+    assert grade.course_config(ROOT / "course").Exchange.root == str(tmp_path / "state" / "exchange")
+    monkeypatch.setenv("RTT_NBGRADER_EXCHANGE", str(tmp_path / "srv"))
+    assert grade.course_config(ROOT / "course").Exchange.root == str(tmp_path / "srv")
+
+
 def test_every_learner_of_the_hubs_book_has_a_row_also_without_a_submission(tmp_path, course_01):
     """grades.csv: a row per learner the hub knows, zeros for an assignment they never handed in."""
     name = IN_MAKE_TEST[0]
@@ -1095,12 +1128,16 @@ def test_nbgrader_autograde_by_hand_runs_no_answer_and_says_what_to_run(tmp_path
     folder = course / "submitted" / "learner" / name
     folder.mkdir(parents=True)
     (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, answers)))
+    graded_before = course / "autograded" / "learner" / name / "graded-before.txt"  # an earlier grading's copy
+    graded_before.parent.mkdir(parents=True)
+    graded_before.write_text("kept")
     env = {k: v for k, v in os.environ.items() if k not in ("RTT_SANDBOX", "RTT_UNSANDBOXED")}
     with pytest.raises(RuntimeError) as refused:
         assignments.nbgrader(course, "autograde", name, "--student", "learner", "--force", env=env)
+    assert graded_before.is_file(), "nbgrader's --force removed the earlier grading's copy before the refusal"
     assert "make grade" in str(refused.value) and "sandbox" in str(refused.value), str(refused.value)[-3000:]
     assert not ran.exists(), "the answer ran"
-    from nbgrader.api import Gradebook
+    from nbgrader.api import Gradebook, MissingEntry
 
-    with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb:
-        assert gb.find_submission(name, "learner").score == 0
+    with Gradebook(f"sqlite:///{course / 'gradebook.db'}") as gb, pytest.raises(MissingEntry):
+        gb.find_submission(name, "learner")  # refused before nbgrader wrote anything

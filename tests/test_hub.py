@@ -514,6 +514,9 @@ def test_learners_as_unix_users_have_their_own_robots(tmp_path, shared_environme
             assert (int(uid), home) == (entry.pw_uid, entry.pw_dir)
             for theirs in ("notebooks/02_step2_joint_state_publisher.ipynb", "project/step1.yaml", "model"):
                 assert (Path(home) / theirs).stat().st_uid == entry.pw_uid, f"{learner.name}'s {theirs} is not theirs"
+        # useradd made their homes others can read (UMASK 022): the hub closed each, so B cannot read A's notebooks
+        peeked = b.run(f"import os; print(os.access({pwd.getpwnam(a.name).pw_dir + '/notebooks'!r}, os.R_OK))")
+        assert peeked.strip() == "False", "a learner can read another learner's home"
         results = {}
         for name, learner, with_joy in (("a", a, True), ("b", b, False)):  # one after the other: a slow machine
             results[name] = run_drive(learner, with_joy)
@@ -918,3 +921,16 @@ def test_a_second_hub_on_the_same_state_folder_is_refused_while_the_first_runs(t
             p.kill()
             p.wait(10)
     assert running_hub(tmp_path) is None  # the hub it names is gone: a stale pid file
+
+
+def test_a_learners_home_is_made_theirs_alone(tmp_path):
+    """Learners as Unix users: useradd makes homes others can read (UMASK 022); the hub closes each one."""
+    from learner_home import close_home
+
+    home = tmp_path / "home"
+    home.mkdir(mode=0o755)
+    os.chmod(home, 0o755)
+    assert close_home(home) and home.stat().st_mode & 0o777 == 0o700
+    assert not close_home(home) and home.stat().st_mode & 0o777 == 0o700  # closed already: left as it is
+    os.chmod(home, 0o750)
+    assert close_home(home) and home.stat().st_mode & 0o777 == 0o700
