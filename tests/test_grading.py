@@ -361,6 +361,20 @@ def test_grading_one_learner_grades_theirs_alone_and_names_one_who_submitted_not
     assert not (course / "autograded" / "someone").exists(), "another learner's submission was graded"
 
 
+def submitted_with_a_mark(course: Path, tmp_path: Path) -> Path:
+    """Learner ``learner``'s submission of assignment 01 in ``course``: the worked solutions, the first answer
+    cell leaving a file when it runs; that file (which must not exist after a run that runs no answer)."""
+    name = IN_MAKE_TEST[0]
+    ran = tmp_path / "the-answer-ran"
+    solved = solution_of(course, name)
+    first = sorted(solved)[0]
+    answers = dict(solved, **{first: f"open({str(ran)!r}, 'w').close()\n" + solved[first]})
+    folder = course / "submitted" / "learner" / name
+    folder.mkdir(parents=True)
+    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, answers)))
+    return ran
+
+
 def test_the_formgraders_autograde_runs_no_answer_either(course_01, tmp_path, monkeypatch):
     """The formgrader's Autograde button (nbgrader's API, in the Jupyter server's process): refused the same way,
     by the executor the course's configuration puts in nbgrader's place."""
@@ -368,13 +382,7 @@ def test_the_formgraders_autograde_runs_no_answer_either(course_01, tmp_path, mo
     from nbgrader.coursedir import CourseDirectory
 
     name = IN_MAKE_TEST[0]
-    ran = tmp_path / "the-answer-ran"
-    solved = solution_of(course_01, name)
-    first = sorted(solved)[0]
-    answers = dict(solved, **{first: f"open({str(ran)!r}, 'w').close()\n" + solved[first]})
-    folder = course_01 / "submitted" / "learner" / name
-    folder.mkdir(parents=True)
-    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course_01, name, answers)))
+    ran = submitted_with_a_mark(course_01, tmp_path)
     for variable in ("RTT_SANDBOX", "RTT_UNSANDBOXED"):
         monkeypatch.delenv(variable, raising=False)
     monkeypatch.chdir(course_01)
@@ -1121,13 +1129,7 @@ def test_nbgrader_autograde_by_hand_runs_no_answer_and_says_what_to_run(tmp_path
     unsealed), nothing of the submission run, and the refusal names ``make grade``."""
     name = IN_MAKE_TEST[0]
     course = course_01
-    ran = tmp_path / "the-answer-ran"
-    solved = solution_of(course, name)
-    first = sorted(solved)[0]
-    answers = dict(solved, **{first: f"open({str(ran)!r}, 'w').close()\n" + solved[first]})
-    folder = course / "submitted" / "learner" / name
-    folder.mkdir(parents=True)
-    (folder / f"{name}.ipynb").write_text(json.dumps(submission(course, name, answers)))
+    ran = submitted_with_a_mark(course, tmp_path)
     graded_before = course / "autograded" / "learner" / name / "graded-before.txt"  # an earlier grading's copy
     graded_before.parent.mkdir(parents=True)
     graded_before.write_text("kept")
