@@ -198,6 +198,8 @@ def _grade(
                   "cannot be told)", file=sys.stderr)  # fmt: skip
     if boxes:
         course_seed(course)  # made once, before the worker threads read it
+    # feedback goes back into the exchange when one is there: collected now, or before (a --no-collect regrade)
+    exchange = collect or Path(course_config(course).Exchange.root).is_dir()
     for assignment in assignments:
         if collect:
             # the staged copies are the teacher's: nbgrader's owner check would warn of every one
@@ -258,10 +260,9 @@ def _grade(
             nbgrader(course, "generate_feedback", assignment, "--force")
             # Into the exchange, for the learners whose submission came through it (nbgrader submit's timestamp
             # and secret, which release_feedback needs): one put into submitted/ by hand is handed back by hand.
-            # A regrade of what was collected before (--no-collect) releases the new feedback too.
             came = ("timestamp.txt", "submission_secret.txt")
             by_hand = [w for w in who if not all((course / "feedback" / w / assignment / f).is_file() for f in came)]
-            if len(by_hand) < len(who) and (collect or Path(course_config(course).Exchange.root).is_dir()):
+            if exchange and len(by_hand) < len(who):
                 exclude = [f"--CourseDirectory.student_id_exclude={','.join(by_hand)}"] if by_hand else []
                 nbgrader(course, "release_feedback", assignment, *exclude)
     csv = course / "grades.csv"

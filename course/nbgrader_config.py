@@ -91,11 +91,12 @@ if os.environ.get("RTT_SANDBOX"):
 else:
     from tutorial.tools.grading.sandbox import REFUSED, UNSANDBOXED, RefusedExecute
 
-    if os.environ.get(UNSANDBOXED) != "1" and sys.argv[1:2] == ["autograde"]:
-        sys.exit(f"nbgrader autograde: refused, nothing changed. {REFUSED}")  # before its --force removes anything
     if os.environ.get(UNSANDBOXED) != "1":
         # nbgrader autograde by hand, or the formgrader's button: refused, with what to run instead (a learner's
-        # code would run with the teacher's rights, unsealed; course/grade.py --unsandboxed sets UNSANDBOXED)
+        # code would run with the teacher's rights, unsealed; course/grade.py --unsandboxed sets UNSANDBOXED).
+        # The command is refused here, before its --force removes anything; the button, by the executor.
+        if sys.argv[1:2] == ["autograde"]:
+            sys.exit(f"nbgrader autograde: refused, nothing changed. {REFUSED}")
         c.Autograde.autograde_preprocessors = [RefusedExecute]
 c.Execute.raise_on_iopub_timeout = False
 c.Execute.iopub_timeout = 30
