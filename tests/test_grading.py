@@ -375,6 +375,7 @@ def submitted_with_a_mark(course: Path, tmp_path: Path) -> Path:
     return ran
 
 
+@pytest.mark.more  # make test keeps the command's refusal (test_nbgrader_autograde_by_hand_runs_no_answer_...)
 def test_the_formgraders_autograde_runs_no_answer_either(course_01, tmp_path, monkeypatch):
     """The formgrader's Autograde button (nbgrader's API, in the Jupyter server's process): refused the same way,
     by the executor the course's configuration puts in nbgrader's place."""
